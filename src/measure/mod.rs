@@ -1,0 +1,257 @@
+//! Per-image measurements at a given threshold: contact pixels, intensities and contact patches.
+//!
+//! The real contact area is the number of contact pixels times the pixel area (Weber et al. 2018,
+//! Methods: Microscopy); the conversion to µm² happens in [`crate::analysis`], where the pixel
+//! size is known. Patches are 8-connected regions of contact pixels.
+
+use image::{ImageBuffer, Luma};
+use imageproc::region_labelling::{connected_components, Connectivity};
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::stack::{Plane, Samples};
+use crate::threshold::{ContactRule, Threshold};
+
+/// A binary contact mask, row-major, 1 = contact, 0 = not.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Mask {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// One byte per pixel: 1 for contact, 0 otherwise.
+    pub data: Vec<u8>,
+}
+
+impl Mask {
+    /// Contact flags as booleans.
+    pub fn as_bools(&self) -> Vec<bool> {
+        self.data.iter().map(|&m| m != 0).collect()
+    }
+}
+
+/// What one image gives at one threshold, in pixel and intensity units.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Measurement {
+    /// Pixels with value > t.
+    pub contact_pixels: u64,
+    /// Pixels with a finite value.
+    pub finite_pixels: u64,
+    /// Mean value over contact pixels; `None` without contact.
+    pub mean_intensity: Option<f64>,
+    /// Sum of values over contact pixels.
+    pub integrated_intensity: f64,
+    /// Mean value over finite non-contact pixels; `None` if every pixel is contact.
+    pub background_mean: Option<f64>,
+    /// Number of 8-connected contact regions.
+    pub patches: u64,
+    /// Pixels in the largest patch.
+    pub largest_patch_pixels: u64,
+}
+
+/// Running sums over one class of pixels.
+#[derive(Default, Clone, Copy)]
+struct ClassSums {
+    count: u64,
+    sum: f64,
+}
+
+impl ClassSums {
+    fn mean(&self) -> Option<f64> {
+        (self.count > 0).then(|| self.sum / self.count as f64)
+    }
+}
+
+/// Classify every pixel and measure. Errors if the threshold's rule does not fit the data.
+pub fn measure(plane: &Plane, threshold: &Threshold) -> Result<(Measurement, Mask)> {
+    if !threshold.fits(&plane.samples) {
+        return Err(Error::InvalidArgument(format!(
+            "a threshold for {} data cannot be applied to {} data",
+            match threshold.rule {
+                ContactRule::CodeAbove { .. } => "integer",
+                _ => "float",
+            },
+            plane.sample_type.name()
+        )));
+    }
+    let mut mask = vec![0u8; plane.len()];
+    let (contact, background) = classify(plane, threshold.rule, &mut mask);
+    let mask = Mask {
+        width: plane.width,
+        height: plane.height,
+        data: mask,
+    };
+    let (patches, largest_patch_pixels) = patch_stats(&mask);
+    let measurement = Measurement {
+        contact_pixels: contact.count,
+        finite_pixels: contact.count + background.count,
+        mean_intensity: contact.mean(),
+        integrated_intensity: contact.sum,
+        background_mean: background.mean(),
+        patches,
+        largest_patch_pixels,
+    };
+    Ok((measurement, mask))
+}
+
+/// Fill `mask` and return the (contact, background) sums.
+fn classify(plane: &Plane, rule: ContactRule, mask: &mut [u8]) -> (ClassSums, ClassSums) {
+    match (&plane.samples, rule) {
+        (Samples::Int { codes, offset }, ContactRule::CodeAbove { code_threshold }) => {
+            classify_codes(codes, *offset, code_threshold, mask)
+        }
+        (Samples::Float(values), rule) => {
+            let is_contact = |v: f32| match rule {
+                ContactRule::BinAbove { binning, bin } => binning.index(v).is_some_and(|b| b > bin),
+                ContactRule::ValueAbove { value } => f64::from(v) > value,
+                ContactRule::CodeAbove { .. } => false,
+            };
+            let (mut contact, mut background) = (ClassSums::default(), ClassSums::default());
+            for (m, &v) in mask.iter_mut().zip(values) {
+                if !v.is_finite() {
+                    continue;
+                }
+                let class = if is_contact(v) {
+                    *m = 1;
+                    &mut contact
+                } else {
+                    &mut background
+                };
+                class.count += 1;
+                class.sum += f64::from(v);
+            }
+            (contact, background)
+        }
+        (Samples::Int { .. }, _) => unreachable!("checked by Threshold::fits"),
+    }
+}
+
+/// Integer classification with exact integer sums (the hot loop of a series analysis).
+fn classify_codes(
+    codes: &[u16],
+    offset: i32,
+    code_threshold: i64,
+    mask: &mut [u8],
+) -> (ClassSums, ClassSums) {
+    let k = code_threshold.clamp(-1, i64::from(u16::MAX));
+    let (mut n_contact, mut s_contact, mut s_all) = (0u64, 0u64, 0u64);
+    for (m, &c) in mask.iter_mut().zip(codes) {
+        let is_contact = i64::from(c) > k;
+        *m = u8::from(is_contact);
+        n_contact += u64::from(is_contact);
+        s_contact += u64::from(c) * u64::from(is_contact);
+        s_all += u64::from(c);
+    }
+    let n_background = codes.len() as u64 - n_contact;
+    let with_offset = |sum: u64, n: u64| sum as f64 + f64::from(offset) * n as f64;
+    (
+        ClassSums {
+            count: n_contact,
+            sum: with_offset(s_contact, n_contact),
+        },
+        ClassSums {
+            count: n_background,
+            sum: with_offset(s_all - s_contact, n_background),
+        },
+    )
+}
+
+/// Number of 8-connected contact regions and the pixel count of the largest.
+pub fn patch_stats(mask: &Mask) -> (u64, u64) {
+    if mask.data.iter().all(|&m| m == 0) {
+        return (0, 0);
+    }
+    let image: ImageBuffer<Luma<u8>, Vec<u8>> =
+        ImageBuffer::from_raw(mask.width as u32, mask.height as u32, mask.data.clone())
+            .expect("mask buffer has width × height bytes");
+    let labels = connected_components(&image, Connectivity::Eight, Luma([0u8]));
+    let mut sizes: Vec<u64> = Vec::new();
+    for label in labels.pixels().map(|p| p.0[0] as usize) {
+        if label == 0 {
+            continue;
+        }
+        if sizes.len() < label {
+            sizes.resize(label, 0);
+        }
+        sizes[label - 1] += 1;
+    }
+    (sizes.len() as u64, sizes.iter().copied().max().unwrap_or(0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::threshold::{Binning, Histogram};
+
+    fn mask_from(rows: &[&str]) -> Mask {
+        let width = rows[0].len();
+        let data = rows
+            .iter()
+            .flat_map(|r| r.bytes().map(|b| u8::from(b == b'#')))
+            .collect();
+        Mask {
+            width,
+            height: rows.len(),
+            data,
+        }
+    }
+
+    #[test]
+    fn patches_are_eight_connected() {
+        let mask = mask_from(&["#..#.", ".#..#", ".....", "##..#"]);
+        // Diagonal neighbours join: {(0,0),(1,1)}, {(0,3),(1,4)}, {(3,0),(3,1)}, {(3,4)}.
+        assert_eq!(patch_stats(&mask), (4, 2));
+        assert_eq!(patch_stats(&mask_from(&["...", "..."])), (0, 0));
+    }
+
+    #[test]
+    fn measures_integer_image_exactly() {
+        let plane = Plane::from_u16(3, 2, vec![10, 10, 300, 12, 400, 500]);
+        let mut h = Histogram::new(Binning::Integer { offset: 0 });
+        h.add_plane(&plane).unwrap();
+        let t = Threshold::otsu(&h, "test").unwrap();
+        assert_eq!(t.value, 12.0);
+        let (m, mask) = measure(&plane, &t).unwrap();
+        assert_eq!(mask.data, vec![0, 0, 1, 0, 1, 1]);
+        assert_eq!(m.contact_pixels, 3);
+        assert_eq!(m.integrated_intensity, 1200.0);
+        assert_eq!(m.mean_intensity, Some(400.0));
+        assert_eq!(m.background_mean, Some(32.0 / 3.0));
+        assert_eq!(m.patches, 1);
+        assert_eq!(m.largest_patch_pixels, 3);
+    }
+
+    #[test]
+    fn offsets_are_applied_to_intensities() {
+        let plane = Plane {
+            width: 2,
+            height: 1,
+            sample_type: crate::stack::SampleType::I16,
+            samples: Samples::Int {
+                codes: vec![32768 - 5, 32768 + 7],
+                offset: -32768,
+            },
+        };
+        let t = Threshold::manual(0.0, &plane.samples);
+        let (m, _) = measure(&plane, &t).unwrap();
+        assert_eq!(m.contact_pixels, 1);
+        assert_eq!(m.mean_intensity, Some(7.0));
+        assert_eq!(m.background_mean, Some(-5.0));
+    }
+
+    #[test]
+    fn float_images_skip_non_finite_pixels() {
+        let plane = Plane {
+            width: 4,
+            height: 1,
+            sample_type: crate::stack::SampleType::F32,
+            samples: Samples::Float(vec![0.1, f32::NAN, 0.9, 1.0]),
+        };
+        let t = Threshold::manual(0.5, &plane.samples);
+        let (m, mask) = measure(&plane, &t).unwrap();
+        assert_eq!(mask.data, vec![0, 0, 1, 1]);
+        assert_eq!(m.finite_pixels, 3);
+        assert_eq!(m.contact_pixels, 2);
+        assert!(measure(&Plane::from_u16(1, 1, vec![3]), &t).is_err());
+    }
+}
