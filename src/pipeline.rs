@@ -75,6 +75,7 @@ pub fn run_analyze(request: &AnalyzeRequest, progress: Progress) -> Result<Analy
         .files
         .iter()
         .map(|f| f.path.clone())
+        .chain(request.series.manifest.clone())
         .collect();
     let staging = Staging::new(&request.out_dir, &inputs)?;
     let sink = |i: usize, image: &ImageRef, plane: &Plane, mask: &Mask| -> Result<()> {

@@ -328,6 +328,7 @@ fn csv_error(e: csv::Error) -> Error {
 pub fn inputs_json(series: &Series, analysis: &Analysis) -> Value {
     json!({
         "images": series.images.len(),
+        "manifest": series.manifest.as_ref().map(|m| m.display().to_string()),
         "channel": series.channel,
         "files": series.files.iter().map(|f| json!({
             "path": f.path.display().to_string(),

@@ -100,6 +100,16 @@ fn parse_number(number: &str, whole: &str) -> Result<f64> {
     Ok(value)
 }
 
+/// `value × factor`, dividing by the exact power of ten for sub-unit factors so that `200nm`
+/// gives exactly the literal `200e-9` (multiplying by the inexact `1e-9` would not).
+fn scale(value: f64, factor: f64) -> f64 {
+    if factor < 1.0 {
+        value / (1.0 / factor).round()
+    } else {
+        value * factor
+    }
+}
+
 fn unit_factor(dim: Dimension, unit: &str, whole: &str) -> Result<f64> {
     dim.factor(unit).ok_or_else(|| {
         if unit.is_empty() {
@@ -123,7 +133,7 @@ fn unit_factor(dim: Dimension, unit: &str, whole: &str) -> Result<f64> {
 pub fn parse_quantity(text: &str, dim: Dimension) -> Result<f64> {
     let (number, unit) = split_number(text);
     let value = parse_number(number, text)?;
-    Ok(value * unit_factor(dim, unit, text)?)
+    Ok(scale(value, unit_factor(dim, unit, text)?))
 }
 
 /// Parse a positive quantity (pixel sizes, radii, moduli).
@@ -161,7 +171,7 @@ pub fn parse_quantity_list(text: &str, dim: Dimension) -> Result<Vec<f64>> {
             unit_factor(dim, unit, item)?
         };
         pending_unit = Some(factor);
-        values[i] = value * factor;
+        values[i] = scale(value, factor);
     }
     Ok(values)
 }
@@ -203,7 +213,12 @@ mod tests {
 
     #[test]
     fn parses_units_and_rejects_missing_or_unknown_ones() {
-        assert_relative_eq!(parse_quantity("290um", Dimension::Length).unwrap(), 290e-6);
+        assert_eq!(parse_quantity("290um", Dimension::Length).unwrap(), 290e-6);
+        assert_eq!(parse_quantity("200nm", Dimension::Length).unwrap(), 200e-9);
+        assert_eq!(
+            parse_quantity_list("4,6mN", Dimension::Force).unwrap(),
+            [4e-3, 6e-3]
+        );
         assert_relative_eq!(parse_quantity("290 µm", Dimension::Length).unwrap(), 290e-6);
         assert_relative_eq!(
             parse_quantity("3.7GPa", Dimension::Pressure).unwrap(),

@@ -36,6 +36,8 @@ pub struct Series {
     pub files: Vec<TiffInfo>,
     /// Selected channel.
     pub channel: usize,
+    /// The manifest the series came from, if any.
+    pub manifest: Option<PathBuf>,
 }
 
 impl Series {
@@ -212,6 +214,7 @@ pub fn from_files(inputs: &[PathBuf], channel: Option<usize>) -> Result<Series> 
         images,
         channel: table.channel(),
         files: table.files,
+        manifest: None,
     })
 }
 
@@ -315,6 +318,7 @@ pub fn from_manifest(manifest: &Path, channel: Option<usize>) -> Result<Series> 
         images,
         channel: table.channel(),
         files: table.files,
+        manifest: Some(manifest.to_path_buf()),
     })
 }
 

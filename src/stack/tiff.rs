@@ -287,13 +287,15 @@ fn convert_samples(
             SampleType::F64,
             Samples::Float(pick.apply(v).into_iter().map(|x| x as f32).collect()),
         ),
-        other => return Err(Error::Unsupported {
-            at: at.clone(),
-            reason: format!(
+        other => {
+            return Err(Error::Unsupported {
+                at: at.clone(),
+                reason: format!(
                 "sample format {} (contactscope reads uint8, uint16, int16, float32 and float64)",
                 decoding_name(&other)
             ),
-        }),
+            })
+        }
     };
     Ok(converted)
 }
