@@ -130,7 +130,7 @@ fn file_series_in_natural_order_gives_one_threshold() {
     let Some(dir) = common::shared_data("real-tiff/neubias/mitocheck-movie") else {
         return;
     };
-    let s = series::from_files(&[dir.clone()], None).unwrap();
+    let s = series::from_files(std::slice::from_ref(&dir), None).unwrap();
     assert_eq!(s.images.len(), 30);
     let names: Vec<String> = s
         .images
