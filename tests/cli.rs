@@ -25,6 +25,37 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// A little-endian classic TIFF with one 16-bit grey strip of 8 bytes but a declared size of
+/// `width × height`.
+fn absurd_tiff(width: u32, height: u32) -> Vec<u8> {
+    let entries: [(u16, u16, u32); 8] = [
+        (256, 4, width),  // ImageWidth
+        (257, 4, height), // ImageLength
+        (258, 3, 16),     // BitsPerSample
+        (259, 3, 1),      // Compression: none
+        (262, 3, 1),      // PhotometricInterpretation: BlackIsZero
+        (273, 4, 110),    // StripOffsets
+        (278, 4, height), // RowsPerStrip
+        (279, 4, 8),      // StripByteCounts
+    ];
+    let mut b = b"II*\x00\x08\x00\x00\x00".to_vec();
+    b.extend_from_slice(&(entries.len() as u16).to_le_bytes());
+    for (tag, kind, value) in entries {
+        b.extend_from_slice(&tag.to_le_bytes());
+        b.extend_from_slice(&kind.to_le_bytes());
+        b.extend_from_slice(&1u32.to_le_bytes());
+        if kind == 3 {
+            b.extend_from_slice(&(value as u16).to_le_bytes());
+            b.extend_from_slice(&[0, 0]);
+        } else {
+            b.extend_from_slice(&value.to_le_bytes());
+        }
+    }
+    b.extend_from_slice(&0u32.to_le_bytes());
+    b.extend_from_slice(&[1, 0, 2, 0, 3, 0, 4, 0]);
+    b
+}
+
 /// The run failed cleanly: non-zero exit, one error line that names `needle`, no output folder.
 fn assert_clean_failure(out: &std::process::Output, needle: &str, out_dir: &Path) {
     assert!(!out.status.success(), "should fail: {}", stdout(out));
@@ -404,6 +435,13 @@ fn bad_inputs_fail_cleanly() {
     let o = analyze(&[s(&u32_file), "--forces", "4mN"]);
     assert_clean_failure(&o, "uint32.tif", &out_dir);
     assert!(stderr(&o).contains("unsupported"), "{}", stderr(&o));
+
+    // A header claiming 200000 × 200000 pixels in a tiny file: refused before allocating.
+    let absurd = d.join("absurd.tif");
+    fs::write(&absurd, absurd_tiff(200_000, 200_000)).unwrap();
+    let o = analyze(&[s(&absurd), "--forces", "4mN"]);
+    assert_clean_failure(&o, "absurd.tif", &out_dir);
+    assert!(stderr(&o).contains("limit"), "{}", stderr(&o));
 
     // Mismatched shapes in a series.
     let mixed = d.join("mixed");

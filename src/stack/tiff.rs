@@ -20,7 +20,7 @@ use super::{PixelSize, PixelSizeSource, Plane, SampleType, Samples};
 use crate::error::{Error, Location, Result};
 
 /// Largest decoded page we accept (bytes); guards allocations against absurd header dimensions.
-pub const MAX_PAGE_BYTES: usize = 2 << 30;
+pub const MAX_PAGE_BYTES: usize = 1 << 30;
 
 /// How the channels of a file are stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
