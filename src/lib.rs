@@ -17,6 +17,36 @@
 //!    [`pipeline`] runs the whole `analyze` job.
 //! 7. [`synth`] — a seeded generator of realistic load series with known ground truth.
 //!
+//! ```
+//! use contactscope::measure::measure;
+//! use contactscope::stack::Plane;
+//! use contactscope::synth::{generate, SynthParams};
+//! use contactscope::threshold::{Binning, Histogram, Threshold};
+//!
+//! // Two loads of a small synthetic series (12-bit, 0.2 µm pixels, known true contact).
+//! let params = SynthParams { width: 64, height: 64, forces_n: vec![4e-3, 8e-3], ..SynthParams::default() };
+//! let images = generate(&params)?;
+//! let planes: Vec<Plane> = images
+//!     .iter()
+//!     .map(|im| Plane::from_u16(64, 64, im.codes.clone()))
+//!     .collect();
+//!
+//! // One histogram over the whole series, one exact Otsu threshold.
+//! let mut pooled = Histogram::new(Binning::Integer { offset: 0 });
+//! for plane in &planes {
+//!     pooled.add_plane(plane)?;
+//! }
+//! let t = Threshold::otsu(&pooled, "series")?;
+//!
+//! // Contact area = contact pixels × pixel area (0.04 µm²).
+//! for (plane, truth) in planes.iter().zip(&images) {
+//!     let (m, _mask) = measure(plane, &t)?;
+//!     let area_um2 = m.contact_pixels as f64 * 0.04;
+//!     assert!((area_um2 / truth.true_area_um2 - 1.0).abs() < 0.15);
+//! }
+//! # Ok::<(), contactscope::Error>(())
+//! ```
+//!
 //! Units: SI inside the library; names of output fields carry their unit (`area_um2`,
 //! `force_mN`). Conventions are written down once in `docs/conventions.md`.
 
