@@ -3,10 +3,12 @@
 //! Pass 1 reads every image once, checks it against the series' first image, and accumulates the
 //! series histogram (per-image histograms merged into one; for float data the finite range first,
 //! then a second histogram pass). The threshold is chosen from the pooled histogram. Pass 2
-//! classifies and measures each image. Decoded planes are kept between passes only up to a memory
-//! budget; the rest are decoded again, so a 500-image series never needs 500 images in memory.
-//! Files are processed in parallel (rayon); pages of one file in order.
+//! classifies and measures each image. Decoded planes of compressed files are kept between passes
+//! up to a memory budget; the rest are decoded again (re-reading an uncompressed page costs less
+//! than keeping it), so a 500-image series never needs 500 images in memory. Work is split into
+//! runs of images of one file, each with its own decoder, processed in parallel (rayon).
 
+use std::collections::HashMap;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -22,8 +24,8 @@ use crate::threshold::{
     histogram, Binning, FloatBinning, Histogram, Method, Threshold, FLOAT_BINS,
 };
 
-/// Default budget for decoded planes kept between the two passes.
-pub const DEFAULT_MEMORY_BUDGET: usize = 256 << 20;
+/// Default budget for decoded planes of compressed files kept between the two passes.
+pub const DEFAULT_MEMORY_BUDGET: usize = 128 << 20;
 
 /// Sphere radius and contact modulus for the Hertz reference columns.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -43,7 +45,7 @@ pub struct AnalysisOptions {
     pub pixel_size_override: Option<(f64, f64)>,
     /// Hertz reference parameters.
     pub hertz: Option<HertzParams>,
-    /// Bytes of decoded planes to keep between passes.
+    /// Bytes of decoded planes of compressed files to keep between passes.
     pub memory_budget: usize,
 }
 
@@ -329,18 +331,25 @@ fn series_pixel_size(
     Ok(first.pixel_size)
 }
 
-/// Reads the series' planes, keeping decoded planes up to a budget for later passes.
+/// Reads the series' planes, keeping decoded planes of compressed files up to a budget.
 struct PlaneReader<'a> {
     series: &'a Series,
     cache: Mutex<Vec<Option<Arc<Plane>>>>,
+    cacheable: Vec<bool>,
     budget_left: Mutex<usize>,
 }
 
 impl<'a> PlaneReader<'a> {
     fn new(series: &'a Series, budget: usize) -> Self {
+        let compressed = |path: &Path| {
+            series
+                .info_of(path)
+                .is_some_and(|info| info.compression != "none")
+        };
         PlaneReader {
             series,
             cache: Mutex::new(vec![None; series.images.len()]),
+            cacheable: series.images.iter().map(|i| compressed(&i.path)).collect(),
             budget_left: Mutex::new(budget),
         }
     }
@@ -361,10 +370,10 @@ impl<'a> PlaneReader<'a> {
         })
     }
 
-    /// Apply `f` to every image; files in parallel, pages of a file in order. Results come back
+    /// Apply `f` to every image, in parallel over runs of images of one file. Results come back
     /// in image order; the first error in image order is returned.
     fn scan<T: Send>(&self, f: impl Fn(usize, &Plane) -> Result<T> + Sync) -> Result<Vec<T>> {
-        let groups = group_by_file(&self.series.images);
+        let groups = work_units(&self.series.images, rayon::current_num_threads());
         let results: Vec<Vec<(usize, Result<T>)>> = groups
             .par_iter()
             .map(|indices| {
@@ -395,7 +404,7 @@ impl<'a> PlaneReader<'a> {
         }
         let plane = Arc::new(self.read(reader, &self.series.images[i])?);
         let mut left = self.budget_left.lock().expect("lock");
-        if plane.heap_bytes() <= *left {
+        if self.cacheable[i] && plane.heap_bytes() <= *left {
             *left -= plane.heap_bytes();
             self.cache.lock().expect("lock")[i] = Some(plane.clone());
         }
@@ -437,14 +446,22 @@ fn check_plane(plane: &Plane, series: &Series, path: &Path, page: usize) -> Resu
     Ok(())
 }
 
-/// Indices of images grouped by file, groups in first-use order.
-fn group_by_file(images: &[ImageRef]) -> Vec<Vec<usize>> {
-    let mut groups: Vec<(&Path, Vec<usize>)> = Vec::new();
+/// Units of parallel work: the image indices of each file (files in first-use order), split into
+/// runs short enough that a single multi-page file keeps every thread busy. Each unit opens its
+/// own decoder.
+fn work_units(images: &[ImageRef], threads: usize) -> Vec<Vec<usize>> {
+    let mut by_file: HashMap<&Path, usize> = HashMap::new();
+    let mut groups: Vec<Vec<usize>> = Vec::new();
     for (i, image) in images.iter().enumerate() {
-        match groups.iter_mut().find(|(p, _)| *p == image.path.as_path()) {
-            Some((_, g)) => g.push(i),
-            None => groups.push((&image.path, vec![i])),
-        }
+        let g = *by_file.entry(&image.path).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(i);
     }
-    groups.into_iter().map(|(_, g)| g).collect()
+    let run = images.len().div_ceil(4 * threads.max(1)).max(1);
+    groups
+        .iter()
+        .flat_map(|g| g.chunks(run).map(<[usize]>::to_vec))
+        .collect()
 }

@@ -4,8 +4,8 @@
 //! Methods: Microscopy); the conversion to µm² happens in [`crate::analysis`], where the pixel
 //! size is known. Patches are 8-connected regions of contact pixels.
 
-use image::{ImageBuffer, Luma};
-use imageproc::region_labelling::{connected_components, Connectivity};
+pub mod patches;
+
 use serde::Serialize;
 
 use crate::error::{Error, Result};
@@ -158,24 +158,7 @@ fn classify_codes(
 
 /// Number of 8-connected contact regions and the pixel count of the largest.
 pub fn patch_stats(mask: &Mask) -> (u64, u64) {
-    if mask.data.iter().all(|&m| m == 0) {
-        return (0, 0);
-    }
-    let image: ImageBuffer<Luma<u8>, Vec<u8>> =
-        ImageBuffer::from_raw(mask.width as u32, mask.height as u32, mask.data.clone())
-            .expect("mask buffer has width × height bytes");
-    let labels = connected_components(&image, Connectivity::Eight, Luma([0u8]));
-    let mut sizes: Vec<u64> = Vec::new();
-    for label in labels.pixels().map(|p| p.0[0] as usize) {
-        if label == 0 {
-            continue;
-        }
-        if sizes.len() < label {
-            sizes.resize(label, 0);
-        }
-        sizes[label - 1] += 1;
-    }
-    (sizes.len() as u64, sizes.iter().copied().max().unwrap_or(0))
+    patches::count_patches(&mask.data, mask.width)
 }
 
 #[cfg(test)]
