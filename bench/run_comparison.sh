@@ -75,7 +75,7 @@ cs_cmd() { # layout memory_mib
     echo "$CS analyze ${INPUT[$1]} --forces $F40 --out $ROOT/out/$1-m$2 --quiet --memory-mib $2"
 }
 for layout in "${LAYOUTS[@]}"; do
-    for mem in 256 0; do
+    for mem in 128 0; do
         cmd=$(cs_cmd "$layout" "$mem")
         if command -v hyperfine >/dev/null; then
             hyperfine --warmup 2 --runs "$RUNS" -N --export-json "$RES/hyperfine_${layout}_m$mem.json" \
@@ -103,7 +103,7 @@ done
 command -v hyperfine >/dev/null && for layout in files multipage; do
     input=$ROOT/big/$layout
     [[ $layout == multipage ]] && input=$input/series.tif
-    for mem in 256 0; do
+    for mem in 128 0; do
         hyperfine --warmup 1 --runs 5 -N --export-json "$RES/hyperfine_big_${layout}_m$mem.json" \
             --command-name "contactscope 500x512 $layout --memory-mib $mem" \
             "$CS analyze $input --forces $F500 --out $ROOT/out/bigh-$layout-m$mem --quiet --memory-mib $mem"
@@ -121,7 +121,7 @@ rss() { # label command…
 {
     echo "# peak RSS (GNU time 'Maximum resident set size', MiB) and wall time"
     for layout in "${LAYOUTS[@]}"; do
-        for mem in 256 0; do
+        for mem in 128 0; do
             # shellcheck disable=SC2046
             rss "cs_40x1024_${layout}_m$mem" $(cs_cmd "$layout" "$mem")
         done
@@ -129,7 +129,7 @@ rss() { # label command…
     for layout in files multipage; do
         input=$ROOT/big/$layout
         [[ $layout == multipage ]] && input=$input/series.tif
-        for mem in 256 64 0; do
+        for mem in 128 32 0; do
             rss "cs_500x512_${layout}_m$mem" "$CS" analyze "$input" --forces "$F500" \
                 --out "$ROOT/out/big-$layout-m$mem" --quiet --memory-mib "$mem"
         done
@@ -148,7 +148,7 @@ import csv, json, sys
 root, res = sys.argv[1], sys.argv[2]
 for layout in ["files_raw", "multipage_raw", "files_lzw", "multipage_lzw"]:
     py = json.load(open(f"{res}/python_{layout}.json"))["layouts"][layout]
-    for mem in (256, 0):
+    for mem in (128, 0):
         rows = list(csv.DictReader(open(f"{root}/out/{layout}-m{mem}/areas.csv")))
         t = {float(r["threshold"]) for r in rows}
         cs = [int(r["contact_pixels"]) for r in rows]
@@ -159,7 +159,7 @@ for layout in ["files_raw", "multipage_raw", "files_lzw", "multipage_lzw"]:
 # 500 × 512²: contactscope (both layouts, every budget) against the python run on big/files
 py = list(csv.DictReader(open(f"{root}/python-out/big_files.csv")))
 for layout in ["files", "multipage"]:
-    for mem in (256, 64, 0):
+    for mem in (128, 32, 0):
         cs = list(csv.DictReader(open(f"{root}/out/big-{layout}-m{mem}/areas.csv")))
         a = [int(r["contact_pixels"]) for r in cs]
         b = [int(r["contact_pixels"]) for r in py]
@@ -174,17 +174,6 @@ for k in ["contact_pixels", "area_um2", "mean_intensity", "integrated_intensity"
     rel = max(abs(float(a[k]) - float(b[k])) / max(abs(float(b[k])), 1e-300) for a, b in zip(cs, py))
     print(f"files_raw column {k:22} max relative difference {rel:.1e}")
 PYEOF
-
-# ---- diagnostic: the same CLI runs with glibc malloc never trimming or mmapping ------------------
-# (shows how much of the time is page faults from per-image scratch allocations; not a fix)
-TUN=glibc.malloc.trim_threshold=4294967296:glibc.malloc.mmap_threshold=4294967296
-command -v hyperfine >/dev/null && for layout in "${LAYOUTS[@]}"; do
-    for mem in 256 0; do
-        GLIBC_TUNABLES=$TUN hyperfine --warmup 2 --runs "$RUNS" -N \
-            --export-json "$RES/hyperfine_tunables_${layout}_m$mem.json" \
-            --command-name "contactscope $layout --memory-mib $mem (GLIBC_TUNABLES)" "$(cs_cmd "$layout" "$mem")"
-    done
-done
 
 # ---- summaries ---------------------------------------------------------------------------------
 python3 - "$RES" "$REPO" <<'PYEOF' | tee "$RES/summary.txt"

@@ -129,7 +129,16 @@ pub fn generate(p: &SynthParams) -> Result<Vec<SynthImage>> {
     let psf_sigma_px = p.psf_fwhm_m / (8.0 * 2f64.ln()).sqrt() / p.pixel_size_m;
     let mut images = Vec::with_capacity(p.forces_n.len());
     for &force in &p.forces_n {
-        let n_contact = ((p.true_area_m2(force) / pixel_area).round() as usize).min(order.len());
+        let n_contact = (p.true_area_m2(force) / pixel_area).round() as usize;
+        if n_contact * 2 > order.len() {
+            return Err(Error::InvalidArgument(format!(
+                "the true contact at {} mN ({:.0} µm²) would cover more than half the {}×{} px field; use a larger image or smaller loads",
+                force * 1e3,
+                p.true_area_m2(force) * 1e12,
+                p.width,
+                p.height
+            )));
+        }
         let mut truth = vec![false; order.len()];
         for &i in &order[..n_contact] {
             truth[i] = true;

@@ -13,8 +13,8 @@ use contactscope::synth::{self, Layout, SynthParams};
 
 fn small_series(dir: &Path, layout: Layout) -> Vec<PathBuf> {
     let p = SynthParams {
-        width: 96,
-        height: 96,
+        width: 128,
+        height: 128,
         forces_n: vec![4e-3, 8e-3, 16e-3, 32e-3],
         ..SynthParams::default()
     };
@@ -173,7 +173,7 @@ fn analyze_a_directory_with_forces() {
     assert_eq!(summary["contactscope_version"], env!("CARGO_PKG_VERSION"));
     assert_eq!(summary["threshold"]["method"], "otsu-global");
     assert_eq!(summary["threshold"]["value"], thresholds[0]);
-    assert_eq!(summary["threshold"]["histogram_pixels"], 4 * 96 * 96);
+    assert_eq!(summary["threshold"]["histogram_pixels"], 4 * 128 * 128);
     assert_eq!(
         summary["inputs"]["pixel_size_used"]["source"],
         "ImageJ unit + X/YResolution"
