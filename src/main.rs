@@ -75,8 +75,8 @@ struct AnalyzeArgs {
     /// Write the contact masks as TIFF.
     #[arg(long)]
     save_masks: bool,
-    /// Decoded images kept in memory between the two passes, in MiB.
-    #[arg(long, default_value_t = 256)]
+    /// Decoded images of compressed files kept in memory between the two passes, in MiB.
+    #[arg(long, default_value_t = analysis::DEFAULT_MEMORY_BUDGET >> 20)]
     memory_mib: usize,
     /// No progress bar.
     #[arg(long, short)]
@@ -362,7 +362,11 @@ fn info(args: InfoArgs) -> Result<()> {
         i.sample_type.name(),
         i.bits_per_sample
     );
-    println!("channels:     {} ({:?})", i.channels, i.channel_layout);
+    println!(
+        "channels:     {} ({})",
+        i.channels,
+        i.channel_layout.describe()
+    );
     println!(
         "compression:  {} (predictor: {}), {}{}, {}-endian",
         i.compression,

@@ -146,9 +146,9 @@ fn check_file(info: &TiffInfo, first: Option<&TiffInfo>, channel: Option<usize>)
         None if info.channels > 1 => Err(Error::bad_input(
             Location::file(&info.path),
             format!(
-                "file has {} channels ({:?}); choose one with --channel 0..{}",
+                "file has {} channels ({}); choose one with --channel 0..{}",
                 info.channels,
-                info.channel_layout,
+                info.channel_layout.describe(),
                 info.channels - 1
             ),
         )),

@@ -36,6 +36,18 @@ pub enum ChannelLayout {
     ImageJPages,
 }
 
+impl ChannelLayout {
+    /// A short description for people.
+    pub fn describe(self) -> &'static str {
+        match self {
+            ChannelLayout::Single => "one channel",
+            ChannelLayout::Contiguous => "interleaved samples per pixel",
+            ChannelLayout::Planar => "one plane per sample (planar)",
+            ChannelLayout::ImageJPages => "ImageJ hyperstack, one page per channel",
+        }
+    }
+}
+
 /// What a TIFF file holds, read from its headers without decoding pixel data.
 #[derive(Debug, Clone, Serialize)]
 pub struct TiffInfo {
