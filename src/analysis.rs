@@ -19,7 +19,7 @@ use crate::error::{Error, Location, Result};
 use crate::measure::{measure, Mask, Measurement};
 use crate::stack::series::{ImageRef, Series};
 use crate::stack::tiff::TiffReader;
-use crate::stack::{PixelSize, PixelSizeSource, Plane};
+use crate::stack::{PixelSize, PixelSizeSource, Plane, Samples};
 use crate::threshold::{
     histogram, Binning, FloatBinning, Histogram, Method, Threshold, FLOAT_BINS,
 };
@@ -230,7 +230,7 @@ fn choose_thresholds(
     let pixels = pooled.total();
     let series_threshold = match method {
         Method::GlobalOtsu => Some(Threshold::otsu(&pooled, "the series")?),
-        Method::Manual(t) => Some(Threshold::manual(t, &reader.sample_kind()?)),
+        Method::Manual(t) => Some(Threshold::manual(t, &empty_samples(series))),
         Method::PerImageOtsu => None,
     };
     let thresholds = per_image
@@ -278,6 +278,18 @@ fn per_image_otsu(method: Method, hist: &Histogram, image: &ImageRef) -> Result<
 
 fn image_name(image: &ImageRef) -> String {
     Location::page(&image.path, image.page).to_string()
+}
+
+/// No pixels, but the series' kind of samples (what a manual threshold needs to know).
+fn empty_samples(series: &Series) -> Samples {
+    if series.files[0].sample_type.is_integer() {
+        Samples::Int {
+            codes: Vec::new(),
+            offset: integer_offset(series),
+        }
+    } else {
+        Samples::Float(Vec::new())
+    }
 }
 
 fn integer_offset(series: &Series) -> i32 {
@@ -352,22 +364,6 @@ impl<'a> PlaneReader<'a> {
             cacheable: series.images.iter().map(|i| compressed(&i.path)).collect(),
             budget_left: Mutex::new(budget),
         }
-    }
-
-    /// A plane of the series' kind (for manual thresholds).
-    fn sample_kind(&self) -> Result<crate::stack::Samples> {
-        let image = &self.series.images[0];
-        let plane = match self.cache.lock().expect("lock")[0].clone() {
-            Some(p) => p,
-            None => Arc::new(self.read(&mut None, image)?),
-        };
-        Ok(match &plane.samples {
-            crate::stack::Samples::Int { offset, .. } => crate::stack::Samples::Int {
-                codes: Vec::new(),
-                offset: *offset,
-            },
-            crate::stack::Samples::Float(_) => crate::stack::Samples::Float(Vec::new()),
-        })
     }
 
     /// Apply `f` to every image, in parallel over runs of images of one file. Results come back
