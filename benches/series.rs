@@ -20,20 +20,17 @@
 //! `docs/performance.md`.
 
 use std::hint::black_box;
-use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
-use tiff::encoder::{colortype, Compression, Rational, TiffEncoder};
-use tiff::tags::{ResolutionUnit, Tag};
 
 use contactscope::analysis::{self, AnalysisOptions, DEFAULT_MEMORY_BUDGET};
 use contactscope::measure::{measure, patch_stats};
 use contactscope::report::Report;
 use contactscope::stack::series::{self, Series};
 use contactscope::stack::tiff::TiffReader;
-use contactscope::stack::write::encode_u16_stack;
+use contactscope::stack::write::{encode_u16_stack_compressed, Compression};
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::{Binning, Histogram, Threshold};
 use contactscope::units::{self, Dimension};
@@ -50,42 +47,6 @@ fn forces_text() -> String {
         .map(|i| format!("{:.3}", 4.0 * 100f64.powf(i as f64 / (IMAGES - 1) as f64)))
         .collect();
     format!("{}mN", items.join(","))
-}
-
-/// Same ImageJ header as `contactscope synth-series` writes.
-fn description(pages: usize) -> String {
-    format!(
-        "ImageJ=1.11a\nimages={pages}\nslices={pages}\nloop=false\nunit=micron\n\
-         contactscope synth-series seed={SEED} fwhm_nm=450\n"
-    )
-}
-
-/// 16-bit grey pages with LZW compression (no predictor), ImageJ calibration as above.
-fn encode_lzw(pages: &[&[u16]]) -> Vec<u8> {
-    let mut bytes = Cursor::new(Vec::new());
-    let mut encoder = TiffEncoder::new(&mut bytes)
-        .expect("encoder")
-        .with_compression(Compression::Lzw);
-    let per_micron = || Rational {
-        n: 1_000_000,
-        d: (PIXEL_SIZE_M * 1e12).round() as u32,
-    };
-    for (i, page) in pages.iter().enumerate() {
-        let mut image = encoder
-            .new_image::<colortype::Gray16>(SIZE as u32, SIZE as u32)
-            .expect("page");
-        if i == 0 {
-            image
-                .encoder()
-                .write_tag(Tag::ImageDescription, description(pages.len()).as_str())
-                .expect("description");
-        }
-        image.resolution_unit(ResolutionUnit::None);
-        image.x_resolution(per_micron());
-        image.y_resolution(per_micron());
-        image.write_data(page).expect("pixels");
-    }
-    bytes.into_inner()
 }
 
 /// Generated files, one folder per layout.
@@ -151,26 +112,25 @@ fn generate() -> Data {
     for name in ["files_raw", "multipage_raw", "files_lzw", "multipage_lzw"] {
         let dir = root.join(name);
         std::fs::create_dir_all(&dir).expect("layout folder");
-        let lzw = name.ends_with("lzw");
+        let compression = if name.ends_with("lzw") {
+            Compression::Lzw
+        } else {
+            Compression::None
+        };
         let bytes: u64 = if name.starts_with("files") {
             pages
                 .iter()
                 .enumerate()
                 .map(|(i, page)| {
-                    let tiff = if lzw {
-                        encode_lzw(&[page])
-                    } else {
-                        encode_u16_stack(&[page], SIZE, SIZE, size, &extra).expect("encode")
-                    };
+                    let tiff =
+                        encode_u16_stack_compressed(&[page], SIZE, SIZE, size, &extra, compression)
+                            .expect("encode");
                     write(&dir.join(format!("load_{:02}.tif", i + 1)), &tiff)
                 })
                 .sum()
         } else {
-            let tiff = if lzw {
-                encode_lzw(&pages)
-            } else {
-                encode_u16_stack(&pages, SIZE, SIZE, size, &extra).expect("encode")
-            };
+            let tiff = encode_u16_stack_compressed(&pages, SIZE, SIZE, size, &extra, compression)
+                .expect("encode");
             write(&dir.join("series.tif"), &tiff)
         };
         eprintln!(

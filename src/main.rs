@@ -12,6 +12,7 @@ use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
 use contactscope::pipeline::{self, AnalyzeRequest};
 use contactscope::stack::series::{self, Series};
 use contactscope::stack::tiff::TiffReader;
+use contactscope::stack::write::Compression;
 use contactscope::synth::{self, Layout, SynthParams};
 use contactscope::threshold::Method;
 use contactscope::units::{self, Dimension};
@@ -113,6 +114,16 @@ enum LayoutArg {
     Files,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum CompressionArg {
+    /// Uncompressed.
+    None,
+    /// LZW.
+    Lzw,
+    /// Deflate.
+    Deflate,
+}
+
 #[derive(clap::Args)]
 struct SynthArgs {
     /// Output folder.
@@ -133,6 +144,9 @@ struct SynthArgs {
     /// multipage or files.
     #[arg(long, value_enum, default_value = "multipage")]
     layout: LayoutArg,
+    /// TIFF compression.
+    #[arg(long, value_enum, default_value = "none")]
+    compression: CompressionArg,
 }
 
 #[derive(clap::Args)]
@@ -405,7 +419,12 @@ fn synth_series(args: SynthArgs) -> Result<()> {
         LayoutArg::Multipage => Layout::MultiPage,
         LayoutArg::Files => Layout::Files,
     };
-    for path in synth::write_series(&params, &args.out, layout)? {
+    let compression = match args.compression {
+        CompressionArg::None => Compression::None,
+        CompressionArg::Lzw => Compression::Lzw,
+        CompressionArg::Deflate => Compression::Deflate,
+    };
+    for path in synth::write_series_compressed(&params, &args.out, layout, compression)? {
         println!("{}", path.display());
     }
     Ok(())

@@ -20,7 +20,7 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::output::write_atomic;
-use crate::stack::write::encode_u16_stack;
+use crate::stack::write::{encode_u16_stack_compressed, Compression};
 
 /// Parameters of a synthetic series. SI units.
 #[derive(Debug, Clone, Serialize)]
@@ -259,6 +259,16 @@ pub enum Layout {
 /// Write a generated series into `dir`: the TIFF(s), `manifest.csv` (file, page, force_mN) and
 /// `truth.csv` (true contact pixels and area per image). Returns the files written.
 pub fn write_series(p: &SynthParams, dir: &Path, layout: Layout) -> Result<Vec<PathBuf>> {
+    write_series_compressed(p, dir, layout, Compression::None)
+}
+
+/// [`write_series`] with a choice of TIFF compression.
+pub fn write_series_compressed(
+    p: &SynthParams,
+    dir: &Path,
+    layout: Layout,
+    compression: Compression,
+) -> Result<Vec<PathBuf>> {
     let images = generate(p)?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let size = Some((p.pixel_size_m, p.pixel_size_m));
@@ -267,12 +277,15 @@ pub fn write_series(p: &SynthParams, dir: &Path, layout: Layout) -> Result<Vec<P
         p.seed,
         p.psf_fwhm_m * 1e9
     );
+    let encode = |pages: &[&[u16]]| {
+        encode_u16_stack_compressed(pages, p.width, p.height, size, &description, compression)
+    };
     let mut written = Vec::new();
     let mut locations = Vec::new();
     match layout {
         Layout::MultiPage => {
             let pages: Vec<&[u16]> = images.iter().map(|im| im.codes.as_slice()).collect();
-            let bytes = encode_u16_stack(&pages, p.width, p.height, size, &description)?;
+            let bytes = encode(&pages)?;
             written.push(write_file(dir, "series.tif", &bytes)?);
             locations.extend((0..images.len()).map(|i| ("series.tif".to_string(), i)));
         }
@@ -280,7 +293,7 @@ pub fn write_series(p: &SynthParams, dir: &Path, layout: Layout) -> Result<Vec<P
             let digits = images.len().to_string().len().max(2);
             for (i, im) in images.iter().enumerate() {
                 let name = format!("load_{:0digits$}.tif", i + 1);
-                let bytes = encode_u16_stack(&[&im.codes], p.width, p.height, size, &description)?;
+                let bytes = encode(&[&im.codes])?;
                 written.push(write_file(dir, &name, &bytes)?);
                 locations.push((name, 0));
             }

@@ -8,9 +8,10 @@ use std::path::Path;
 
 use contactscope::analysis::{analyze, Analysis, AnalysisOptions};
 use contactscope::stack::series;
+use contactscope::stack::write::{encode_u16_stack_compressed, Compression};
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::Method;
-use tiff::encoder::{colortype, Compression, TiffEncoder};
+use tiff::encoder::{colortype, TiffEncoder};
 
 fn params() -> SynthParams {
     SynthParams {
@@ -23,15 +24,10 @@ fn params() -> SynthParams {
 
 /// Write the pages as one Deflate-compressed multi-page TIFF (no calibration).
 fn write_deflate(path: &Path, pages: &[Vec<u16>], width: usize, height: usize) {
-    let mut bytes = Cursor::new(Vec::new());
-    let mut enc = TiffEncoder::new(&mut bytes)
-        .unwrap()
-        .with_compression(Compression::Deflate(Default::default()));
-    for page in pages {
-        enc.write_image::<colortype::Gray16>(width as u32, height as u32, page)
-            .unwrap();
-    }
-    std::fs::write(path, bytes.into_inner()).unwrap();
+    let pages: Vec<&[u16]> = pages.iter().map(Vec::as_slice).collect();
+    let bytes =
+        encode_u16_stack_compressed(&pages, width, height, None, "", Compression::Deflate).unwrap();
+    std::fs::write(path, bytes).unwrap();
 }
 
 fn run(paths: &[std::path::PathBuf], options: &AnalysisOptions) -> Analysis {

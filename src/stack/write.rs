@@ -6,7 +6,7 @@
 
 use std::io::Cursor;
 
-use tiff::encoder::{colortype, Rational, TiffEncoder, TiffValue};
+use tiff::encoder::{colortype, Compression as TiffCompression, Rational, TiffEncoder, TiffValue};
 use tiff::tags::{ResolutionUnit, Tag};
 
 use crate::error::{Error, Result};
@@ -33,18 +33,43 @@ fn imagej_description(pages: usize, pixel_size: Option<(f64, f64)>, extra: &str)
     d
 }
 
+/// Compression of written TIFF pages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Compression {
+    /// Uncompressed strips.
+    #[default]
+    None,
+    /// LZW, no predictor.
+    Lzw,
+    /// Adobe Deflate, no predictor.
+    Deflate,
+}
+
+impl Compression {
+    fn to_tiff(self) -> TiffCompression {
+        match self {
+            Compression::None => TiffCompression::Uncompressed,
+            Compression::Lzw => TiffCompression::Lzw,
+            Compression::Deflate => TiffCompression::Deflate(Default::default()),
+        }
+    }
+}
+
 fn encode_stack<C: colortype::ColorType>(
     pages: &[&[C::Inner]],
     width: usize,
     height: usize,
     pixel_size: Option<(f64, f64)>,
     extra_description: &str,
+    compression: Compression,
 ) -> Result<Vec<u8>>
 where
     [C::Inner]: TiffValue,
 {
     let mut bytes = Cursor::new(Vec::new());
-    let mut encoder = TiffEncoder::new(&mut bytes).map_err(encode_error)?;
+    let mut encoder = TiffEncoder::new(&mut bytes)
+        .map_err(encode_error)?
+        .with_compression(compression.to_tiff());
     let description = imagej_description(pages.len(), pixel_size, extra_description);
     for (i, page) in pages.iter().enumerate() {
         if page.len() != width * height {
@@ -72,7 +97,8 @@ where
     Ok(bytes.into_inner())
 }
 
-/// Encode 16-bit grey pages as one multi-page TIFF with ImageJ calibration (pixel size in m).
+/// Encode 16-bit grey pages as one uncompressed multi-page TIFF with ImageJ calibration (pixel
+/// size in m).
 pub fn encode_u16_stack(
     pages: &[&[u16]],
     width: usize,
@@ -80,7 +106,33 @@ pub fn encode_u16_stack(
     pixel_size: Option<(f64, f64)>,
     extra_description: &str,
 ) -> Result<Vec<u8>> {
-    encode_stack::<colortype::Gray16>(pages, width, height, pixel_size, extra_description)
+    encode_u16_stack_compressed(
+        pages,
+        width,
+        height,
+        pixel_size,
+        extra_description,
+        Compression::None,
+    )
+}
+
+/// [`encode_u16_stack`] with a choice of compression.
+pub fn encode_u16_stack_compressed(
+    pages: &[&[u16]],
+    width: usize,
+    height: usize,
+    pixel_size: Option<(f64, f64)>,
+    extra_description: &str,
+    compression: Compression,
+) -> Result<Vec<u8>> {
+    encode_stack::<colortype::Gray16>(
+        pages,
+        width,
+        height,
+        pixel_size,
+        extra_description,
+        compression,
+    )
 }
 
 /// Encode 8-bit grey pages (masks: 0 or 255) as one multi-page TIFF with ImageJ calibration.
@@ -90,5 +142,5 @@ pub fn encode_u8_stack(
     height: usize,
     pixel_size: Option<(f64, f64)>,
 ) -> Result<Vec<u8>> {
-    encode_stack::<colortype::Gray8>(pages, width, height, pixel_size, "")
+    encode_stack::<colortype::Gray8>(pages, width, height, pixel_size, "", Compression::Deflate)
 }
