@@ -105,6 +105,18 @@ pub enum Error {
     /// A plot could not be drawn.
     #[error("plot: {0}")]
     Plot(String),
+    /// An iterative solver stopped at its iteration limit without meeting its tolerance.
+    #[error("{what} did not converge in {iterations} iterations (residual {residual:.3e}, tolerance {tolerance:.1e})")]
+    NotConverged {
+        /// Which solver.
+        what: String,
+        /// Iterations done.
+        iterations: usize,
+        /// Final residual (relative).
+        residual: f64,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
     /// Writing an output file failed.
     #[error("cannot write {path}: {reason}")]
     Output {
