@@ -80,30 +80,38 @@ impl ElasticOperator {
     /// A scratch buffer set for [`ElasticOperator::apply`].
     pub fn workspace(&self) -> Workspace {
         Workspace {
-            real: vec![0.0; self.fft.len()],
+            real: vec![0.0; self.ny * self.fft.nx()],
             spectrum: self.fft.make_spectrum(),
+            scratch: Vec::new(),
         }
     }
 
-    /// u = G∗p for `p` and `u` of `ny·nx` values (row-major).
+    /// u = G∗p for `p` and `u` of `ny·nx` values (row-major). With free boundaries only the
+    /// physical rows are transformed forward and back: the padding rows are known zeros on the
+    /// way in and discarded on the way out.
     pub fn apply(&self, p: &[f64], u: &mut [f64], work: &mut Workspace) {
         let n = self.nx * self.ny;
         assert!(p.len() == n && u.len() == n, "operator: field lengths");
         let fx = self.fft.nx();
-        match self.boundary {
-            Boundary::Periodic => work.real.copy_from_slice(p),
-            Boundary::Free => {
-                work.real.fill(0.0);
-                for (row, src) in work.real.chunks_mut(fx).zip(p.chunks(self.nx)) {
-                    row[..self.nx].copy_from_slice(src);
-                }
-            }
+        for (row, src) in work.real.chunks_mut(fx).zip(p.chunks(self.nx)) {
+            row[..self.nx].copy_from_slice(src);
+            row[self.nx..].fill(0.0);
         }
-        self.fft.forward(&mut work.real, &mut work.spectrum);
+        self.fft.forward_rows(
+            &mut work.real,
+            self.ny,
+            &mut work.spectrum,
+            &mut work.scratch,
+        );
         for (c, t) in work.spectrum.iter_mut().zip(&self.transfer) {
             *c *= *t;
         }
-        self.fft.inverse(&mut work.spectrum, &mut work.real);
+        self.fft.inverse_rows(
+            &mut work.spectrum,
+            self.ny,
+            &mut work.real,
+            &mut work.scratch,
+        );
         for (dst, row) in u.chunks_mut(self.nx).zip(work.real.chunks(fx)) {
             dst.copy_from_slice(&row[..self.nx]);
         }
@@ -115,6 +123,7 @@ impl ElasticOperator {
 pub struct Workspace {
     real: Vec<f64>,
     spectrum: Vec<Complex64>,
+    scratch: Vec<Complex64>,
 }
 
 fn free_transfer(fft: &RealFft2, dx: f64, dy: f64, e_star: f64) -> Vec<f64> {

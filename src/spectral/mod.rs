@@ -99,40 +99,72 @@ impl RealFft2 {
     /// Forward transform of `input` (`ny·nx` values, row-major) into `output` (transposed half
     /// spectrum). `input` is used as scratch and left unspecified.
     pub fn forward(&self, input: &mut [f64], output: &mut [Complex64]) {
-        assert_eq!(input.len(), self.len(), "forward: input length");
+        let mut scratch = Vec::new();
+        self.forward_rows(input, self.ny, output, &mut scratch);
+    }
+
+    /// Forward transform when only the first `live_rows` rows can be non-zero (zero padding):
+    /// `input` holds just those rows (`live_rows·nx` values); the zero rows' transforms are
+    /// skipped. `scratch` is reused between calls.
+    pub fn forward_rows(
+        &self,
+        input: &mut [f64],
+        live_rows: usize,
+        output: &mut [Complex64],
+        scratch: &mut Vec<Complex64>,
+    ) {
+        assert!(live_rows <= self.ny, "forward: live rows");
+        assert_eq!(input.len(), live_rows * self.nx, "forward: input length");
         assert_eq!(output.len(), self.spectrum_len(), "forward: output length");
         let half = self.nx / 2 + 1;
-        let mut rows = vec![Complex::new(0.0, 0.0); self.ny * half];
+        scratch.resize(self.ny * half, Complex::new(0.0, 0.0));
+        let (live, dead) = scratch.split_at_mut(live_rows * half);
+        dead.fill(Complex::new(0.0, 0.0));
         input
             .par_chunks_mut(self.nx)
-            .zip(rows.par_chunks_mut(half))
+            .zip(live.par_chunks_mut(half))
             .for_each_init(
                 || self.row_forward.make_scratch_vec(),
-                |scratch, (row, out)| {
+                |work, (row, out)| {
                     self.row_forward
-                        .process_with_scratch(row, out, scratch)
+                        .process_with_scratch(row, out, work)
                         .expect("row lengths match the plan");
                 },
             );
-        transpose(&rows, output, self.ny, half);
+        transpose(scratch, output, self.ny, half);
         self.columns(output, &self.col_forward);
     }
 
     /// Inverse transform of a transposed half spectrum (destroyed) into `output` (`ny·nx`
     /// values), unnormalised. The imaginary parts of the self-conjugate bins are ignored.
     pub fn inverse(&self, input: &mut [Complex64], output: &mut [f64]) {
+        let mut scratch = Vec::new();
+        self.inverse_rows(input, self.ny, output, &mut scratch);
+    }
+
+    /// Inverse transform computing only the first `live_rows` output rows (`output` holds
+    /// `live_rows·nx` values); the other rows' transforms are skipped.
+    pub fn inverse_rows(
+        &self,
+        input: &mut [Complex64],
+        live_rows: usize,
+        output: &mut [f64],
+        scratch: &mut Vec<Complex64>,
+    ) {
+        assert!(live_rows <= self.ny, "inverse: live rows");
         assert_eq!(input.len(), self.spectrum_len(), "inverse: input length");
-        assert_eq!(output.len(), self.len(), "inverse: output length");
+        assert_eq!(output.len(), live_rows * self.nx, "inverse: output length");
         let half = self.nx / 2 + 1;
         self.columns(input, &self.col_inverse);
-        let mut rows = vec![Complex::new(0.0, 0.0); self.ny * half];
-        transpose(input, &mut rows, half, self.ny);
+        scratch.resize(self.ny * half, Complex::new(0.0, 0.0));
+        transpose(input, scratch, half, self.ny);
         let nx_even = self.nx % 2 == 0;
-        rows.par_chunks_mut(half)
+        scratch[..live_rows * half]
+            .par_chunks_mut(half)
             .zip(output.par_chunks_mut(self.nx))
             .for_each_init(
                 || self.row_inverse.make_scratch_vec(),
-                |scratch, (row, out)| {
+                |work, (row, out)| {
                     // realfft insists on real DC (and Nyquist) bins; rounding leaves tiny
                     // imaginary parts there after the column pass.
                     row[0].im = 0.0;
@@ -140,7 +172,7 @@ impl RealFft2 {
                         row[half - 1].im = 0.0;
                     }
                     self.row_inverse
-                        .process_with_scratch(row, out, scratch)
+                        .process_with_scratch(row, out, work)
                         .expect("row lengths match the plan");
                 },
             );
@@ -154,18 +186,23 @@ impl RealFft2 {
     }
 }
 
-/// `out[c * rows + r] = input[r * cols + c]`, blocked for cache reuse.
+/// `out[c * rows + r] = input[r * cols + c]`, blocked for cache reuse, in parallel over blocks
+/// of output rows.
 fn transpose(input: &[Complex64], out: &mut [Complex64], rows: usize, cols: usize) {
     const BLOCK: usize = 32;
-    for r0 in (0..rows).step_by(BLOCK) {
-        for c0 in (0..cols).step_by(BLOCK) {
-            for r in r0..(r0 + BLOCK).min(rows) {
+    out.par_chunks_mut(rows * BLOCK)
+        .enumerate()
+        .for_each(|(block, chunk)| {
+            let c0 = block * BLOCK;
+            for r0 in (0..rows).step_by(BLOCK) {
                 for c in c0..(c0 + BLOCK).min(cols) {
-                    out[c * rows + r] = input[r * cols + c];
+                    let dst = &mut chunk[(c - c0) * rows..];
+                    for r in r0..(r0 + BLOCK).min(rows) {
+                        dst[r] = input[r * cols + c];
+                    }
                 }
             }
-        }
-    }
+        });
 }
 
 #[cfg(test)]
