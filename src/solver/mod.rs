@@ -5,3 +5,4 @@
 pub mod cg;
 pub mod greens;
 pub mod halfspace;
+pub mod simulate;
