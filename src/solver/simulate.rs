@@ -162,7 +162,7 @@ fn check_setup(setup: &Setup) -> Result<()> {
             modulus_pa_per_m,
             initial_pa,
         } => {
-            if !positive(modulus_pa_per_m) || !(initial_pa >= 0.0 && initial_pa.is_finite()) {
+            if !(positive(modulus_pa_per_m) && initial_pa >= 0.0 && initial_pa.is_finite()) {
                 return Err(Error::InvalidArgument(
                     "hardening needs k > 0 and p_Y0 ≥ 0".into(),
                 ));
