@@ -7,7 +7,10 @@
 //!
 //! * [`stats`] — rms height, slope and curvature (finite-difference and spectral estimators) and
 //!   the radially averaged power spectral density (Jacobs, Junge, Pastewka 2017).
+//! * [`generate`] — seeded self-affine random surfaces by Fourier filtering (Ramisetti et al.
+//!   2011; methods.md §5.2).
 
+pub mod generate;
 pub mod stats;
 
 use ndarray::Array2;
