@@ -9,8 +9,11 @@
 //!   the radially averaged power spectral density (Jacobs, Junge, Pastewka 2017).
 //! * [`generate`] — seeded self-affine random surfaces by Fourier filtering (Ramisetti et al.
 //!   2011; methods.md §5.2).
+//! * [`io`] — height maps from `.npy`, float TIFF, Gwyddion `.gsf`, text matrices, WSxM `.top`
+//!   and Bruker/Nanoscope files.
 
 pub mod generate;
+pub mod io;
 pub mod stats;
 
 use ndarray::Array2;
