@@ -61,6 +61,7 @@ pub mod output;
 pub mod pipeline;
 pub mod plot;
 pub mod report;
+pub mod solver;
 pub mod spectral;
 pub mod stack;
 pub mod surface;

@@ -1,0 +1,3 @@
+//! Contact-mechanics solvers: reference models and, later, the half-space solvers.
+
+pub mod gt;
