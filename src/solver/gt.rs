@@ -51,7 +51,10 @@
 
 use std::f64::consts::{FRAC_2_PI, FRAC_2_SQRT_PI, PI, SQRT_2};
 
+use ndarray::Array2;
+
 use crate::error::{Error, Result};
+use crate::surface::Topography;
 
 /// 1/√(2π), the peak of the standard normal density.
 const FRAC_1_SQRT_2PI: f64 = 0.398_942_280_401_432_7;
@@ -799,6 +802,504 @@ pub struct ScaledSolution {
     pub final_change: f64,
 }
 
+// ---------------------------------------------------------------------------------------------
+// Dimensional API
+// ---------------------------------------------------------------------------------------------
+
+/// Material and roughness parameters of the GT model, SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GtParams {
+    /// Sphere radius R, m.
+    pub sphere_radius_m: f64,
+    /// Contact modulus E* (`methods.md` §0), Pa.
+    pub e_star_pa: f64,
+    /// Rms roughness height h_rms, m; used as the summit-height deviation σ.
+    pub h_rms_m: f64,
+    /// Rms curvature h''_rms, 1/m; the summit radius is β = 1/h''_rms (Weber et al.).
+    pub h_double_prime_rms_per_m: f64,
+    /// The product η·h_rms·β fixing the summit density η; Weber et al. use 0.05.
+    pub eta_h_beta: f64,
+}
+
+impl GtParams {
+    /// Weber et al.'s η·h_rms·β.
+    pub const DEFAULT_ETA_H_BETA: f64 = 0.05;
+
+    /// Parameters with η·h_rms·β = 0.05.
+    pub fn new(
+        sphere_radius_m: f64,
+        e_star_pa: f64,
+        h_rms_m: f64,
+        h_double_prime_rms_per_m: f64,
+    ) -> Self {
+        GtParams {
+            sphere_radius_m,
+            e_star_pa,
+            h_rms_m,
+            h_double_prime_rms_per_m,
+            eta_h_beta: Self::DEFAULT_ETA_H_BETA,
+        }
+    }
+
+    /// Every parameter must be finite and positive.
+    pub fn validate(&self) -> Result<()> {
+        let named = [
+            ("sphere radius", self.sphere_radius_m, "m"),
+            ("contact modulus E*", self.e_star_pa, "Pa"),
+            ("h_rms", self.h_rms_m, "m"),
+            ("h''_rms", self.h_double_prime_rms_per_m, "1/m"),
+            ("η·h_rms·β", self.eta_h_beta, ""),
+        ];
+        for (name, value, unit) in named {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "Greenwood–Tripp: {name} must be positive and finite (got {value} {unit})"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Summit-height deviation σ = h_rms, m.
+    pub fn sigma_m(&self) -> f64 {
+        self.h_rms_m
+    }
+
+    /// Summit radius β = 1/h''_rms, m.
+    pub fn asperity_radius_m(&self) -> f64 {
+        1.0 / self.h_double_prime_rms_per_m
+    }
+
+    /// Summit density η = (η·h_rms·β)/(σβ), 1/m².
+    pub fn summit_density_per_m2(&self) -> f64 {
+        self.eta_h_beta / (self.sigma_m() * self.asperity_radius_m())
+    }
+
+    /// μ = (8/3)·η·σ·√(2Rβ) (dimensionless).
+    pub fn mu(&self) -> f64 {
+        8.0 / 3.0
+            * self.summit_density_per_m2()
+            * self.sigma_m()
+            * (2.0 * self.sphere_radius_m * self.asperity_radius_m()).sqrt()
+    }
+
+    /// Length unit of ρ: √(2Rσ), m.
+    pub fn length_scale_m(&self) -> f64 {
+        (2.0 * self.sphere_radius_m * self.sigma_m()).sqrt()
+    }
+
+    /// Pressure unit of p̃: E*·√(σ/(8R)), Pa.
+    pub fn pressure_scale_pa(&self) -> f64 {
+        self.e_star_pa * (self.sigma_m() / (8.0 * self.sphere_radius_m)).sqrt()
+    }
+
+    /// Load unit of P̃: E*·σ^{3/2}·√(R/2), N.
+    pub fn load_scale_n(&self) -> f64 {
+        self.e_star_pa * self.sigma_m().powf(1.5) * (0.5 * self.sphere_radius_m).sqrt()
+    }
+}
+
+/// Numerical settings of [`gt_profile_with`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GtNumerics {
+    /// Radial grid points (uniform on [0, ρ_max]).
+    pub points: usize,
+    /// Newton tolerance on max |Δp̃| relative to the central pressure.
+    pub rel_tol: f64,
+    /// Newton iterations allowed per solve at fixed d.
+    pub max_iter: usize,
+    /// Accepted relative mismatch between the computed and the requested load.
+    pub load_rtol: f64,
+}
+
+impl Default for GtNumerics {
+    /// 256 points, rel_tol 1e-10, 100 Newton iterations, load to 1e-9.
+    fn default() -> Self {
+        GtNumerics {
+            points: 256,
+            rel_tol: 1e-10,
+            max_iter: 100,
+            load_rtol: 1e-9,
+        }
+    }
+}
+
+/// The GT solution for one load, SI units, on a radial grid from the sphere's axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GtProfile {
+    /// Radii r, m, from 0 on the axis.
+    pub r_m: Vec<f64>,
+    /// Asperity pressure p(r), Pa.
+    pub pressure_pa: Vec<f64>,
+    /// Mean-plane separation u_GT(r) = d + r²/(2R) + w(r) − w(0), m (negative where the mean
+    /// planes interpenetrate).
+    pub separation_m: Vec<f64>,
+    /// Central separation d = u_GT(0), m.
+    pub central_separation_m: f64,
+    /// Rigid-body approach δ = w(0) − d, m: the compression Hertz's δ = a²/R corresponds to.
+    pub approach_m: f64,
+    /// Load 2π ∫ p r dr of this profile, N (the requested force within the load tolerance).
+    pub load_n: f64,
+    /// GT's own real contact area 2π ∫ π·η·β·σ·F₁(u/σ) r dr, m².
+    pub gt_area_m2: f64,
+    /// Sphere radius R, m (continues u_GT beyond the grid, see [`GtProfile::separation_at`]).
+    pub sphere_radius_m: f64,
+    /// Newton iterations over all solves of the load search.
+    pub iterations: usize,
+}
+
+impl GtProfile {
+    /// u_GT at radius `r_m` (m): linear between grid points; beyond the last grid radius r_max,
+    /// u_GT(r_max) + (r² − r_max²)/(2R), i.e. the sphere's parabola with the bulk deflection
+    /// frozen at its r_max value (the pressure there is below 1e-6 of the central one).
+    /// NaN for an empty profile.
+    pub fn separation_at(&self, r_m: f64) -> f64 {
+        let r = r_m.abs();
+        let n = self.r_m.len().min(self.separation_m.len());
+        if n == 0 {
+            return f64::NAN;
+        }
+        let (r_max, u_max) = (self.r_m[n - 1], self.separation_m[n - 1]);
+        if r >= r_max || n == 1 {
+            return u_max + (r * r - r_max * r_max) / (2.0 * self.sphere_radius_m);
+        }
+        let j = self.r_m[..n].partition_point(|&x| x <= r).clamp(1, n - 1) - 1;
+        let t = (r - self.r_m[j]) / (self.r_m[j + 1] - self.r_m[j]);
+        self.separation_m[j] + t * (self.separation_m[j + 1] - self.separation_m[j])
+    }
+
+    fn check(&self) -> Result<()> {
+        let n = self.r_m.len();
+        let radius_ok = self.sphere_radius_m > 0.0;
+        if n < 2 || self.separation_m.len() != n || !radius_ok {
+            return Err(Error::InvalidArgument(
+                "GT profile needs at least 2 radii, one separation per radius and R > 0".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// GT profile for `force_n` (N) with [`GtNumerics::default`]; see [`gt_profile_with`].
+pub fn gt_profile(params: &GtParams, force_n: f64) -> Result<GtProfile> {
+    gt_profile_with(params, force_n, &GtNumerics::default())
+}
+
+/// Solves the GT model of a rough sphere under the normal force `force_n` (N).
+///
+/// The central separation d is found by a bracketing root search on ln N(d), which decreases
+/// monotonically with d (`methods.md` §4.3 item 3); every solve at fixed d uses Newton's method,
+/// warm-started from the previous one. The grid runs to ρ_max = 2·ρ_Hertz + 5 (ρ_Hertz: the
+/// Hertz radius in units of √(2Rσ); the 5 covers the rough tail at light loads) and is extended
+/// by half until the pressure at ρ_max is below 1e-6 of the central pressure.
+///
+/// Errors: invalid parameters or force (not positive and finite, or so small that the pressure
+/// underflows), and non-convergence.
+///
+/// ```
+/// use contactscope::solver::gt::{gt_bearing_area, gt_profile, GtParams};
+/// use contactscope::surface::Topography;
+/// use ndarray::Array2;
+///
+/// // The PS sphere of Weber et al. (R = 290 µm, E* = 3.7 GPa), 50 nm rms roughness, β = 1 µm.
+/// let params = GtParams::new(290e-6, 3.7e9, 50e-9, 1e6);
+/// let profile = gt_profile(&params, 4e-3)?;
+/// assert!((profile.load_n / 4e-3 - 1.0).abs() < 1e-6);
+///
+/// // A roughness map that is flat at u_GT(5 µm) touches inside r = 5 µm.
+/// let level = profile.separation_at(5e-6);
+/// let roughness = Topography::new(Array2::from_elem((100, 100), level), 0.2e-6, 0.2e-6)?;
+/// let map = gt_bearing_area(&roughness, &profile, None)?;
+/// let disc = std::f64::consts::PI * 25e-12;
+/// assert!((map.area_m2 / disc - 1.0).abs() < 0.05);
+/// # Ok::<(), contactscope::Error>(())
+/// ```
+pub fn gt_profile_with(
+    params: &GtParams,
+    force_n: f64,
+    numerics: &GtNumerics,
+) -> Result<GtProfile> {
+    params.validate()?;
+    check_numerics(numerics)?;
+    if !(force_n.is_finite() && force_n > 0.0) {
+        return Err(Error::InvalidArgument(format!(
+            "Greenwood–Tripp: force must be positive and finite (got {force_n} N)"
+        )));
+    }
+    let target = force_n / params.load_scale_n();
+    if target.is_nan() || target <= 1e-250 {
+        return Err(Error::InvalidArgument(format!(
+            "Greenwood–Tripp: force {force_n} N is negligible against E*·σ^(3/2)·√(R/2) = {} N",
+            params.load_scale_n()
+        )));
+    }
+    let mut rho_max = 2.0 * hertz_rho(target) + 5.0;
+    for _ in 0..8 {
+        let kernel = RadialKernel::uniform(rho_max, numerics.points)?;
+        let mut search = LoadSearch::new(&kernel, params.mu(), target, numerics);
+        let solution = search.run()?;
+        let centre = solution.pressure[0];
+        if solution.pressure[solution.pressure.len() - 1] < 1e-6 * centre {
+            return Ok(dimensional(params, &solution, search.iterations));
+        }
+        rho_max *= 1.5;
+    }
+    Err(Error::InvalidArgument(format!(
+        "Greenwood–Tripp: pressure still above 1e-6 of the centre at ρ_max = {rho_max:.3}"
+    )))
+}
+
+fn check_numerics(numerics: &GtNumerics) -> Result<()> {
+    let ok = numerics.points >= 3
+        && numerics.rel_tol > 0.0
+        && numerics.max_iter > 0
+        && numerics.load_rtol > 0.0;
+    if !ok {
+        return Err(Error::InvalidArgument(format!(
+            "Greenwood–Tripp numerics: need ≥ 3 points and positive tolerances (got {numerics:?})"
+        )));
+    }
+    Ok(())
+}
+
+/// Hertz contact radius in units of √(2Rσ) for the scaled load: P̃ = (16/3)·ρ_a³.
+fn hertz_rho(scaled_load: f64) -> f64 {
+    (3.0 * scaled_load / 16.0).cbrt()
+}
+
+fn dimensional(params: &GtParams, s: &ScaledSolution, iterations: usize) -> GtProfile {
+    let (sigma, length) = (params.sigma_m(), params.length_scale_m());
+    let area_density = PI * params.summit_density_per_m2() * params.asperity_radius_m() * sigma;
+    // The load weights integrate 2π ∫ f ρ dρ; r = ρ·√(2Rσ) brings the factor length².
+    let f1: Vec<f64> = s.separation.iter().map(|u| f_one(*u)).collect();
+    let weights = load_weights(&s.rho);
+    GtProfile {
+        r_m: s.rho.iter().map(|r| r * length).collect(),
+        pressure_pa: s
+            .pressure
+            .iter()
+            .map(|p| p * params.pressure_scale_pa())
+            .collect(),
+        separation_m: s.separation.iter().map(|u| u * sigma).collect(),
+        central_separation_m: s.d_star * sigma,
+        approach_m: (s.displacement[0] - s.d_star) * sigma,
+        load_n: s.load * params.load_scale_n(),
+        gt_area_m2: area_density * length * length * dot(&weights, &f1),
+        sphere_radius_m: params.sphere_radius_m,
+        iterations,
+    }
+}
+
+/// Load control: a bracket on d* by marching from a Hertz-based guess with growing steps, then
+/// Illinois regula falsi on f(d*) = ln(P̃(d*)/P̃_target), every solve warm-started.
+struct LoadSearch<'a> {
+    kernel: &'a RadialKernel,
+    mu: f64,
+    target: f64,
+    numerics: &'a GtNumerics,
+    iterations: usize,
+}
+
+impl<'a> LoadSearch<'a> {
+    fn new(kernel: &'a RadialKernel, mu: f64, target: f64, numerics: &'a GtNumerics) -> Self {
+        LoadSearch {
+            kernel,
+            mu,
+            target,
+            numerics,
+            iterations: 0,
+        }
+    }
+
+    fn run(&mut self) -> Result<ScaledSolution> {
+        let d0 = self.initial_d();
+        let first = self.solve(d0, &self.initial_pressure(d0))?;
+        if self.mismatch(&first).abs() < self.numerics.load_rtol {
+            return Ok(first);
+        }
+        let (heavy, light) = self.bracket(first)?;
+        self.refine(heavy, light)
+    }
+
+    /// d* at which the central pressure μF_{3/2}(d*) equals the Hertz p̃₀ = (8/π)ρ_a.
+    fn initial_d(&self) -> f64 {
+        let y = 8.0 / PI * hertz_rho(self.target) / self.mu;
+        let (mut lo, mut hi) = (-(y.powf(2.0 / 3.0) + 1.0), 38.0);
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if f_half_orders(mid).1 > y {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    /// max(rigid-sphere pressure, Hertz pressure with the same centre): right in both limits.
+    fn initial_pressure(&self, d_star: f64) -> Vec<f64> {
+        let p0 = self.mu * f_half_orders(d_star).1;
+        let a = PI * p0 / 8.0;
+        self.kernel
+            .rho()
+            .iter()
+            .map(|r| {
+                let rigid = self.mu * f_half_orders(d_star + r * r).1;
+                let hertz = 8.0 / PI * (a * a - r * r).max(0.0).sqrt();
+                rigid.max(hertz)
+            })
+            .collect()
+    }
+
+    fn solve(&mut self, d_star: f64, start: &[f64]) -> Result<ScaledSolution> {
+        let centre = self.mu * f_half_orders(d_star).1;
+        let options = ScaledOptions {
+            method: ScaledMethod::Newton,
+            tol: (self.numerics.rel_tol * centre).max(f64::MIN_POSITIVE),
+            max_iter: self.numerics.max_iter,
+        };
+        let solution = self.kernel.solve(self.mu, d_star, Some(start), &options)?;
+        self.iterations += solution.iterations;
+        Ok(solution)
+    }
+
+    fn mismatch(&self, s: &ScaledSolution) -> f64 {
+        (s.load.max(1e-300) / self.target).ln()
+    }
+
+    /// (heavier solution at smaller d*, lighter solution at larger d*).
+    fn bracket(&mut self, first: ScaledSolution) -> Result<(ScaledSolution, ScaledSolution)> {
+        let upwards = self.mismatch(&first) > 0.0;
+        let (mut current, mut step) = (first, 0.5);
+        for _ in 0..200 {
+            let d = current.d_star + if upwards { step } else { -step };
+            match self.solve(d, &current.pressure) {
+                Ok(next) => {
+                    if (self.mismatch(&next) > 0.0) != upwards {
+                        return Ok(if upwards {
+                            (current, next)
+                        } else {
+                            (next, current)
+                        });
+                    }
+                    (current, step) = (next, 2.0 * step);
+                }
+                Err(e) if step < 1e-6 => return Err(e),
+                Err(_) => step *= 0.25,
+            }
+        }
+        Err(Error::InvalidArgument(
+            "Greenwood–Tripp: no central separation brackets the load".into(),
+        ))
+    }
+
+    fn refine(
+        &mut self,
+        mut heavy: ScaledSolution,
+        mut light: ScaledSolution,
+    ) -> Result<ScaledSolution> {
+        let (mut f_heavy, mut f_light) = (self.mismatch(&heavy), self.mismatch(&light));
+        let mut last_side = 0;
+        for _ in 0..200 {
+            let (a, b) = (heavy.d_star, light.d_star);
+            let mut d = (a * f_light - b * f_heavy) / (f_light - f_heavy);
+            if !(d > a && d < b) {
+                d = 0.5 * (a + b);
+            }
+            let start = if d - a < b - d {
+                &heavy.pressure
+            } else {
+                &light.pressure
+            };
+            let next = self.solve(d, start)?;
+            let f = self.mismatch(&next);
+            if f.abs() < self.numerics.load_rtol || b - a < 1e-13 * (1.0 + d.abs()) {
+                return Ok(next);
+            }
+            // Illinois: halve the value kept at the end that survived twice.
+            if f > 0.0 {
+                (heavy, f_heavy) = (next, f);
+                if last_side == 1 {
+                    f_light *= 0.5;
+                }
+                last_side = 1;
+            } else {
+                (light, f_light) = (next, f);
+                if last_side == -1 {
+                    f_heavy *= 0.5;
+                }
+                last_side = -1;
+            }
+        }
+        Err(Error::InvalidArgument(
+            "Greenwood–Tripp: load search did not converge in 200 steps".into(),
+        ))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bearing-area map
+// ---------------------------------------------------------------------------------------------
+
+/// The GT bearing-area contact map (Weber et al. 2018, Fig. 2b; `methods.md` §4.4).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactMap {
+    /// Contact pixels, shape `(ny, nx)` like the roughness map.
+    pub mask: Array2<bool>,
+    /// Number of contact pixels.
+    pub contact_pixels: usize,
+    /// Contact pixels over all pixels.
+    pub contact_fraction: f64,
+    /// Contact pixels × pixel area, m² (the geometric overlap area).
+    pub area_m2: f64,
+    /// GT's own real-area integral 2π ∫ π·η·β·σ·F₁(u/σ) r dr of the profile, m², for
+    /// comparison: it is not the overlap area (per asperity the overlap is twice the Hertz area,
+    /// and the overlap fraction at separation u is about F₀(u/σ)).
+    pub gt_area_m2: f64,
+    /// Centre of the sphere used, (x, y) in m from the outer corner of pixel (0, 0).
+    pub centre_m: (f64, f64),
+}
+
+/// Overlays a roughness map on the GT separation profile: a pixel is in contact where
+/// z_rough(x, y) ≥ u_GT(r(x, y)) (`methods.md` §4.4).
+///
+/// `roughness` is the measured **roughness** z_rough, not the sphere: heights in m with the mean
+/// plane removed, positive towards the flat (the [`Topography`] convention); the caller removes
+/// the sphere and the mean plane, because u_GT already contains the sphere's r²/(2R). Pixel
+/// (iy, ix) sits at its centre ((ix + ½)·dx, (iy + ½)·dy); r is measured from `centre` ((x, y)
+/// in m from the outer corner of pixel (0, 0); default: the middle of the map). Beyond the
+/// profile's last radius u_GT continues as in [`GtProfile::separation_at`]. No elastic
+/// interaction between the overlapping asperities is modelled.
+pub fn gt_bearing_area(
+    roughness: &Topography,
+    profile: &GtProfile,
+    centre: Option<(f64, f64)>,
+) -> Result<ContactMap> {
+    profile.check()?;
+    let (dx, dy) = (roughness.dx_m, roughness.dy_m);
+    let (width, height) = roughness.size_m();
+    let (x0, y0) = centre.unwrap_or((0.5 * width, 0.5 * height));
+    if !(x0.is_finite() && y0.is_finite()) {
+        return Err(Error::InvalidArgument(format!(
+            "bearing-area centre must be finite (got ({x0}, {y0}) m)"
+        )));
+    }
+    let mask = Array2::from_shape_fn(roughness.heights.dim(), |(iy, ix)| {
+        let x = (ix as f64 + 0.5) * dx - x0;
+        let y = (iy as f64 + 0.5) * dy - y0;
+        roughness.heights[[iy, ix]] >= profile.separation_at(x.hypot(y))
+    });
+    let contact_pixels = mask.iter().filter(|&&c| c).count();
+    Ok(ContactMap {
+        contact_fraction: contact_pixels as f64 / mask.len() as f64,
+        area_m2: contact_pixels as f64 * dx * dy,
+        mask,
+        contact_pixels,
+        gt_area_m2: profile.gt_area_m2,
+        centre_m: (x0, y0),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1043,5 +1544,261 @@ mod tests {
         };
         let err = kernel.solve(B12_MU, 0.5, None, &options).unwrap_err();
         assert!(matches!(err, Error::InvalidArgument(ref m) if m.contains("did not converge")));
+    }
+
+    fn ps_sphere(h_rms_m: f64) -> GtParams {
+        // Weber et al.: PS sphere R = 290 µm, E* = 3.7 GPa; summit radius 1 µm.
+        GtParams::new(290e-6, 3.7e9, h_rms_m, 1e6)
+    }
+
+    #[test]
+    fn hertz_limit() {
+        // σ = 1e-4·δ_Hertz: the asperity layer is a stiff penalty, GT must give Hertz.
+        let (force, radius, e_star) = (0.01, 290e-6, 3.7e9);
+        let a = crate::hertz::contact_radius(force, radius, e_star);
+        let delta = a * a / radius;
+        let params = ps_sphere(1e-4 * delta);
+        let profile = gt_profile(&params, force).unwrap();
+        assert!(rel(profile.load_n, force) < 1e-8);
+        // Load at the same central compression δ = w(0) − d (measured: 0.13 %).
+        let hertz_load = 4.0 / 3.0 * e_star * radius.sqrt() * profile.approach_m.powf(1.5);
+        assert!(
+            rel(hertz_load, force) < 0.02,
+            "Hertz load at GT approach {hertz_load}"
+        );
+        // Pressure against p₀·√(1 − r²/a²) (measured: centre 0.1 %, rms 0.16 % and worst 2.2 %
+        // of p₀, the worst at the edge, where GT rounds the square-root profile off).
+        let p0 = 2.0 * e_star * a / (PI * radius);
+        assert!(rel(profile.pressure_pa[0], p0) < 0.005);
+        let deviations: Vec<f64> = profile
+            .r_m
+            .iter()
+            .zip(&profile.pressure_pa)
+            .map(|(r, p)| (p - p0 * (1.0 - (r / a).powi(2)).max(0.0).sqrt()) / p0)
+            .collect();
+        let rms = (dot(&deviations, &deviations) / deviations.len() as f64).sqrt();
+        assert!(
+            max_abs(&deviations) < 0.05 && rms < 0.005,
+            "max {}, rms {rms}",
+            max_abs(&deviations)
+        );
+        // The mean planes meet at the Hertz radius (u_GT ≈ 0 up to the penetration ~ 20σ).
+        let edge = profile.separation_at(a);
+        assert!(edge.abs() < 50.0 * params.sigma_m(), "u_GT(a) = {edge}");
+    }
+
+    #[test]
+    fn profiles_over_the_paper_range() {
+        // Roughness from 1 nm to 1 µm, loads 0.1 mN to 400 mN: the load search converges, the
+        // pressure falls and the separation rises with r, and the tail check holds.
+        let numerics = GtNumerics {
+            points: 128,
+            ..GtNumerics::default()
+        };
+        for h_rms in [1e-9, 1e-8, 1e-7, 1e-6] {
+            for h2 in [1e5, 1e7] {
+                for force in [1e-4, 4e-3, 0.4] {
+                    let params = GtParams::new(290e-6, 3.7e9, h_rms, h2);
+                    let what = format!("h_rms {h_rms}, h'' {h2}, N {force}");
+                    let profile = gt_profile_with(&params, force, &numerics).expect(&what);
+                    assert!(rel(profile.load_n, force) < 1e-8, "{what}");
+                    let p = &profile.pressure_pa;
+                    assert!(p.windows(2).all(|w| w[1] <= w[0] * (1.0 + 1e-9)), "{what}");
+                    assert!(p[p.len() - 1] < 1e-6 * p[0], "{what}");
+                    let u = &profile.separation_m;
+                    assert!(u.windows(2).all(|w| w[1] > w[0]), "{what}");
+                    // Roughness spreads the load: the centre never exceeds Hertz's p₀.
+                    let a = crate::hertz::contact_radius(force, 290e-6, 3.7e9);
+                    assert!(p[0] < 1.001 * 2.0 * 3.7e9 * a / (PI * 290e-6), "{what}");
+                    assert!(profile.gt_area_m2 > 0.0 && profile.gt_area_m2.is_finite());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn derived_parameters() {
+        let p = GtParams::new(290e-6, 3.7e9, 50e-9, 2e6);
+        assert_eq!(p.eta_h_beta, 0.05);
+        assert!(rel(p.asperity_radius_m(), 0.5e-6) < 1e-15);
+        assert!(rel(p.summit_density_per_m2(), 0.05 / (50e-9 * 0.5e-6)) < 1e-15);
+        // With η = 0.05/(σβ), μ = (0.4/3)·√(2R/β) does not depend on σ.
+        assert!(rel(p.mu(), 0.4 / 3.0 * (2.0 * 290e-6 / 0.5e-6_f64).sqrt()) < 1e-14);
+        // N = P̃·E*σ^{3/2}√(R/2) = p̃·E*√(σ/8R) integrated over (√(2Rσ))² of area.
+        let consistent = p.pressure_scale_pa() * p.length_scale_m().powi(2);
+        assert!(rel(p.load_scale_n(), consistent) < 1e-14);
+    }
+
+    fn rough_profile() -> (GtParams, GtProfile) {
+        let params = ps_sphere(50e-9);
+        let profile = gt_profile(&params, 4e-3).unwrap();
+        (params, profile)
+    }
+
+    #[test]
+    fn bearing_area_of_a_constant_roughness_is_a_disc() {
+        let (_, profile) = rough_profile();
+        let (nx, ny, dx, dy) = (201, 151, 0.2e-6, 0.25e-6);
+        let radius = 10e-6;
+        let c = profile.separation_at(radius);
+        let topo = Topography::new(Array2::from_elem((ny, nx), c), dx, dy).unwrap();
+        for centre in [None, Some((15e-6, 20e-6))] {
+            let map = gt_bearing_area(&topo, &profile, centre).unwrap();
+            let (x0, y0) = centre.unwrap_or((0.5 * nx as f64 * dx, 0.5 * ny as f64 * dy));
+            assert_eq!(map.centre_m, (x0, y0));
+            // Contact exactly where u_GT(r) ≤ c.
+            for ((iy, ix), &contact) in map.mask.indexed_iter() {
+                let r = ((ix as f64 + 0.5) * dx - x0).hypot((iy as f64 + 0.5) * dy - y0);
+                assert_eq!(contact, profile.separation_at(r) <= c, "pixel ({iy}, {ix})");
+            }
+            // u_GT rises with r, so that set is the disc of radius 10 µm.
+            assert!(
+                rel(map.area_m2, PI * radius * radius) < 0.01,
+                "area {}",
+                map.area_m2
+            );
+            assert_eq!(map.area_m2, map.contact_pixels as f64 * dx * dy);
+            assert_eq!(
+                map.contact_fraction,
+                map.contact_pixels as f64 / (nx * ny) as f64
+            );
+            assert_eq!(map.gt_area_m2, profile.gt_area_m2);
+        }
+    }
+
+    #[test]
+    fn bearing_area_beyond_the_profile_follows_the_sphere() {
+        let (_, profile) = rough_profile();
+        let r_max = profile.r_m[profile.r_m.len() - 1];
+        let u_max = profile.separation_m[profile.separation_m.len() - 1];
+        assert_eq!(profile.separation_at(r_max), u_max);
+        // Contact radius 1.5·r_max on 1 µm pixels.
+        let radius = 1.5 * r_max;
+        let c = u_max + (radius * radius - r_max * r_max) / (2.0 * profile.sphere_radius_m);
+        let n = (2.0 * radius / 1e-6) as usize + 20;
+        let topo = Topography::new(Array2::from_elem((n, n), c), 1e-6, 1e-6).unwrap();
+        let map = gt_bearing_area(&topo, &profile, None).unwrap();
+        assert!(
+            rel(map.area_m2, PI * radius * radius) < 0.01,
+            "area {}",
+            map.area_m2
+        );
+    }
+
+    #[test]
+    fn bearing_fraction_of_gaussian_roughness_is_f0() {
+        // i.i.d. Gaussian heights of deviation σ: a pixel at separation u is in contact with
+        // probability F₀(u/σ) (methods.md §4.4), so the count matches Σ F₀ within noise.
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        let (params, profile) = rough_profile();
+        let sigma = params.sigma_m();
+        let (n, dx) = (256, 0.1e-6);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2018);
+        let normal = Normal::new(0.0, sigma).unwrap();
+        let heights = Array2::from_shape_simple_fn((n, n), || normal.sample(&mut rng));
+        let topo = Topography::new(heights, dx, dx).unwrap();
+        let map = gt_bearing_area(&topo, &profile, None).unwrap();
+        let (mut mean, mut variance) = (0.0, 0.0);
+        for iy in 0..n {
+            for ix in 0..n {
+                let r = ((ix as f64 + 0.5 - 0.5 * n as f64) * dx)
+                    .hypot((iy as f64 + 0.5 - 0.5 * n as f64) * dx);
+                let q = gt_f(0.0, profile.separation_at(r) / sigma);
+                mean += q;
+                variance += q * (1.0 - q);
+            }
+        }
+        let observed = map.contact_pixels as f64;
+        assert!(
+            mean > 100.0,
+            "too few expected contacts ({mean}) for a useful test"
+        );
+        assert!(
+            (observed - mean).abs() < 5.0 * variance.sqrt(),
+            "{observed} vs {mean}"
+        );
+        // The overlap differs from GT's own area (methods.md §4.4); both are reported.
+        assert!(map.gt_area_m2 > 0.0 && map.gt_area_m2 != map.area_m2);
+    }
+
+    #[test]
+    fn invalid_input_is_an_error() {
+        let good = ps_sphere(50e-9);
+        let bad = [
+            GtParams {
+                sphere_radius_m: -290e-6,
+                ..good
+            },
+            GtParams {
+                e_star_pa: 0.0,
+                ..good
+            },
+            GtParams {
+                h_rms_m: f64::NAN,
+                ..good
+            },
+            GtParams {
+                h_double_prime_rms_per_m: 0.0,
+                ..good
+            },
+            GtParams {
+                eta_h_beta: -0.05,
+                ..good
+            },
+            GtParams {
+                sphere_radius_m: f64::INFINITY,
+                ..good
+            },
+        ];
+        for params in bad {
+            assert!(matches!(
+                gt_profile(&params, 4e-3),
+                Err(Error::InvalidArgument(_))
+            ));
+        }
+        for force in [0.0, -1e-3, f64::NAN, f64::INFINITY, 1e-300] {
+            assert!(gt_profile(&good, force).is_err(), "force {force}");
+        }
+        let numerics = GtNumerics {
+            points: 2,
+            ..GtNumerics::default()
+        };
+        assert!(gt_profile_with(&good, 4e-3, &numerics).is_err());
+
+        assert!(RadialKernel::new(vec![0.0, 1.0]).is_err());
+        assert!(RadialKernel::new(vec![0.1, 1.0, 2.0]).is_err());
+        assert!(RadialKernel::new(vec![0.0, 1.0, 1.0]).is_err());
+        assert!(RadialKernel::new(vec![0.0, 1.0, f64::NAN]).is_err());
+        assert!(RadialKernel::uniform(-1.0, 10).is_err());
+        let kernel = RadialKernel::uniform(5.0, 20).unwrap();
+        let newton = ScaledOptions {
+            method: ScaledMethod::Newton,
+            tol: 1e-8,
+            max_iter: 50,
+        };
+        assert!(kernel.solve(0.0, 0.5, None, &newton).is_err());
+        assert!(kernel.solve(1.0, f64::NAN, None, &newton).is_err());
+        assert!(kernel.solve(1.0, 0.5, Some(&[0.0; 3]), &newton).is_err());
+        for mixing in [0.0, 1.5, f64::NAN] {
+            let options = ScaledOptions {
+                method: ScaledMethod::FixedPoint { mixing },
+                ..ScaledOptions::default()
+            };
+            assert!(kernel.solve(1.0, 0.5, None, &options).is_err());
+        }
+        assert!(kernel
+            .solve(1.0, 0.5, None, &ScaledOptions { tol: 0.0, ..newton })
+            .is_err());
+
+        let (_, profile) = rough_profile();
+        let topo = Topography::new(Array2::zeros((4, 4)), 1e-6, 1e-6).unwrap();
+        assert!(gt_bearing_area(&topo, &profile, Some((f64::NAN, 0.0))).is_err());
+        let empty = GtProfile {
+            r_m: vec![],
+            separation_m: vec![],
+            ..profile
+        };
+        assert!(gt_bearing_area(&topo, &empty, None).is_err());
     }
 }
