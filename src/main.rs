@@ -10,9 +10,16 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
 use contactscope::pipeline::{self, AnalyzeRequest};
+use contactscope::solver::cg::SolverOptions;
+use contactscope::solver::job::{self, ModelChoice, SimulateRequest};
+use contactscope::solver::simulate::Model;
 use contactscope::stack::series::{self, Series};
 use contactscope::stack::tiff::TiffReader;
 use contactscope::stack::write::Compression;
+use contactscope::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
+use contactscope::surface::io::{read_topography, write_gsf, write_npy};
+use contactscope::surface::stats::SurfaceStats;
+use contactscope::surface::Detrend;
 use contactscope::synth::{self, Layout, SynthParams};
 use contactscope::threshold::Method;
 use contactscope::units::{self, Dimension};
@@ -40,6 +47,144 @@ enum Command {
     SynthSeries(SynthArgs),
     /// Analyse the bundled synthetic load series and compare with its ground truth.
     Demo(DemoArgs),
+    /// Simulate contact of a rough topography under a load sweep (elastic, hardness, hardening, gt).
+    Simulate(SimulateArgs),
+    /// Generate a self-affine random surface (Fourier filtering, seeded).
+    Surface(SurfaceArgs),
+    /// Print a topography's size, pixel size and roughness statistics.
+    Topography(TopographyArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ModelArg {
+    /// Linear elastic hard-wall contact.
+    Elastic,
+    /// Penetration hardness (bounded pressure).
+    Hardness,
+    /// Linear contact hardening.
+    Hardening,
+    /// Greenwood–Tripp bearing area.
+    Gt,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum DetrendArg {
+    /// Keep the heights as read.
+    None,
+    /// Subtract the mean height.
+    Mean,
+    /// Subtract the least-squares plane.
+    Plane,
+}
+
+#[derive(clap::Args)]
+struct TopographyInput {
+    /// Height map: .npy, float TIFF, .gsf, text matrix (.txt/.csv/.dat), WSxM .top, Nanoscope .di.
+    #[arg(long = "topography")]
+    path: PathBuf,
+    /// Pixel size (needed for .npy and text; overrides metadata): 32nm or 32x40nm.
+    #[arg(long)]
+    pixel_size: Option<String>,
+    /// Height unit of files that do not state one (.npy, text, TIFF), e.g. 1nm; default metres.
+    #[arg(long)]
+    height_unit: Option<String>,
+    /// Detrending before anything else.
+    #[arg(long, value_enum, default_value = "plane")]
+    detrend: DetrendArg,
+}
+
+#[derive(clap::Args)]
+struct SimulateArgs {
+    #[command(flatten)]
+    input: TopographyInput,
+    /// Sphere radius added to a flattened map (and the GT sphere), e.g. 290um.
+    #[arg(long)]
+    radius: Option<String>,
+    /// Contact modulus E*, e.g. 3.7GPa.
+    #[arg(long)]
+    modulus: String,
+    /// Contact model.
+    #[arg(long, value_enum)]
+    model: ModelArg,
+    /// Penetration hardness p_Y for --model hardness, e.g. 370MPa.
+    #[arg(long)]
+    hardness: Option<String>,
+    /// Hardening modulus k for --model hardening, e.g. 4MPa/nm.
+    #[arg(long)]
+    hardening: Option<String>,
+    /// Initial yield pressure p_Y0 for --model hardening (the paper's model has 0).
+    #[arg(long, default_value = "0MPa")]
+    initial_hardness: String,
+    /// Volume-conserving plastic increment (Eq. 5) for --model hardness, relaxation α in (0, 1].
+    #[arg(long, num_args = 0..=1, default_missing_value = "1.0")]
+    volume_conserving: Option<f64>,
+    /// Periodic boundaries (nominally flat periodic surfaces); free otherwise.
+    #[arg(long)]
+    periodic: bool,
+    /// Loads: 4mN,10mN,40mN or 4mN..400mN:12 (log-spaced).
+    #[arg(long)]
+    loads: String,
+    /// Relative solver tolerance.
+    #[arg(long, default_value_t = 1e-8)]
+    tolerance: f64,
+    /// Most CG iterations per solve.
+    #[arg(long, default_value_t = 5000)]
+    max_iterations: usize,
+    /// Output folder.
+    #[arg(long, default_value = "contactscope-out/simulate")]
+    out: PathBuf,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(clap::Args)]
+struct SurfaceArgs {
+    /// Grid size in pixels (square).
+    #[arg(long, default_value_t = 1024)]
+    size: usize,
+    /// Pixel size, e.g. 32nm.
+    #[arg(long)]
+    pixel_size: String,
+    /// Hurst exponent H in (0, 1].
+    #[arg(long, default_value_t = 0.8)]
+    hurst: f64,
+    /// RMS slope h'_rms (central differences); or give --rms-height.
+    #[arg(long, conflicts_with = "rms_height")]
+    rms_slope: Option<f64>,
+    /// RMS height, e.g. 50nm.
+    #[arg(long)]
+    rms_height: Option<String>,
+    /// Roll-off wavelength (PSD flat above it), e.g. 8um.
+    #[arg(long)]
+    rolloff: Option<String>,
+    /// Short cutoff wavelength (no roughness below it), e.g. 128nm.
+    #[arg(long)]
+    cutoff: Option<String>,
+    /// Random seed.
+    #[arg(long, default_value_t = 7)]
+    seed: u64,
+    /// Output file: .npy or .gsf (heights in metres).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct TopographyArgs {
+    /// Height map file.
+    file: PathBuf,
+    /// Pixel size (needed for .npy and text).
+    #[arg(long)]
+    pixel_size: Option<String>,
+    /// Height unit of files that do not state one, e.g. 1nm.
+    #[arg(long)]
+    height_unit: Option<String>,
+    /// Detrending before the statistics.
+    #[arg(long, value_enum, default_value = "plane")]
+    detrend: DetrendArg,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(clap::Args)]
@@ -164,6 +309,9 @@ fn main() -> ExitCode {
         Command::Info(args) => info(args),
         Command::SynthSeries(args) => synth_series(args),
         Command::Demo(args) => demo(args),
+        Command::Simulate(args) => simulate(args),
+        Command::Surface(args) => surface(args),
+        Command::Topography(args) => topography(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -483,4 +631,221 @@ fn demo(args: DemoArgs) -> Result<()> {
     println!("\ntable: {}", args.out.join("areas.csv").display());
     println!("plot:  {}", args.out.join("area_vs_load.png").display());
     Ok(())
+}
+
+fn detrend_of(arg: DetrendArg) -> Detrend {
+    match arg {
+        DetrendArg::None => Detrend::None,
+        DetrendArg::Mean => Detrend::Mean,
+        DetrendArg::Plane => Detrend::Plane,
+    }
+}
+
+fn optional_length(text: &Option<String>, flag: &str) -> Result<Option<f64>> {
+    text.as_deref()
+        .map(|t| units::parse_positive(t, Dimension::Length).with_context(|| flag.to_string()))
+        .transpose()
+}
+
+fn model_of(args: &SimulateArgs) -> Result<ModelChoice> {
+    let pressure = |t: &str, flag: &str| {
+        units::parse_positive(t, Dimension::Pressure).with_context(|| flag.to_string())
+    };
+    Ok(match args.model {
+        ModelArg::Elastic => ModelChoice::HalfSpace(Model::Elastic),
+        ModelArg::Gt => ModelChoice::GreenwoodTripp,
+        ModelArg::Hardness => ModelChoice::HalfSpace(Model::Hardness {
+            hardness_pa: pressure(
+                args.hardness
+                    .as_deref()
+                    .context("--model hardness needs --hardness, e.g. 370MPa")?,
+                "--hardness",
+            )?,
+            volume_conserving: args.volume_conserving,
+        }),
+        ModelArg::Hardening => ModelChoice::HalfSpace(Model::Hardening {
+            modulus_pa_per_m: units::parse_ratio(
+                args.hardening
+                    .as_deref()
+                    .context("--model hardening needs --hardening, e.g. 4MPa/nm")?,
+                Dimension::Pressure,
+                Dimension::Length,
+            )
+            .context("--hardening")?,
+            initial_pa: units::parse_quantity(&args.initial_hardness, Dimension::Pressure)
+                .context("--initial-hardness")?,
+        }),
+    })
+}
+
+fn simulate(args: SimulateArgs) -> Result<()> {
+    let hardness_model = matches!(args.model, ModelArg::Hardness);
+    let hardening_model = matches!(args.model, ModelArg::Hardening);
+    if args.volume_conserving.is_some() && !hardness_model {
+        bail!("--volume-conserving applies to --model hardness only");
+    }
+    if args.hardness.is_some() && !hardness_model {
+        bail!("--hardness applies to --model hardness only");
+    }
+    if args.hardening.is_some() && !hardening_model {
+        bail!("--hardening applies to --model hardening only");
+    }
+    let request = SimulateRequest {
+        topography: args.input.path.clone(),
+        pixel_size_m: args
+            .input
+            .pixel_size
+            .as_deref()
+            .map(units::parse_pixel_size)
+            .transpose()
+            .context("--pixel-size")?,
+        height_unit_m: optional_length(&args.input.height_unit, "--height-unit")?,
+        detrend: detrend_of(args.input.detrend),
+        radius_m: optional_length(&args.radius, "--radius")?,
+        e_star_pa: units::parse_positive(&args.modulus, Dimension::Pressure)
+            .context("--modulus")?,
+        model: model_of(&args)?,
+        periodic: args.periodic,
+        loads_n: units::parse_loads(&args.loads).context("--loads")?,
+        options: SolverOptions {
+            max_iterations: args.max_iterations,
+            tolerance: args.tolerance,
+        },
+        out_dir: args.out.clone(),
+        command_line: std::env::args().collect(),
+    };
+    let bar = progress_bar(request.loads_n.len(), args.quiet);
+    bar.set_message("loads");
+    let outcome = job::run_simulate(&request, &|done, _| bar.set_position(done as u64));
+    bar.finish_and_clear();
+    let outcome = outcome?;
+    for w in &outcome.warnings {
+        eprintln!("contactscope: warning: {w}");
+    }
+    println!(
+        "topography: h_rms = {:.4} nm, h'_rms = {:.5}, h''_rms = {:.5} 1/µm",
+        outcome.stats.h_rms_m * 1e9,
+        outcome.stats.h_prime_rms,
+        outcome.stats.h_double_prime_rms_per_m * 1e-6
+    );
+    println!(
+        "{:>10} {:>12} {:>9} {:>10} {:>8} {:>6}",
+        "force_mN", "area_µm²", "fraction", "p_mean_MPa", "patches", "iters"
+    );
+    for l in &outcome.loads {
+        println!(
+            "{:>10.4} {:>12.4} {:>9.5} {:>10.2} {:>8} {:>6}",
+            l.force_n * 1e3,
+            l.area_m2 * 1e12,
+            l.contact_fraction,
+            l.mean_pressure_pa * 1e-6,
+            l.patches,
+            l.iterations
+        );
+    }
+    println!(
+        "wrote {} files to {}",
+        outcome.written.len(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn surface(args: SurfaceArgs) -> Result<()> {
+    let (dx, _) = units::parse_pixel_size(&args.pixel_size).context("--pixel-size")?;
+    let target = match (&args.rms_slope, &args.rms_height) {
+        (Some(slope), None) => RmsTarget::Slope(*slope),
+        (None, Some(h)) => {
+            RmsTarget::Height(units::parse_positive(h, Dimension::Length).context("--rms-height")?)
+        }
+        _ => bail!("give --rms-slope or --rms-height"),
+    };
+    let params = SelfAffineParams {
+        nx: args.size,
+        ny: args.size,
+        dx_m: dx,
+        hurst: args.hurst,
+        rolloff_wavelength_m: optional_length(&args.rolloff, "--rolloff")?,
+        short_cutoff_wavelength_m: optional_length(&args.cutoff, "--cutoff")?,
+        target,
+        seed: args.seed,
+    };
+    let topo = self_affine(&params)?;
+    match args.out.extension().and_then(|e| e.to_str()) {
+        Some("npy") => write_npy(&args.out, &topo)?,
+        Some("gsf") => write_gsf(&args.out, &topo)?,
+        _ => bail!(
+            "{}: the output must end in .npy or .gsf",
+            args.out.display()
+        ),
+    }
+    let stats = SurfaceStats::finite_differences(&topo)?;
+    println!(
+        "{}: {}×{} px of {}, h_rms = {:.4} nm, h'_rms = {:.5}, h''_rms = {:.5} 1/µm",
+        args.out.display(),
+        topo.nx(),
+        topo.ny(),
+        units::format_length(dx),
+        stats.h_rms_m * 1e9,
+        stats.h_prime_rms,
+        stats.h_double_prime_rms_per_m * 1e-6
+    );
+    Ok(())
+}
+
+fn topography(args: TopographyArgs) -> Result<()> {
+    let mut topo = read_topography(
+        &args.file,
+        args.pixel_size
+            .as_deref()
+            .map(units::parse_pixel_size)
+            .transpose()
+            .context("--pixel-size")?,
+        optional_length(&args.height_unit, "--height-unit")?,
+    )?;
+    topo.detrend(detrend_of(args.detrend));
+    let stats = SurfaceStats::finite_differences(&topo)?;
+    let (w, h) = topo.size_m();
+    if args.json {
+        let value = serde_json::json!({
+            "file": args.file.display().to_string(),
+            "nx": topo.nx(), "ny": topo.ny(),
+            "pixel_size_x_nm": topo.dx_m * 1e9, "pixel_size_y_nm": topo.dy_m * 1e9,
+            "width_um": w * 1e6, "height_um": h * 1e6,
+            "detrend": topo_detrend_name(args.detrend),
+            "h_rms_nm": stats.h_rms_m * 1e9,
+            "h_prime_rms": stats.h_prime_rms,
+            "h_double_prime_rms_per_um": stats.h_double_prime_rms_per_m * 1e-6,
+        });
+        println!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    println!("file:        {}", args.file.display());
+    println!(
+        "size:        {} × {} px = {:.4} × {:.4} µm",
+        topo.nx(),
+        topo.ny(),
+        w * 1e6,
+        h * 1e6
+    );
+    println!(
+        "pixel size:  {} × {}",
+        units::format_length(topo.dx_m),
+        units::format_length(topo.dy_m)
+    );
+    println!("detrend:     {}", topo_detrend_name(args.detrend));
+    println!("h_rms:       {:.5} nm", stats.h_rms_m * 1e9);
+    println!(
+        "h'_rms:      {:.6} (central differences)",
+        stats.h_prime_rms
+    );
+    println!(
+        "h''_rms:     {:.6} 1/µm (5-point Laplacian)",
+        stats.h_double_prime_rms_per_m * 1e-6
+    );
+    Ok(())
+}
+
+fn topo_detrend_name(arg: DetrendArg) -> &'static str {
+    detrend_of(arg).name()
 }

@@ -176,6 +176,61 @@ pub fn parse_quantity_list(text: &str, dim: Dimension) -> Result<Vec<f64>> {
     Ok(values)
 }
 
+/// Parse loads: a list (`4,10,40mN`) or a log-spaced range `4mN..400mN:12` (12 values from 4 to
+/// 400 mN, equal ratios). Returns newtons; every value must be positive.
+pub fn parse_loads(text: &str) -> Result<Vec<f64>> {
+    let values = match text.split_once("..") {
+        Some((from, rest)) => {
+            let (to, count) = rest.split_once(':').ok_or_else(|| {
+                Error::InvalidArgument(format!(
+                    "load range '{text}' needs a count: e.g. 4mN..400mN:12"
+                ))
+            })?;
+            let (a, b) = (
+                parse_quantity(from, Dimension::Force)?,
+                parse_quantity(to, Dimension::Force)?,
+            );
+            let n: usize = count.trim().parse().map_err(|_| {
+                Error::InvalidArgument(format!("'{count}' in '{text}' is not a count"))
+            })?;
+            if n < 2 || !(a > 0.0 && b > a) {
+                return Err(Error::InvalidArgument(format!(
+                    "load range '{text}' needs 0 < start < end and at least 2 values"
+                )));
+            }
+            (0..n)
+                .map(|i| a * (b / a).powf(i as f64 / (n - 1) as f64))
+                .collect()
+        }
+        None => parse_quantity_list(text, Dimension::Force)?,
+    };
+    if let Some(bad) = values.iter().find(|v| **v <= 0.0) {
+        return Err(Error::InvalidArgument(format!(
+            "load {bad} N must be positive"
+        )));
+    }
+    Ok(values)
+}
+
+/// Parse a ratio of two quantities, e.g. a hardening modulus `4MPa/nm` (returned in Pa/m).
+pub fn parse_ratio(text: &str, numerator: Dimension, denominator: Dimension) -> Result<f64> {
+    let (top, bottom) = text.split_once('/').ok_or_else(|| {
+        Error::InvalidArgument(format!(
+            "'{text}' must be a {} per {}, e.g. 4MPa/nm",
+            numerator.name(),
+            denominator.name()
+        ))
+    })?;
+    let (number, unit) = split_number(top);
+    let value = parse_number(number, text)?;
+    let per = parse_positive(&format!("1{}", bottom.trim()), denominator)?;
+    let ratio = scale(value, unit_factor(numerator, unit, text)?) / per;
+    if !(ratio > 0.0 && ratio.is_finite()) {
+        return Err(Error::InvalidArgument(format!("'{text}' must be positive")));
+    }
+    Ok(ratio)
+}
+
 /// Parse a pixel size: `200nm`, `0.2um`, or `200x210nm` (x by y) for non-square pixels.
 /// Returns (x, y) in metres.
 pub fn parse_pixel_size(text: &str) -> Result<(f64, f64)> {
@@ -245,6 +300,25 @@ mod tests {
         assert!(parse_quantity_list("4,10,20", Dimension::Force).is_err());
         assert!(parse_quantity_list("4mN,,5mN", Dimension::Force).is_err());
         assert!(parse_quantity_list("4mN,10", Dimension::Force).is_err());
+    }
+
+    #[test]
+    fn loads_and_ratios() {
+        let l = parse_loads("4mN..400mN:3").unwrap();
+        assert_eq!(l.len(), 3);
+        assert_relative_eq!(l[1], 0.04, max_relative = 1e-12);
+        assert_relative_eq!(l[2], 0.4, max_relative = 1e-12);
+        assert_eq!(parse_loads("4,10mN").unwrap(), [4e-3, 10e-3]);
+        assert!(parse_loads("4mN..400mN").is_err());
+        assert!(parse_loads("400mN..4mN:3").is_err());
+        assert!(parse_loads("0mN,1mN").is_err());
+        assert_relative_eq!(
+            parse_ratio("4MPa/nm", Dimension::Pressure, Dimension::Length).unwrap(),
+            4e15,
+            max_relative = 1e-12
+        );
+        assert!(parse_ratio("4MPa", Dimension::Pressure, Dimension::Length).is_err());
+        assert!(parse_ratio("4MPa/s", Dimension::Pressure, Dimension::Length).is_err());
     }
 
     #[test]

@@ -144,3 +144,21 @@ pub fn encode_u8_stack(
 ) -> Result<Vec<u8>> {
     encode_stack::<colortype::Gray8>(pages, width, height, pixel_size, "", Compression::Deflate)
 }
+
+/// Encode 32-bit float grey pages (maps of the solver) as one TIFF with ImageJ calibration.
+pub fn encode_f32_stack(
+    pages: &[&[f32]],
+    width: usize,
+    height: usize,
+    pixel_size: Option<(f64, f64)>,
+    extra_description: &str,
+) -> Result<Vec<u8>> {
+    encode_stack::<colortype::Gray32Float>(
+        pages,
+        width,
+        height,
+        pixel_size,
+        extra_description,
+        Compression::Deflate,
+    )
+}

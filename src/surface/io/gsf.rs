@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::surface::Topography;
 
 use super::{
@@ -136,7 +136,7 @@ pub fn write_gsf(path: &Path, topography: &Topography) -> Result<()> {
     for h in topography.heights.iter() {
         out.extend_from_slice(&(*h as f32).to_le_bytes());
     }
-    std::fs::write(path, out).map_err(|e| Error::io(path, e))
+    crate::output::write_atomic(path, &out)
 }
 
 #[cfg(test)]
