@@ -322,10 +322,12 @@ fn main() -> ExitCode {
     }
 }
 
-fn progress_bar(images: usize, quiet: bool) -> ProgressBar {
-    let visible = !quiet && images > 3 && std::io::stderr().is_terminal();
+/// A progress bar on stderr, hidden with --quiet, when stderr is not a terminal, or when there
+/// are fewer than `min_items` items (a short job needs none).
+fn progress_bar(items: usize, min_items: usize, quiet: bool) -> ProgressBar {
+    let visible = !quiet && items >= min_items && std::io::stderr().is_terminal();
     let bar = ProgressBar::with_draw_target(
-        Some(images as u64),
+        Some(items as u64),
         if visible {
             ProgressDrawTarget::stderr()
         } else {
@@ -392,7 +394,7 @@ fn analyze(args: AnalyzeArgs) -> Result<()> {
 }
 
 fn run_with_progress(request: &AnalyzeRequest, quiet: bool) -> Result<pipeline::AnalyzeOutcome> {
-    let bar = progress_bar(request.series.images.len(), quiet);
+    let bar = progress_bar(request.series.images.len(), 4, quiet);
     let progress = |pass: Pass, done: usize, _total: usize| {
         bar.set_message(match pass {
             Pass::Histogram => "histogram",
@@ -710,13 +712,25 @@ fn simulate(args: SimulateArgs) -> Result<()> {
         options: SolverOptions {
             max_iterations: args.max_iterations,
             tolerance: args.tolerance,
+            monitor: None,
         },
         out_dir: args.out.clone(),
         command_line: std::env::args().collect(),
     };
-    let bar = progress_bar(request.loads_n.len(), args.quiet);
-    bar.set_message("loads");
-    let outcome = job::run_simulate(&request, &|done, _| bar.set_position(done as u64));
+    let bar = progress_bar(request.loads_n.len(), 1, args.quiet);
+    bar.set_style(
+        ProgressStyle::with_template("[{bar:30}] {pos}/{len} loads ({elapsed}) {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    let monitor = |iteration: usize, residual: f64| {
+        bar.set_message(format!("CG iteration {iteration}, residual {residual:.2e}"));
+    };
+    let outcome = job::run_simulate(
+        &request,
+        &|done, _| bar.set_position(done as u64),
+        Some(&monitor),
+    );
     bar.finish_and_clear();
     let outcome = outcome?;
     for w in &outcome.warnings {

@@ -16,21 +16,44 @@ use crate::error::{Error, Result};
 
 use super::halfspace::{ElasticOperator, Workspace};
 
+/// Called after every CG iteration with (iteration, relative residual), e.g. for a progress bar.
+pub type Monitor<'a> = &'a (dyn Fn(usize, f64) + Sync);
+
 /// Iteration limits and tolerances.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SolverOptions {
+#[derive(Clone, Copy)]
+pub struct SolverOptions<'a> {
     /// Most CG iterations per solve.
     pub max_iterations: usize,
     /// Relative tolerance: on the gap (relative to the separation's range) over loaded pixels,
     /// on the complementarity violation, and on the pressure change between iterations.
     pub tolerance: f64,
+    /// Progress callback.
+    pub monitor: Option<Monitor<'a>>,
 }
 
-impl Default for SolverOptions {
+impl std::fmt::Debug for SolverOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SolverOptions")
+            .field("max_iterations", &self.max_iterations)
+            .field("tolerance", &self.tolerance)
+            .finish()
+    }
+}
+
+impl Default for SolverOptions<'_> {
     fn default() -> Self {
         SolverOptions {
             max_iterations: 2000,
             tolerance: 1e-10,
+            monitor: None,
+        }
+    }
+}
+
+impl SolverOptions<'_> {
+    fn report(&self, iteration: usize, residual: (f64, f64)) {
+        if let Some(monitor) = self.monitor {
+            monitor(iteration, residual.0.max(residual.1));
         }
     }
 }
@@ -232,6 +255,7 @@ pub fn solve_load(problem: &Problem, force: f64, options: &SolverOptions) -> Res
             .fold(0.0, f64::max)
             / scale;
         residual = (gap_residual, change);
+        options.report(iteration, residual);
         if !overlap && gap_residual < options.tolerance && change < options.tolerance {
             return Ok(finish(problem, p, delta, iteration, residual, &mut work));
         }
@@ -346,6 +370,7 @@ pub fn solve_displacement(
             .sum::<f64>()
             / total;
         residual = (gap_residual, change);
+        options.report(iteration, residual);
         if gap_residual < options.tolerance && change < options.tolerance {
             return Ok(finish_displacement(
                 problem, previous, delta, plasticity, iteration, residual, &mut work,

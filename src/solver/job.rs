@@ -16,7 +16,7 @@ use crate::surface::io::read_topography;
 use crate::surface::stats::SurfaceStats;
 use crate::surface::{Detrend, Topography};
 
-use super::cg::SolverOptions;
+use super::cg::{Monitor, SolverOptions};
 use super::gt::{gt_bearing_area, gt_profile, GtParams};
 use super::halfspace::Boundary;
 use super::simulate::{separation, sweep, LoadStep, Model, Setup};
@@ -61,8 +61,8 @@ pub struct SimulateRequest {
     pub periodic: bool,
     /// Normal forces, N, in order.
     pub loads_n: Vec<f64>,
-    /// Solver limits.
-    pub options: SolverOptions,
+    /// Solver limits (the progress monitor is passed to [`run_simulate`] separately).
+    pub options: SolverOptions<'static>,
     /// Output folder.
     pub out_dir: PathBuf,
     /// The command line, for the summary.
@@ -112,10 +112,11 @@ pub struct SimulateOutcome {
 /// Progress callback: (loads done, loads in all).
 pub type SimulateProgress<'a> = &'a dyn Fn(usize, usize);
 
-/// Run `simulate`.
+/// Run `simulate`. `progress` hears of finished loads, `monitor` of every CG iteration.
 pub fn run_simulate(
     request: &SimulateRequest,
     progress: SimulateProgress,
+    monitor: Option<Monitor>,
 ) -> Result<SimulateOutcome> {
     let mut roughness = read_topography(
         &request.topography,
@@ -132,7 +133,11 @@ pub fn run_simulate(
             if let Some(r) = request.radius_m {
                 body.add_sphere(r)?;
             }
-            run_halfspace(request, model, &body, &staging, progress)?
+            let options = SolverOptions {
+                monitor,
+                ..request.options
+            };
+            run_halfspace(request, model, &body, options, &staging, progress)?
         }
     };
     staging.write("areas.csv", &areas_csv(&loads)?)?;
@@ -155,6 +160,7 @@ fn run_halfspace(
     request: &SimulateRequest,
     model: Model,
     body: &Topography,
+    options: SolverOptions,
     staging: &Staging,
     progress: SimulateProgress,
 ) -> Result<Rows> {
@@ -167,7 +173,7 @@ fn run_halfspace(
             Boundary::Free
         },
         model,
-        options: request.options,
+        options,
     };
     let base = separation(body);
     let total = request.loads_n.len();

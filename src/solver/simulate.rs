@@ -68,7 +68,7 @@ pub struct Setup<'a> {
     /// The model.
     pub model: Model,
     /// CG limits.
-    pub options: SolverOptions,
+    pub options: SolverOptions<'a>,
 }
 
 /// The result at one load.
