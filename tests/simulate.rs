@@ -31,6 +31,7 @@ fn run(topo: &Topography, model: Model, loads: &[f64]) -> Vec<LoadStep> {
         options: SolverOptions {
             max_iterations: 3000,
             tolerance: 1e-9,
+            monitor: None,
         },
     };
     sweep(&setup, loads, &|_, _| {}).unwrap()

@@ -326,6 +326,7 @@ fn iteration_limit_is_a_typed_error() {
     let options = SolverOptions {
         max_iterations: 3,
         tolerance: 1e-12,
+        monitor: None,
     };
     match solve_load(&problem, 15.0, &options) {
         Err(contactscope::Error::NotConverged {
@@ -389,6 +390,7 @@ fn persson_slope_kappa_for_a_periodic_self_affine_surface() {
         let options = SolverOptions {
             max_iterations: 5000,
             tolerance: 1e-8,
+            monitor: None,
         };
         let sol = solve_load(&problem, mean * 1.0, &options).unwrap();
         let fraction = sol.contact_pixels() as f64 / (n * n) as f64;
