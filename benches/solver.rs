@@ -12,21 +12,25 @@
 //! spheres add a paraboloid of R = 290 µm ([`Topography::add_sphere`]). E* = 3.7 GPa. The sphere
 //! loads give a Hertz radius a = 2.5 µm (512²) and 5 µm (1024²), N = 4E*a³/(3R).
 //!
-//! Per problem it prints: surface and operator set-up times, the median of `--applies` timings of
-//! one [`ElasticOperator::apply`] (half before, half after the solves), `--repeats` full solves (iterations, median solve time, time
-//! per iteration), the FFT share `2·apply / (time per iteration)` (each Polonsky–Keer iteration
-//! applies G twice: u = G∗p and r = G∗t), the contact fraction and whether the contact touches
-//! the border of a free map. `tolcheck` solves `sphere512` at 1e-8 and 1e-10 and compares the
-//! contact sets.
+//! Per problem it prints: surface and operator set-up times; the median of `--applies` timings
+//! of one [`ElasticOperator::apply`] (half before, half after the solves); `--repeats` full
+//! solves (iterations, median solve time, time per iteration); the FFT share
+//! `2·apply / (time per iteration)` (each Polonsky–Keer iteration applies G twice: u = G∗p and
+//! r = G∗t); the contact fraction, whether the contact touches the border of a free map, and a
+//! digest of the pressure bits (equal digests: bit-identical results, to compare builds).
+//! `tolcheck` solves `sphere512` at `--tolerance` and at 1e-10 and compares the contact sets.
 //!
 //! ```sh
 //! cargo bench --bench solver                                   # everything
 //! cargo bench --bench solver -- --only sphere1024 --repeats 1  # one problem
-//! /usr/bin/time -v target/release/deps/solver-* --only periodic2048 --repeats 1   # peak RSS
+//! cargo bench --bench solver -- --only periodic2048 --repeats 0 --applies 40   # apply only
+//! # peak RSS: run the executable that `cargo bench --bench solver --no-run` names
+//! /usr/bin/time -v target/release/deps/solver-HASH --only sphere1024 --repeats 1
 //! ```
 //!
-//! Options: `--only NAME` (repeatable), `--repeats N` (default 3), `--applies N` (default 20),
-//! `--tolerance T` (default 1e-8). Unknown arguments (cargo's `--bench`) are ignored.
+//! Options: `--only NAME` (repeatable), `--repeats N` (default 3; 0: time `apply` only),
+//! `--applies N` (default 20), `--tolerance T` (default 1e-8). Unknown arguments (cargo's
+//! `--bench`) are ignored.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -151,6 +155,13 @@ fn edge_contact(pressure: &[f64], n: usize) -> bool {
     })
 }
 
+/// FNV-1a over the bits of a field: equal digests mean bit-identical results (to compare builds).
+fn digest(values: &[f64]) -> u64 {
+    values.iter().fold(0xcbf2_9ce4_8422_2325, |h, v| {
+        (h ^ v.to_bits()).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
 fn solve(problem: &Problem, force: f64, tolerance: f64) -> (Solution, f64) {
     let options = SolverOptions {
         tolerance,
@@ -196,10 +207,21 @@ fn run(case: &Case, setup_s: f64, args: &Args) {
             .collect()
     };
     let mut apply = time_applies(args.applies.div_ceil(2));
+    if args.repeats == 0 {
+        apply.extend(time_applies(args.applies / 2));
+        println!(
+            "{}: apply median {:.2} ms of {} (min {:.2})",
+            case.name,
+            median(apply.clone()) * 1e3,
+            apply.len(),
+            apply.iter().copied().fold(f64::INFINITY, f64::min) * 1e3
+        );
+        return;
+    }
 
     let mut times = Vec::new();
     let mut last = None;
-    for _ in 0..args.repeats.max(1) {
+    for _ in 0..args.repeats {
         let (solution, t) = solve(&problem, case.force_n, args.tolerance);
         times.push(t);
         last = Some(solution);
@@ -244,12 +266,13 @@ fn run(case: &Case, setup_s: f64, args: &Args) {
         (per_iteration - 2.0 * apply_s) * 1e3
     );
     println!(
-        "  contact {contact} px = {:.4} %, edge contact {}, gap residual {:.2e}, pressure change {:.2e}, force {:.6e} N",
+        "  contact {contact} px = {:.4} %, edge contact {}, gap residual {:.2e}, pressure change {:.2e}, force {:.6e} N, pressure digest {:016x}",
         100.0 * contact as f64 / (n * n) as f64,
         case.boundary == Boundary::Free && edge_contact(&solution.pressure, n),
         solution.gap_residual,
         solution.pressure_change,
         solution.force,
+        digest(&solution.pressure),
     );
 }
 
