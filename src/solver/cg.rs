@@ -12,6 +12,8 @@
 //! the final residuals were, and why it stopped; the iteration limit gives
 //! [`Error::NotConverged`] with the residual.
 
+use rayon::prelude::*;
+
 use crate::error::{Error, Result};
 
 use super::halfspace::{ElasticOperator, Workspace};
@@ -192,68 +194,70 @@ pub fn solve_load(problem: &Problem, force: f64, options: &SolverOptions) -> Res
     let scale = problem.gap_scale();
     let mut p = vec![force / (area * n as f64); n];
     let (mut u, mut r, mut t) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let mut g = vec![0.0; n];
+    let (mut g, mut previous) = (vec![0.0; n], vec![0.0; n]);
     let (mut g_old, mut conjugate) = (1.0, false);
     let mut residual = (f64::INFINITY, f64::INFINITY);
+    let s = problem.separation;
+    // The loaded set {p > 0} and the support {p ≠ 0} as ascending index lists. Sums run over
+    // them in index order: the same additions, in the same order, as a sum over all pixels
+    // (adding 0 to a sum that starts at +0 changes nothing), so the result is bit for bit that of
+    // one serial pass per quantity. The element-wise passes over all pixels run in parallel.
+    let mut loaded: Vec<usize> = (0..n).collect();
+    let mut support = loaded.clone();
     for iteration in 1..=options.max_iterations {
         op.apply(&p, &mut u, &mut work);
-        for i in 0..n {
-            g[i] = problem.separation[i] + u[i];
-        }
-        let loaded = |i: usize, p: &[f64]| p[i] > 0.0;
-        let count = (0..n).filter(|&i| loaded(i, &p)).count().max(1);
-        let delta = (0..n).filter(|&i| loaded(i, &p)).map(|i| g[i]).sum::<f64>() / count as f64;
-        g.iter_mut().for_each(|v| *v -= delta);
-        let g_sq: f64 = (0..n).filter(|&i| loaded(i, &p)).map(|i| g[i] * g[i]).sum();
+        // δ is the mean gap over the loaded set.
+        let count = loaded.len().max(1);
+        let delta = loaded.iter().fold(0.0, |a, &i| a + (s[i] + u[i])) / count as f64;
+        g.par_iter_mut()
+            .zip(s)
+            .zip(&u)
+            .for_each(|((g, s), u)| *g = s + u - delta);
+        let g_sq = loaded.iter().fold(0.0, |a, &i| a + g[i] * g[i]);
         let beta = if conjugate { g_sq / g_old } else { 0.0 };
         g_old = g_sq;
-        for i in 0..n {
-            t[i] = if loaded(i, &p) {
-                g[i] + beta * t[i]
-            } else {
-                0.0
-            };
-        }
+        t.par_iter_mut()
+            .zip(&g)
+            .zip(&p)
+            .for_each(|((t, g), p)| *t = if *p > 0.0 { g + beta * *t } else { 0.0 });
         op.apply(&t, &mut r, &mut work);
-        let r_mean = (0..n).filter(|&i| loaded(i, &p)).map(|i| r[i]).sum::<f64>() / count as f64;
-        let (num, den) = (0..n)
-            .filter(|&i| loaded(i, &p))
-            .fold((0.0, 0.0), |(a, b), i| {
-                (a + g[i] * t[i], b + (r[i] - r_mean) * t[i])
-            });
+        let (r_sum, num) = loaded
+            .iter()
+            .fold((0.0, 0.0), |(a, b), &i| (a + r[i], b + g[i] * t[i]));
+        let r_mean = r_sum / count as f64;
+        let den = loaded.iter().fold(0.0, |a, &i| a + (r[i] - r_mean) * t[i]);
         let tau = if den > 0.0 {
             num / den
         } else {
             1.0 / op.self_coefficient()
         };
-        let previous = p.clone();
-        for i in 0..n {
-            if loaded(i, &previous) {
-                p[i] = (p[i] - tau * t[i]).max(0.0);
-            }
-        }
-        let mut overlap = false;
-        for i in 0..n {
-            if p[i] == 0.0 && g[i] < 0.0 {
-                p[i] = -tau * g[i];
-                overlap = true;
-            }
-        }
+        // Step on the loaded set, project onto p ≥ 0, and load overlapping unloaded pixels.
+        let overlap = p
+            .par_iter_mut()
+            .zip(&mut previous)
+            .zip(&t)
+            .zip(&g)
+            .map(|(((p, previous), t), g)| {
+                *previous = *p;
+                if *previous > 0.0 {
+                    *p = (*p - tau * t).max(0.0);
+                }
+                let engage = *p == 0.0 && *g < 0.0;
+                if engage {
+                    *p = -tau * g;
+                }
+                engage
+            })
+            .reduce(|| false, |a, b| a || b);
         conjugate = !overlap;
-        let total: f64 = p.iter().sum::<f64>() * area;
-        p.iter_mut().for_each(|v| *v *= force / total);
-        let change = p
-            .iter()
-            .zip(&previous)
-            .map(|(a, b)| (a - b).abs())
-            .sum::<f64>()
-            * area
-            / force;
-        let gap_residual = (0..n)
-            .filter(|&i| previous[i] > 0.0)
-            .map(|i| g[i].abs())
-            .fold(0.0, f64::max)
-            / scale;
+        let old_support = std::mem::take(&mut support);
+        support = (0..n).into_par_iter().filter(|&i| p[i] != 0.0).collect();
+        let total = support.iter().fold(0.0, |a, &i| a + p[i]) * area;
+        p.par_iter_mut().for_each(|v| *v *= force / total);
+        let change =
+            sum_over_union(&old_support, &support, |i| (p[i] - previous[i]).abs()) * area / force;
+        let gap_residual = loaded.iter().fold(0.0, |m: f64, &i| m.max(g[i].abs())) / scale;
+        loaded = support.iter().copied().filter(|&i| p[i] > 0.0).collect();
         residual = (gap_residual, change);
         options.report(iteration, residual);
         if !overlap && gap_residual < options.tolerance && change < options.tolerance {
@@ -266,6 +270,33 @@ pub fn solve_load(problem: &Problem, force: f64, options: &SolverOptions) -> Res
         residual: residual.0.max(residual.1),
         tolerance: options.tolerance,
     })
+}
+
+/// Σ f(i) over the union of two ascending index lists, in ascending order, each index once.
+fn sum_over_union(a: &[usize], b: &[usize], f: impl Fn(usize) -> f64) -> f64 {
+    let (mut i, mut j, mut sum) = (0, 0, 0.0);
+    loop {
+        let k = match (a.get(i), b.get(j)) {
+            (Some(&x), Some(&y)) if x == y => {
+                (i, j) = (i + 1, j + 1);
+                x
+            }
+            (Some(&x), Some(&y)) if x < y => {
+                i += 1;
+                x
+            }
+            (Some(&x), None) => {
+                i += 1;
+                x
+            }
+            (_, Some(&y)) => {
+                j += 1;
+                y
+            }
+            (None, None) => return sum,
+        };
+        sum += f(k);
+    }
 }
 
 fn finish(
@@ -501,4 +532,23 @@ pub fn solve_load_bounded(
         residual: (best.force - force).abs() / force,
         tolerance: options.tolerance,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sum_over_union;
+
+    #[test]
+    fn union_sum_visits_each_index_once_in_order() {
+        let order = std::cell::RefCell::new(Vec::new());
+        let f = |i: usize| {
+            order.borrow_mut().push(i);
+            i as f64
+        };
+        assert_eq!(sum_over_union(&[0, 2, 5, 9], &[1, 2, 9, 11], f), 28.0);
+        assert_eq!(*order.borrow(), [0, 1, 2, 5, 9, 11]);
+        assert_eq!(sum_over_union(&[], &[3], |i| i as f64), 3.0);
+        assert_eq!(sum_over_union(&[4], &[], |i| i as f64), 4.0);
+        assert_eq!(sum_over_union(&[], &[], |i| i as f64), 0.0);
+    }
 }

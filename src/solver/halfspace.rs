@@ -9,7 +9,7 @@
 //!
 //! Both are symmetric positive (semi-)definite, as conjugate gradients need.
 
-use crate::spectral::{Complex64, RealFft2};
+use crate::spectral::{ConvolveWork, RealFft2};
 
 use super::greens::{love_pixel, periodic_compliance};
 
@@ -80,50 +80,25 @@ impl ElasticOperator {
     /// A scratch buffer set for [`ElasticOperator::apply`].
     pub fn workspace(&self) -> Workspace {
         Workspace {
-            real: vec![0.0; self.ny * self.fft.nx()],
-            spectrum: self.fft.make_spectrum(),
-            scratch: Vec::new(),
+            convolve: self.fft.convolve_work(self.ny),
         }
     }
 
     /// u = G∗p for `p` and `u` of `ny·nx` values (row-major). With free boundaries only the
     /// physical rows are transformed forward and back: the padding rows are known zeros on the
-    /// way in and discarded on the way out.
+    /// way in and discarded on the way out ([`RealFft2::convolve`]).
     pub fn apply(&self, p: &[f64], u: &mut [f64], work: &mut Workspace) {
         let n = self.nx * self.ny;
         assert!(p.len() == n && u.len() == n, "operator: field lengths");
-        let fx = self.fft.nx();
-        for (row, src) in work.real.chunks_mut(fx).zip(p.chunks(self.nx)) {
-            row[..self.nx].copy_from_slice(src);
-            row[self.nx..].fill(0.0);
-        }
-        self.fft.forward_rows(
-            &mut work.real,
-            self.ny,
-            &mut work.spectrum,
-            &mut work.scratch,
-        );
-        for (c, t) in work.spectrum.iter_mut().zip(&self.transfer) {
-            *c *= *t;
-        }
-        self.fft.inverse_rows(
-            &mut work.spectrum,
-            self.ny,
-            &mut work.real,
-            &mut work.scratch,
-        );
-        for (dst, row) in u.chunks_mut(self.nx).zip(work.real.chunks(fx)) {
-            dst.copy_from_slice(&row[..self.nx]);
-        }
+        self.fft
+            .convolve(p, self.nx, &self.transfer, u, &mut work.convolve);
     }
 }
 
 /// Scratch buffers of one operator application.
 #[derive(Debug, Clone)]
 pub struct Workspace {
-    real: Vec<f64>,
-    spectrum: Vec<Complex64>,
-    scratch: Vec<Complex64>,
+    convolve: ConvolveWork,
 }
 
 fn free_transfer(fft: &RealFft2, dx: f64, dy: f64, e_star: f64) -> Vec<f64> {
