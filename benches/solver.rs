@@ -162,6 +162,15 @@ fn digest(values: &[f64]) -> u64 {
     })
 }
 
+/// Largest distance of a contact pixel from the map centre, m.
+fn contact_extent(pressure: &[f64], n: usize, dx: f64) -> f64 {
+    let c = (n as f64 - 1.0) / 2.0;
+    (0..n * n)
+        .filter(|&i| pressure[i] > 0.0)
+        .map(|i| ((i % n) as f64 - c).hypot((i / n) as f64 - c) * dx)
+        .fold(0.0, f64::max)
+}
+
 fn solve(problem: &Problem, force: f64, tolerance: f64) -> (Solution, f64) {
     let options = SolverOptions {
         tolerance,
@@ -260,6 +269,14 @@ fn run(case: &Case, setup_s: f64, args: &Args) {
             .collect::<Vec<_>>(),
         per_iteration * 1e3
     );
+    if case.boundary == Boundary::Free {
+        println!(
+            "  contact extent: farthest contact pixel {:.2} µm from the centre (map half-width \
+             {:.2} µm)",
+            contact_extent(&solution.pressure, n, topo.dx_m) * 1e6,
+            n as f64 * topo.dx_m / 2.0 * 1e6
+        );
+    }
     println!(
         "  FFT share 2·apply/iteration = {:.1} %, non-FFT {:.1} ms/iteration",
         200.0 * apply_s / per_iteration,
