@@ -182,11 +182,7 @@ fn solve_step(
 ) -> Result<(Solution, usize)> {
     let topo = setup.topography;
     let pixel_area = topo.dx_m * topo.dy_m;
-    let geometry: Vec<f64> = base
-        .iter()
-        .zip(plastic.iter())
-        .map(|(s, h)| s + h)
-        .collect();
+    let geometry = deformed(base, plastic);
     let problem = Problem {
         operator,
         separation: &geometry,
@@ -228,6 +224,11 @@ fn solve_step(
             Ok((sol, 1))
         }
     }
+}
+
+/// The separation of the plastically deformed body, s + h_pl.
+fn deformed(base: &[f64], plastic: &[f64]) -> Vec<f64> {
+    base.iter().zip(plastic).map(|(s, h)| s + h).collect()
 }
 
 /// Overlap o = max(0, −g) on pixels at the cap (Eq. 4's increment), zero elsewhere.
@@ -273,11 +274,7 @@ fn conserving_step(
     let mut first_overlap = None;
     let mut worst = f64::NAN;
     for outer in 1..=CONSERVING_MAX_OUTER {
-        let geometry: Vec<f64> = base
-            .iter()
-            .zip(plastic.iter())
-            .map(|(s, h)| s + h)
-            .collect();
+        let geometry = deformed(base, plastic);
         let problem = Problem {
             operator,
             separation: &geometry,
