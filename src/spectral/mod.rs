@@ -13,6 +13,8 @@
 //! * Rows and columns are transformed in parallel (rayon); each call allocates only the scratch it
 //!   needs per thread.
 
+pub mod autocorrelation;
+
 use std::sync::Arc;
 
 use rayon::prelude::*;
