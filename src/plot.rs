@@ -1,4 +1,5 @@
-//! Figures: log-log area–load charts (PNG and SVG) and micrographs with contact edges.
+//! Figures: line-and-marker charts on log-log or linear axes (PNG and SVG) and micrographs with
+//! contact edges.
 //!
 //! Everything here returns bytes or text; writing files (atomically) is the caller's job.
 //!
@@ -6,21 +7,22 @@
 //! so that plots render identically on machines without system fonts, including glyphs such as
 //! `µ` and `²` in axis labels.
 //!
-//! Log axes cannot show zero, negative or non-finite values: such points are skipped, and a plot
-//! with no positive point at all is an [`Error::Plot`].
+//! Non-finite values are never drawn, and log axes cannot show zero or negative values either:
+//! such points are skipped, and a chart with nothing left to draw is an [`Error::Plot`].
 
 use std::io::Cursor;
 use std::sync::OnceLock;
 
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder};
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle, Palette, Palette99};
 
 use crate::error::{Error, Result};
 
-/// Size of [`LogLogPlot`] images in pixels.
+/// Size of [`Chart`] images in pixels.
 const PLOT_SIZE: (u32, u32) = (900, 650);
 
 /// Registered font name. It doubles as the SVG `font-family` attribute, so it is a CSS font
@@ -70,23 +72,53 @@ pub struct Curve {
     pub xy: Vec<(f64, f64)>,
 }
 
-/// A log-log plot: title, axis labels with units, point sets and curves; the legend shows all
+/// Axis scales of a [`Chart`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Axes {
+    /// Both axes logarithmic (area–load curves, power laws).
+    #[default]
+    LogLog,
+    /// Both axes linear (profiles, autocorrelations).
+    Linear,
+}
+
+impl Axes {
+    fn shows(self, (x, y): (f64, f64)) -> bool {
+        x.is_finite() && y.is_finite() && (self == Axes::Linear || (x > 0.0 && y > 0.0))
+    }
+}
+
+/// Corner of a [`Chart`]'s legend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Legend {
+    /// Top left (default; suits rising curves).
+    #[default]
+    UpperLeft,
+    /// Top right (suits decaying curves).
+    UpperRight,
+}
+
+/// A chart: title, axis labels with units, point sets and curves; the legend shows all
 /// non-empty labels.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct LogLogPlot {
+pub struct Chart {
     /// Title above the chart.
     pub title: String,
     /// Description of the x axis, with unit, e.g. `"normal force F (mN)"`.
     pub x_label: String,
     /// Description of the y axis, with unit, e.g. `"contact area A (µm²)"`.
     pub y_label: String,
+    /// Log-log (default) or linear axes.
+    pub axes: Axes,
+    /// Corner of the legend, chosen where the data leaves room.
+    pub legend: Legend,
     /// Measured points, drawn as filled circles.
     pub points: Vec<PointSet>,
     /// Curves, drawn as 2 px solid lines.
     pub curves: Vec<Curve>,
 }
 
-/// What is left of a [`LogLogPlot`] after dropping points that log axes cannot show.
+/// What is left of a [`Chart`] after dropping points that log axes cannot show.
 struct Prepared {
     points: Vec<Vec<(f64, f64)>>,
     /// Per curve, its unbroken runs of drawable vertices.
@@ -95,7 +127,7 @@ struct Prepared {
     y_range: (f64, f64),
 }
 
-impl LogLogPlot {
+impl Chart {
     /// PNG bytes (RGB8), 900×650 px.
     ///
     /// Errors with [`Error::Plot`] if no point or curve vertex is positive and finite, or if
@@ -112,9 +144,9 @@ impl LogLogPlot {
         encode_png(&rgb, w, h)
     }
 
-    /// SVG document text, with the same layout as [`LogLogPlot::to_png`].
+    /// SVG document text, with the same layout as [`Chart::to_png`].
     ///
-    /// Errors as [`LogLogPlot::to_png`] does.
+    /// Errors as [`Chart::to_png`] does.
     pub fn to_svg(&self) -> Result<String> {
         let data = self.prepare()?;
         let mut svg = String::new();
@@ -127,18 +159,22 @@ impl LogLogPlot {
     }
 
     fn prepare(&self) -> Result<Prepared> {
+        let shows = |p: &(f64, f64)| self.axes.shows(*p);
         let points: Vec<Vec<(f64, f64)>> = self
             .points
             .iter()
-            .map(|set| set.xy.iter().copied().filter(|&p| drawable(p)).collect())
+            .map(|set| set.xy.iter().copied().filter(shows).collect())
             .collect();
-        let curves: Vec<Vec<Vec<(f64, f64)>>> =
-            self.curves.iter().map(|c| drawable_runs(&c.xy)).collect();
+        let curves: Vec<Vec<Vec<(f64, f64)>>> = self
+            .curves
+            .iter()
+            .map(|c| drawable_runs(&c.xy, self.axes))
+            .collect();
         let all = points
             .iter()
             .flatten()
             .chain(curves.iter().flatten().flatten());
-        let (x_range, y_range) = padded_ranges(all)?;
+        let (x_range, y_range) = padded_ranges(all, self.axes)?;
         Ok(Prepared {
             points,
             curves,
@@ -156,21 +192,47 @@ impl LogLogPlot {
         root.fill(&WHITE).map_err(plot_err)?;
         let (x0, x1) = data.x_range;
         let (y0, y1) = data.y_range;
-        let mut chart = ChartBuilder::on(root)
+        let mut builder = ChartBuilder::on(root);
+        builder
             .caption(&self.title, (FONT, 24))
             .margin(15)
             .x_label_area_size(55)
-            .y_label_area_size(80)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(plot_err)?;
+            .y_label_area_size(80);
+        match self.axes {
+            Axes::LogLog => {
+                let chart = builder
+                    .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+                    .map_err(plot_err)?;
+                self.draw(chart, data)
+            }
+            Axes::Linear => {
+                let chart = builder
+                    .build_cartesian_2d(x0..x1, y0..y1)
+                    .map_err(plot_err)?;
+                self.draw(chart, data)
+            }
+        }
+    }
+
+    /// Mesh, series and legend on a chart with either axis type.
+    fn draw<'a, DB, X, Y>(
+        &self,
+        mut chart: ChartContext<'a, DB, Cartesian2d<X, Y>>,
+        data: &Prepared,
+    ) -> Result<()>
+    where
+        DB: DrawingBackend + 'a,
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
         chart
             .configure_mesh()
             .x_desc(self.x_label.as_str())
             .y_desc(self.y_label.as_str())
             .label_style((FONT, 15))
             .axis_desc_style((FONT, 18))
-            .x_label_formatter(&|v| tick_label(*v))
-            .y_label_formatter(&|v| tick_label(*v))
+            .x_label_formatter(&|v| tick_label(snap_zero(*v, data.x_range)))
+            .y_label_formatter(&|v| tick_label(snap_zero(*v, data.y_range)))
             .draw()
             .map_err(plot_err)?;
 
@@ -203,7 +265,10 @@ impl LogLogPlot {
         if labelled {
             chart
                 .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
+                .position(match self.legend {
+                    Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+                    Legend::UpperRight => SeriesLabelPosition::UpperRight,
+                })
                 .background_style(WHITE)
                 .border_style(BLACK)
                 .label_font((FONT, 15))
@@ -333,13 +398,9 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     }
 }
 
-fn drawable((x, y): (f64, f64)) -> bool {
-    x.is_finite() && y.is_finite() && x > 0.0 && y > 0.0
-}
-
-/// Splits a polyline into runs of drawable vertices, dropping runs that are empty.
-fn drawable_runs(xy: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
-    xy.split(|&p| !drawable(p))
+/// Splits a polyline into runs of vertices the axes can show, dropping runs that are empty.
+fn drawable_runs(xy: &[(f64, f64)], axes: Axes) -> Vec<Vec<(f64, f64)>> {
+    xy.split(|&p| !axes.shows(p))
         .filter(|run| !run.is_empty())
         .map(<[_]>::to_vec)
         .collect()
@@ -349,21 +410,29 @@ fn drawable_runs(xy: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
 type Ranges = ((f64, f64), (f64, f64));
 
 /// Axis ranges covering all points, padded so that markers are not cut by the frame.
-fn padded_ranges<'a>(points: impl Iterator<Item = &'a (f64, f64)>) -> Result<Ranges> {
+fn padded_ranges<'a>(points: impl Iterator<Item = &'a (f64, f64)>, axes: Axes) -> Result<Ranges> {
     let mut bounds: Option<[f64; 4]> = None;
     for &(x, y) in points {
         let b = bounds.get_or_insert([x, x, y, y]);
         *b = [b[0].min(x), b[1].max(x), b[2].min(y), b[3].max(y)];
     }
-    let [x0, x1, y0, y1] =
-        bounds.ok_or_else(|| Error::Plot("no positive data to plot on log axes".into()))?;
+    let [x0, x1, y0, y1] = bounds.ok_or_else(|| {
+        Error::Plot(match axes {
+            Axes::LogLog => "no positive data to plot on log axes".into(),
+            Axes::Linear => "no finite data to plot".into(),
+        })
+    })?;
+    let pad = match axes {
+        Axes::LogLog => pad_log,
+        Axes::Linear => pad_linear,
+    };
     Ok((pad(x0, x1)?, pad(y0, y1)?))
 }
 
 /// Pads `lo..hi` by ×0.8 / ×1.25. A range inside one decade is widened down to the power of ten
 /// below it, because plotters puts log-axis ticks only from a power of ten upwards and would
 /// otherwise leave the axis without any labels.
-fn pad(lo: f64, hi: f64) -> Result<(f64, f64)> {
+fn pad_log(lo: f64, hi: f64) -> Result<(f64, f64)> {
     let (mut a, b) = (lo * 0.8, hi * 1.25);
     let decade = 10f64.powf(a.log10().floor());
     if decade > 0.0 && decade * 10.0 > b {
@@ -375,6 +444,37 @@ fn pad(lo: f64, hi: f64) -> Result<(f64, f64)> {
         Err(Error::Plot(format!(
             "data range {lo:e}..{hi:e} cannot be shown on log axes"
         )))
+    }
+}
+
+/// Pads `lo..hi` by 5 % of its span on each side; a single value gets a span of 10 % of its
+/// magnitude (or ±1 at zero).
+fn pad_linear(lo: f64, hi: f64) -> Result<(f64, f64)> {
+    let span = hi - lo;
+    let margin = if span > 0.0 {
+        0.05 * span
+    } else if lo != 0.0 {
+        0.05 * lo.abs()
+    } else {
+        1.0
+    };
+    let (a, b) = (lo - margin, hi + margin);
+    if a.is_finite() && b.is_finite() && a < b {
+        Ok((a, b))
+    } else {
+        Err(Error::Plot(format!(
+            "data range {lo:e}..{hi:e} cannot be shown on linear axes"
+        )))
+    }
+}
+
+/// Zero for a tick that is zero up to rounding (linear ticks are accumulated in steps, so the
+/// zero tick can come out as 1e-16); other values unchanged.
+fn snap_zero(v: f64, (lo, hi): (f64, f64)) -> f64 {
+    if v.abs() <= 1e-9 * (hi - lo) {
+        0.0
+    } else {
+        v
     }
 }
 
@@ -440,12 +540,14 @@ fn plot_err(e: impl std::fmt::Display) -> Error {
 mod tests {
     use super::*;
 
-    fn area_load_plot() -> LogLogPlot {
+    fn area_load_plot() -> Chart {
         let forces = [0.5, 1.0, 2.0, 5.0, 10.0];
-        LogLogPlot {
+        Chart {
             title: "Contact area vs load".into(),
             x_label: "normal force F (mN)".into(),
             y_label: "contact area A (µm²)".into(),
+            axes: Axes::LogLog,
+            legend: Legend::UpperLeft,
             points: vec![PointSet {
                 label: "measured".into(),
                 xy: forces
@@ -489,7 +591,7 @@ mod tests {
 
     #[test]
     fn nothing_positive_is_an_error() {
-        let plot = LogLogPlot {
+        let plot = Chart {
             points: vec![PointSet {
                 label: "bad".into(),
                 xy: vec![(0.0, 1.0), (-1.0, 2.0), (1.0, -3.0), (f64::NAN, 1.0)],
@@ -498,14 +600,11 @@ mod tests {
                 label: "zero".into(),
                 xy: vec![(0.0, 0.0), (f64::INFINITY, 1.0)],
             }],
-            ..LogLogPlot::default()
+            ..Chart::default()
         };
         assert!(matches!(plot.to_png(), Err(Error::Plot(_))));
         assert!(matches!(plot.to_svg(), Err(Error::Plot(_))));
-        assert!(matches!(
-            LogLogPlot::default().to_png(),
-            Err(Error::Plot(_))
-        ));
+        assert!(matches!(Chart::default().to_png(), Err(Error::Plot(_))));
     }
 
     #[test]
@@ -517,14 +616,56 @@ mod tests {
         plot.curves[0].xy.insert(10, (f64::NAN, f64::NAN));
         plot.points.push(PointSet::default());
         assert!(plot.to_png().is_ok());
-        let single = LogLogPlot {
+        let single = Chart {
             points: vec![PointSet {
                 label: String::new(),
                 xy: vec![(1.0, 1.0)],
             }],
-            ..LogLogPlot::default()
+            ..Chart::default()
         };
         assert!(single.to_svg().is_ok());
+    }
+
+    #[test]
+    fn linear_chart_shows_zero_and_negative_values() {
+        let chart = Chart {
+            title: "Autocorrelation".into(),
+            x_label: "lag r (µm)".into(),
+            y_label: "C(r)".into(),
+            axes: Axes::Linear,
+            legend: Legend::UpperRight,
+            curves: vec![Curve {
+                label: "cosine".into(),
+                xy: (0..=40)
+                    .map(|i| f64::from(i) * 0.25)
+                    .map(|r| (r, r.cos()))
+                    .collect(),
+            }],
+            ..Chart::default()
+        };
+        let svg = chart.to_svg().unwrap();
+        assert!(svg.contains("cosine") && svg.contains("lag r (µm)"));
+        let ticks: Vec<&str> = svg.lines().filter(|l| !l.starts_with('<')).collect();
+        assert!(
+            ticks.iter().any(|t| t.starts_with('-')),
+            "negative tick expected"
+        );
+        assert!(ticks.contains(&"0"), "zero tick expected: {ticks:?}");
+        assert!(!svg.contains("e-16"), "rounding noise in a tick label");
+        let only_zero = Chart {
+            axes: Axes::Linear,
+            points: vec![PointSet {
+                label: String::new(),
+                xy: vec![(0.0, 0.0)],
+            }],
+            ..Chart::default()
+        };
+        assert!(only_zero.to_png().is_ok());
+        let log = Chart {
+            axes: Axes::LogLog,
+            ..only_zero
+        };
+        assert!(matches!(log.to_png(), Err(Error::Plot(_))));
     }
 
     /// 20×10 image, contact rectangle x in 5..11, y in 3..7, on a background gradient.
@@ -610,13 +751,16 @@ mod tests {
 
     #[test]
     fn ranges_are_padded_and_reach_a_power_of_ten() {
-        assert_eq!(pad(1.0, 100.0).unwrap(), (0.8, 125.0));
-        let (a, b) = pad(2.0e-10, 4.0e-10).unwrap();
+        assert_eq!(pad_log(1.0, 100.0).unwrap(), (0.8, 125.0));
+        let (a, b) = pad_log(2.0e-10, 4.0e-10).unwrap();
         assert!(
             (a - 1e-10).abs() < 1e-22 && (b - 5e-10).abs() < 1e-22,
             "{a} {b}"
         );
-        assert!(pad(1.0, f64::MAX).is_err());
+        assert!(pad_log(1.0, f64::MAX).is_err());
+        assert_eq!(pad_linear(0.0, 10.0).unwrap(), (-0.5, 10.5));
+        assert_eq!(pad_linear(0.0, 0.0).unwrap(), (-1.0, 1.0));
+        assert!(pad_linear(-f64::MAX, f64::MAX).is_err());
     }
 
     #[test]

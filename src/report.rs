@@ -8,7 +8,7 @@ use crate::analysis::{Analysis, HertzParams};
 use crate::error::{Error, Result};
 use crate::fit::{fit_power_law, fit_proportional, PowerLawFit};
 use crate::hertz;
-use crate::plot::{Curve, LogLogPlot, PointSet};
+use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::stack::series::Series;
 
 /// One row of `areas.csv`, in physical units where a pixel size is known.
@@ -256,7 +256,7 @@ impl Report {
     }
 
     /// Log–log plot of area against force with both fits (and the Hertz area if known).
-    pub fn area_plot(&self, title: &str) -> LogLogPlot {
+    pub fn area_plot(&self, title: &str) -> Chart {
         let measured: Vec<(f64, f64)> = self
             .rows
             .iter()
@@ -307,10 +307,12 @@ impl Report {
                     .collect(),
             });
         }
-        LogLogPlot {
+        Chart {
             title: title.to_string(),
             x_label: "normal force N (mN)".into(),
             y_label: self.unit.axis_label().into(),
+            axes: Axes::LogLog,
+            legend: Legend::UpperLeft,
             points: vec![PointSet {
                 label: "measured (Otsu contact pixels × pixel area)".into(),
                 xy: measured,

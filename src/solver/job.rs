@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::fit::fit_power_law;
 use crate::measure::patches::count_patches;
 use crate::output::Staging;
-use crate::plot::{Curve, LogLogPlot, PointSet};
+use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::stack::write::encode_f32_stack;
 use crate::surface::io::read_topography;
 use crate::surface::stats::SurfaceStats;
@@ -372,7 +372,7 @@ fn areas_csv(loads: &[SimulatedLoad]) -> Result<Vec<u8>> {
         .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
 }
 
-fn area_plot(request: &SimulateRequest, loads: &[SimulatedLoad]) -> LogLogPlot {
+fn area_plot(request: &SimulateRequest, loads: &[SimulatedLoad]) -> Chart {
     let xy: Vec<(f64, f64)> = loads
         .iter()
         .map(|l| (l.force_n * 1e3, l.area_m2 * 1e12))
@@ -385,10 +385,12 @@ fn area_plot(request: &SimulateRequest, loads: &[SimulatedLoad]) -> LogLogPlot {
         })
         .into_iter()
         .collect();
-    LogLogPlot {
+    Chart {
         title: format!("Simulated contact area ({} model)", request.model.name()),
         x_label: "normal force N (mN)".into(),
         y_label: "contact area A (µm²)".into(),
+        axes: Axes::LogLog,
+        legend: Legend::UpperLeft,
         points: vec![PointSet {
             label: "simulated (pixels with p > 0)".into(),
             xy,
