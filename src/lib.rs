@@ -57,6 +57,7 @@ pub mod error;
 pub mod fit;
 pub mod hertz;
 pub mod measure;
+pub mod optics;
 pub mod output;
 pub mod pipeline;
 pub mod plot;

@@ -5,6 +5,7 @@
 //! so that one 65 536-bin histogram indexes any 8-bit, 16-bit or signed 16-bit image directly and
 //! exactly. Float data is held as `f32`.
 
+pub mod image;
 pub mod metadata;
 pub mod series;
 pub mod tiff;
