@@ -19,6 +19,7 @@ use rand_distr::{Distribution, Poisson, StandardNormal};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
+use crate::optics::blur::{self, Edges};
 use crate::output::write_atomic;
 use crate::stack::write::{encode_u16_stack_compressed, Compression};
 
@@ -209,42 +210,10 @@ fn render(p: &SynthParams, signal: &[f64], rng: &mut ChaCha8Rng) -> Result<Vec<u
         .collect()
 }
 
-/// Separable Gaussian blur with mirrored edges; `sigma_px` in pixels.
+/// Separable Gaussian blur with mirrored edges; `sigma_px` in pixels (see
+/// [`crate::optics::blur::gaussian_blur`]).
 pub fn gaussian_blur(data: &[f64], width: usize, height: usize, sigma_px: f64) -> Vec<f64> {
-    if sigma_px <= 0.0 {
-        return data.to_vec();
-    }
-    let radius = (4.0 * sigma_px).ceil() as isize;
-    let kernel: Vec<f64> = (-radius..=radius)
-        .map(|k| (-(k * k) as f64 / (2.0 * sigma_px * sigma_px)).exp())
-        .collect();
-    let total: f64 = kernel.iter().sum();
-    let kernel: Vec<f64> = kernel.iter().map(|k| k / total).collect();
-    let mirror = |i: isize, n: usize| -> usize {
-        let n = n as isize;
-        let period = 2 * n;
-        let m = i.rem_euclid(period);
-        (if m < n { m } else { period - 1 - m }) as usize
-    };
-    let mut rows = vec![0.0; data.len()];
-    for y in 0..height {
-        for x in 0..width {
-            rows[y * width + x] = (-radius..=radius)
-                .zip(&kernel)
-                .map(|(k, w)| w * data[y * width + mirror(x as isize + k, width)])
-                .sum();
-        }
-    }
-    let mut out = vec![0.0; data.len()];
-    for y in 0..height {
-        for x in 0..width {
-            out[y * width + x] = (-radius..=radius)
-                .zip(&kernel)
-                .map(|(k, w)| w * rows[mirror(y as isize + k, height) * width + x])
-                .sum();
-        }
-    }
-    out
+    blur::gaussian_blur(data, width, height, (sigma_px, sigma_px), Edges::Mirror)
 }
 
 /// How a generated series is laid out on disk.
