@@ -13,6 +13,7 @@ use contactscope::pipeline::{self, AnalyzeRequest};
 use contactscope::solver::cg::SolverOptions;
 use contactscope::solver::job::{self, ModelChoice, SimulateRequest};
 use contactscope::solver::simulate::Model;
+use contactscope::spectral::job::{run_autocorr, AutocorrRequest};
 use contactscope::stack::series::{self, Series};
 use contactscope::stack::tiff::TiffReader;
 use contactscope::stack::write::Compression;
@@ -53,6 +54,27 @@ enum Command {
     Surface(SurfaceArgs),
     /// Print a topography's size, pixel size and roughness statistics.
     Topography(TopographyArgs),
+    /// Radially averaged intensity autocorrelation of images (several go on one plot).
+    Autocorr(AutocorrArgs),
+}
+
+#[derive(clap::Args)]
+struct AutocorrArgs {
+    /// TIFF images (every page of a multi-page file counts as one image).
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// Pixel size, overriding the files' metadata (e.g. 200nm or 200x210nm).
+    #[arg(long)]
+    pixel_size: Option<String>,
+    /// Largest lag (e.g. 20um); default half the smaller image side.
+    #[arg(long)]
+    max_lag: Option<String>,
+    /// Channel of multi-channel files.
+    #[arg(long)]
+    channel: Option<usize>,
+    /// Output folder.
+    #[arg(long, default_value = "contactscope-out/autocorr")]
+    out: PathBuf,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -312,6 +334,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate(args),
         Command::Surface(args) => surface(args),
         Command::Topography(args) => topography(args),
+        Command::Autocorr(args) => autocorr(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -862,4 +885,40 @@ fn topography(args: TopographyArgs) -> Result<()> {
 
 fn topo_detrend_name(arg: DetrendArg) -> &'static str {
     detrend_of(arg).name()
+}
+
+fn autocorr(args: AutocorrArgs) -> Result<()> {
+    let request = AutocorrRequest {
+        inputs: args.inputs.clone(),
+        channel: args.channel,
+        pixel_size_m: args
+            .pixel_size
+            .as_deref()
+            .map(units::parse_pixel_size)
+            .transpose()
+            .context("--pixel-size")?,
+        max_lag_m: optional_length(&args.max_lag, "--max-lag")?,
+        out_dir: args.out.clone(),
+        command_line: std::env::args().collect(),
+    };
+    let outcome = run_autocorr(&request)?;
+    for w in &outcome.warnings {
+        eprintln!("contactscope: warning: {w}");
+    }
+    let um = |m: Option<f64>| m.map_or("—".to_string(), |v| format!("{:.3}", v * 1e6));
+    println!("{:>12} {:>14}  image", "ξ_1/e (µm)", "first zero (µm)");
+    for c in &outcome.curves {
+        println!(
+            "{:>12} {:>14}  {}",
+            um(c.xi_1e_m),
+            um(c.first_zero_m),
+            c.label
+        );
+    }
+    println!(
+        "wrote {} files to {}",
+        outcome.written.len(),
+        args.out.display()
+    );
+    Ok(())
 }

@@ -14,6 +14,7 @@
 //!   needs per thread.
 
 pub mod autocorrelation;
+pub mod job;
 
 use std::sync::Arc;
 
