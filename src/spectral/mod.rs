@@ -15,6 +15,7 @@
 
 pub mod autocorrelation;
 pub mod job;
+pub mod register;
 
 use std::sync::Arc;
 
