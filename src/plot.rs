@@ -300,20 +300,59 @@ pub fn overlay_png(
     mask: &[bool],
     scale: usize,
 ) -> Result<Vec<u8>> {
-    let (out_w, out_h) = overlay_size(values.len(), width, height, mask.len(), scale)?;
-    let grey = grey_levels(values);
-    let mut rgb = Vec::with_capacity(out_w * out_h * 3);
-    let mut row = Vec::with_capacity(out_w * 3);
+    edge_panels_png(&[values], width, height, mask, scale)
+}
+
+/// Several images of one scene side by side (left to right, 2 white pixels apart before
+/// scaling), each with the same contact edges in green, as in Fig. 2 of Weber et al. 2018
+/// (micrograph, then simulations). All panels share the grey scale of the first one, so a
+/// simulated image put on the micrograph's intensity scale looks comparable; otherwise as
+/// [`overlay_png`], which is the one-panel case.
+pub fn edge_panels_png(
+    panels: &[&[f64]],
+    width: usize,
+    height: usize,
+    mask: &[bool],
+    scale: usize,
+) -> Result<Vec<u8>> {
+    let Some(first) = panels.first() else {
+        return Err(Error::Plot("no panels to draw".into()));
+    };
+    for p in panels {
+        overlay_size(p.len(), width, height, mask.len(), scale)?;
+    }
+    let gap = if panels.len() > 1 { 2 * scale } else { 0 };
+    let panel_w = width * scale;
+    let total_w = panels.len() * panel_w + (panels.len() - 1) * gap;
+    let out_h = height * scale;
+    if total_w
+        .checked_mul(out_h)
+        .is_none_or(|n| n > MAX_OVERLAY_PIXELS)
+    {
+        return Err(Error::Plot(format!(
+            "{} panels of {width}×{height} at scale {scale} exceed {MAX_OVERLAY_PIXELS} pixels",
+            panels.len()
+        )));
+    }
+    let range = stretch_range(first);
+    let greys: Vec<Vec<u8>> = panels.iter().map(|p| grey_levels(p, range)).collect();
+    let mut rgb = Vec::with_capacity(total_w * out_h * 3);
+    let mut row = Vec::with_capacity(total_w * 3);
     for y in 0..height {
         row.clear();
-        for x in 0..width {
-            let colour = if is_edge(mask, width, height, x, y) {
-                EDGE_GREEN
-            } else {
-                [grey[y * width + x]; 3]
-            };
-            for _ in 0..scale {
-                row.extend_from_slice(&colour);
+        for (k, grey) in greys.iter().enumerate() {
+            if k > 0 {
+                row.extend(std::iter::repeat_n(255u8, gap * 3));
+            }
+            for x in 0..width {
+                let colour = if is_edge(mask, width, height, x, y) {
+                    EDGE_GREEN
+                } else {
+                    [grey[y * width + x]; 3]
+                };
+                for _ in 0..scale {
+                    row.extend_from_slice(&colour);
+                }
             }
         }
         for _ in 0..scale {
@@ -321,7 +360,7 @@ pub fn overlay_png(
         }
     }
     let dim = |n: usize| u32::try_from(n).map_err(|_| Error::Plot("overlay too large".into()));
-    encode_png(&rgb, dim(out_w)?, dim(out_h)?)
+    encode_png(&rgb, dim(total_w)?, dim(out_h)?)
 }
 
 /// Checks the overlay inputs; returns the output size in pixels.
@@ -366,17 +405,22 @@ fn is_edge(mask: &[bool], width: usize, height: usize, x: usize, y: usize) -> bo
             || (y + 1 < height && not_contact(x, y + 1)))
 }
 
-/// Contrast-stretched 8-bit grey level per pixel; non-finite values become 0 (black).
-fn grey_levels(values: &[f64]) -> Vec<u8> {
+/// Grey-scale limits of an image: its 0.5th and 99.5th percentiles of the finite values (min and
+/// max if those coincide); `None` without finite values.
+fn stretch_range(values: &[f64]) -> Option<(f64, f64)> {
     let mut finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     finite.sort_unstable_by(f64::total_cmp);
-    let Some((&min, &max)) = finite.first().zip(finite.last()) else {
+    let (&min, &max) = finite.first().zip(finite.last())?;
+    let (lo, hi) = (percentile(&finite, 0.005), percentile(&finite, 0.995));
+    Some(if lo < hi { (lo, hi) } else { (min, max) })
+}
+
+/// Contrast-stretched 8-bit grey level per pixel between `range`; non-finite values become 0
+/// (black), everything is mid-grey when the range is empty.
+fn grey_levels(values: &[f64], range: Option<(f64, f64)>) -> Vec<u8> {
+    let Some((lo, hi)) = range else {
         return vec![0; values.len()];
     };
-    let (mut lo, mut hi) = (percentile(&finite, 0.005), percentile(&finite, 0.995));
-    if lo >= hi {
-        (lo, hi) = (min, max);
-    }
     values
         .iter()
         .map(|&v| match v {
@@ -721,6 +765,27 @@ mod tests {
         let png = overlay_png(&[7.0; 6], 3, 2, &[false; 6], 1).unwrap();
         let img = image::load_from_memory(&png).unwrap().to_rgb8();
         assert!(img.pixels().all(|p| p.0 == [128, 128, 128]));
+    }
+
+    #[test]
+    fn panels_share_the_first_panels_grey_scale() {
+        let (values, mask) = rectangle_scene();
+        let dimmer: Vec<f64> = values.iter().map(|v| v * 0.5).collect();
+        let png = edge_panels_png(&[&values, &dimmer], 20, 10, &mask, 2).unwrap();
+        let img = image::load_from_memory(&png).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (2 * 40 + 4, 20));
+        // Same interior pixel: full white in panel 1, about half grey in panel 2.
+        let left = img.get_pixel(12, 8).0[0];
+        let right = img.get_pixel(44 + 12, 8).0[0];
+        assert_eq!(left, 255);
+        assert!((100..=160).contains(&right), "{right}");
+        assert_eq!(img.get_pixel(41, 8).0, [255, 255, 255], "white gap");
+        assert_eq!(
+            img.get_pixel(44 + 10, 6).0,
+            EDGE_GREEN,
+            "edges on both panels"
+        );
+        assert!(edge_panels_png(&[], 20, 10, &mask, 1).is_err());
     }
 
     #[test]

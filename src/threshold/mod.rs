@@ -143,8 +143,51 @@ impl Threshold {
     }
 }
 
+/// Exact Otsu threshold of float values pooled from several images, with [`FLOAT_BINS`] equal
+/// bins over their finite range as for float images; contact is value > t. `what` names the
+/// data in the error for constant values.
+pub fn otsu_of_values(images: &[&[f64]], what: &str) -> Result<f64> {
+    let finite = || {
+        images
+            .iter()
+            .flat_map(|v| v.iter())
+            .copied()
+            .filter(|v| v.is_finite())
+    };
+    let (lo, hi) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
+        return Err(Error::ConstantData {
+            what: what.to_string(),
+            value: lo,
+        });
+    }
+    let binning = FloatBinning::new(lo, hi, FLOAT_BINS)?;
+    let mut counts = vec![0u64; FLOAT_BINS];
+    for v in finite() {
+        if let Some(i) = binning.index(v as f32) {
+            counts[i] += 1;
+        }
+    }
+    let k = otsu::otsu_split(&counts).ok_or_else(|| Error::ConstantData {
+        what: what.to_string(),
+        value: lo,
+    })?;
+    Ok(binning.upper_edge(k))
+}
+
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn otsu_of_values_splits_two_levels() {
+        let a = [0.1, 0.1, 0.12, 0.9];
+        let b = [0.88, 0.9, 0.11];
+        let t = otsu_of_values(&[&a, &b], "test").unwrap();
+        assert!(t > 0.12 && t < 0.88, "{t}");
+        assert!(otsu_of_values(&[&[0.5, 0.5, f64::NAN]], "flat").is_err());
+    }
     use super::*;
     use crate::stack::Plane;
 
