@@ -53,6 +53,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod compare;
 pub mod error;
 pub mod fit;
 pub mod hertz;

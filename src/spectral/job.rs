@@ -37,6 +37,11 @@ impl AcfCurve {
         (dx_m, dy_m): (f64, f64),
         max_lag_m: f64,
     ) -> Result<Self> {
+        if !(max_lag_m.is_finite() && max_lag_m > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "largest lag {max_lag_m:e} m is not a positive length"
+            )));
+        }
         let acf = autocorrelation(values, width, height)?;
         let profile = radial_average(&acf, dx_m, dy_m, max_lag_m);
         Ok(AcfCurve {

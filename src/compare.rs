@@ -1,0 +1,639 @@
+//! Simulated contact maps against micrographs, load by load (Weber et al. 2018, Fig. 2 and
+//! "Comparison with experiments"; methods.md §7.4 and §8).
+//!
+//! Per load present in both (matched by force): the simulated contact map (pixels with g = 0) is
+//! blurred with the PSF and integrated onto the micrograph's pixels ([`crate::optics::blur`]),
+//! placed at the centre of a canvas the size of the micrograph, registered to it by phase
+//! correlation (optionally over the 8 dihedral transforms; [`crate::spectral::register`]), and
+//! both are thresholded: the micrographs with one exact Otsu threshold over the whole experiment
+//! series (as `analyze`), the simulated images with one Otsu threshold over all of them (the
+//! same procedure on the simulated series). Scores are computed on the region the simulation
+//! covers after registration: Dice, Jaccard, the area ratio, their sensitivity to ±10 % of the
+//! experiment's threshold, and the RMS distance between the radially averaged intensity
+//! autocorrelations of the two images.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::{json, Value};
+
+use crate::analysis::global_threshold;
+use crate::error::{Error, Location, Result};
+use crate::optics::blur::{microscope_image, Grid, IntensityScale};
+use crate::output::Staging;
+use crate::plot::edge_panels_png;
+use crate::spectral::job::AcfCurve;
+use crate::spectral::register::{register, translate, Dihedral, Shift};
+use crate::stack::image::{pixel_size_or, read_image};
+use crate::stack::series::{self, Series};
+use crate::stack::tiff::TiffReader;
+use crate::threshold::otsu_of_values;
+
+/// Where the micrographs come from.
+#[derive(Debug, Clone)]
+pub enum ExperimentInput {
+    /// A manifest CSV (`file, page, force_mN`), or a folder holding `manifest.csv`.
+    Manifest(PathBuf),
+    /// TIFF files or folders with one force per image, N.
+    Files {
+        /// Files or folders, in natural order.
+        inputs: Vec<PathBuf>,
+        /// Normal force per image, N.
+        forces_n: Vec<f64>,
+    },
+}
+
+/// Everything `compare` needs, already parsed.
+#[derive(Debug, Clone)]
+pub struct CompareRequest {
+    /// The experiment series.
+    pub experiment: ExperimentInput,
+    /// Channel of multi-channel micrographs.
+    pub channel: Option<usize>,
+    /// Micrograph pixel size override (x, y), m.
+    pub pixel_size_m: Option<(f64, f64)>,
+    /// Output folder of `contactscope simulate` (areas.csv + load_NNN_contact.tif).
+    pub simulation: PathBuf,
+    /// PSF FWHM, m.
+    pub psf_fwhm_m: f64,
+    /// Try the 8 dihedral transforms (mirror and 90° rotations) when registering.
+    pub dihedral: bool,
+    /// Sub-pixel resolution of the registration, 1/`upsample` px.
+    pub upsample: usize,
+    /// Largest relative force difference for two loads to match.
+    pub force_tolerance: f64,
+    /// Output folder.
+    pub out_dir: PathBuf,
+    /// The command line, for the JSON.
+    pub command_line: Vec<String>,
+}
+
+/// Scores of one matched load.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadComparison {
+    /// Experimental normal force, N.
+    pub force_n: f64,
+    /// Simulated normal force, N.
+    pub simulated_force_n: f64,
+    /// Micrograph file and page.
+    pub micrograph: (PathBuf, usize),
+    /// Simulated contact map file.
+    pub simulated_map: PathBuf,
+    /// Transform applied to the simulated image.
+    pub transform: Dihedral,
+    /// Translation applied after the transform, micrograph pixels (x, y).
+    pub shift_px: (f64, f64),
+    /// Normalised phase-correlation peak (1 = perfect).
+    pub correlation_peak: f64,
+    /// Experimental contact area inside the compared region, m².
+    pub experiment_area_m2: f64,
+    /// Blurred-and-thresholded simulated contact area inside the region, m².
+    pub simulated_area_m2: f64,
+    /// Raw simulated contact area (g = 0 pixels on the simulation grid), m².
+    pub simulated_raw_area_m2: f64,
+    /// Dice coefficient 2|A∩B|/(|A|+|B|).
+    pub dice: f64,
+    /// Jaccard index |A∩B|/|A∪B|.
+    pub jaccard: f64,
+    /// Dice with the experiment's threshold lowered and raised by 10 %.
+    pub dice_threshold_pm10: (f64, f64),
+    /// RMS difference of the radially averaged autocorrelations over common lags.
+    pub acf_rms_distance: Option<f64>,
+    /// Correlation lengths ξ_1/e of experiment and simulation, m.
+    pub xi_1e_m: (Option<f64>, Option<f64>),
+    /// Simulated intensity put on the micrograph's grey scale.
+    pub intensity: IntensityScale,
+}
+
+/// What `compare` computed and wrote.
+#[derive(Debug, Clone)]
+pub struct CompareOutcome {
+    /// One entry per matched load, in experiment order.
+    pub loads: Vec<LoadComparison>,
+    /// Experiment threshold (grey levels) and simulated threshold (blurred intensity, 0..1).
+    pub thresholds: (f64, f64),
+    /// Files written.
+    pub written: Vec<PathBuf>,
+    /// Notes for the user.
+    pub warnings: Vec<String>,
+}
+
+/// The PSF FWHM (m) recorded by `contactscope psf` in its `psf.json` (`fwhm_nm_mean`).
+pub fn fwhm_from_psf_json(path: &Path) -> Result<f64> {
+    let at = Location::file(path);
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let value: Value = serde_json::from_str(&text)
+        .map_err(|e| Error::bad_input(at.clone(), format!("not JSON: {e}")))?;
+    match value.get("fwhm_nm_mean").and_then(Value::as_f64) {
+        Some(nm) if nm > 0.0 && nm.is_finite() => Ok(nm * 1e-9),
+        _ => Err(Error::bad_input(
+            at,
+            "no positive fwhm_nm_mean (expected the psf.json written by `contactscope psf`)",
+        )),
+    }
+}
+
+/// One simulated load: force and contact map file.
+struct SimulatedLoad {
+    force_n: f64,
+    map: PathBuf,
+}
+
+/// A matched pair before thresholding.
+struct Prepared {
+    force_n: f64,
+    sim: SimulatedLoad,
+    micrograph: (PathBuf, usize),
+    /// Micrograph (width, height), pixels.
+    size: (usize, usize),
+    experiment: Vec<f64>,
+    simulated: Vec<f64>,
+    footprint: Vec<bool>,
+    transform: Dihedral,
+    shift: Shift,
+    raw_area_m2: f64,
+}
+
+/// Below this correlation peak a registration is reported as doubtful.
+const WEAK_PEAK: f64 = 0.05;
+
+/// Run `compare`: match loads, render, register, threshold, score, and write `compare.csv`,
+/// `compare.json` and one `panel_NNN.png` per matched load (all or nothing).
+pub fn run_compare(request: &CompareRequest) -> Result<CompareOutcome> {
+    let series = experiment_series(request)?;
+    let simulated = simulated_loads(&request.simulation)?;
+    let pairs = match_loads(&series, &simulated, request.force_tolerance)?;
+    let (threshold, _, mut warnings) = global_threshold(&series, &|_, _, _| {})?;
+    let pixel = experiment_pixel(&series, request)?;
+    let mut prepared = Vec::new();
+    for (image, sim) in pairs {
+        prepared.push(prepare(request, &series, image, sim, pixel)?);
+    }
+    let sim_sets: Vec<Vec<f64>> = prepared.iter().map(inside_footprint).collect();
+    let refs: Vec<&[f64]> = sim_sets.iter().map(Vec::as_slice).collect();
+    let sim_threshold = otsu_of_values(&refs, "the blurred simulated maps")?;
+    let loads: Vec<LoadComparison> = prepared
+        .iter()
+        .map(|p| score(p, threshold.value, sim_threshold, pixel))
+        .collect::<Result<_>>()?;
+    for l in &loads {
+        if l.correlation_peak < WEAK_PEAK {
+            warnings.push(format!(
+                "{:.3} mN: weak registration (correlation peak {:.3}); check the overlay panel",
+                l.force_n * 1e3,
+                l.correlation_peak
+            ));
+        }
+    }
+    let staging = Staging::new(&request.out_dir, &input_files(request, &series))?;
+    staging.write("compare.csv", compare_csv(&loads, pixel)?.as_bytes())?;
+    for (i, p) in prepared.iter().enumerate() {
+        staging.write(
+            &format!("panel_{:03}.png", i + 1),
+            &panel(p, &loads[i], threshold.value)?,
+        )?;
+    }
+    let summary = summary_json(request, &loads, (threshold.value, sim_threshold), &warnings);
+    let text = serde_json::to_string_pretty(&summary)
+        .map_err(|e| Error::InvalidArgument(format!("JSON: {e}")))?;
+    staging.write("compare.json", text.as_bytes())?;
+    Ok(CompareOutcome {
+        loads,
+        thresholds: (threshold.value, sim_threshold),
+        written: staging.commit()?,
+        warnings,
+    })
+}
+
+fn experiment_series(request: &CompareRequest) -> Result<Series> {
+    match &request.experiment {
+        ExperimentInput::Manifest(path) => {
+            let manifest = if path.is_dir() {
+                path.join("manifest.csv")
+            } else {
+                path.clone()
+            };
+            if !manifest.is_file() {
+                return Err(Error::bad_input(
+                    Location::file(path),
+                    "no manifest: give a manifest CSV (file, page, force_mN) or a folder holding manifest.csv, or TIFF files with --forces",
+                ));
+            }
+            series::from_manifest(&manifest, request.channel)
+        }
+        ExperimentInput::Files { inputs, forces_n } => {
+            let mut s = series::from_files(inputs, request.channel)?;
+            series::assign_forces(&mut s, forces_n)?;
+            Ok(s)
+        }
+    }
+}
+
+/// The loads of a `simulate` output folder: `areas.csv` rows and `load_NNN_contact.tif`.
+fn simulated_loads(dir: &Path) -> Result<Vec<SimulatedLoad>> {
+    let table = dir.join("areas.csv");
+    let at = Location::file(&table);
+    let text = std::fs::read_to_string(&table).map_err(|e| {
+        Error::bad_input(
+            Location::file(dir),
+            format!("not a `contactscope simulate` output folder (areas.csv: {e})"),
+        )
+    })?;
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let headers = reader
+        .headers()
+        .map_err(|e| Error::bad_input(at.clone(), format!("bad CSV header: {e}")))?
+        .clone();
+    let col = headers
+        .iter()
+        .position(|h| h == "force_mN")
+        .ok_or_else(|| Error::bad_input(at.clone(), "no force_mN column"))?;
+    let mut loads = Vec::new();
+    for (i, record) in reader.records().enumerate() {
+        let record =
+            record.map_err(|e| Error::bad_input(at.clone(), format!("row {}: {e}", i + 1)))?;
+        let force_mn: f64 = record
+            .get(col)
+            .and_then(|v| v.trim().parse().ok())
+            .ok_or_else(|| {
+                Error::bad_input(
+                    at.clone(),
+                    format!("row {}: force_mN is not a number", i + 1),
+                )
+            })?;
+        let map = dir.join(format!("load_{:03}_contact.tif", i + 1));
+        if !map.is_file() {
+            return Err(Error::bad_input(
+                Location::file(&map),
+                "contact map listed in areas.csv is missing",
+            ));
+        }
+        loads.push(SimulatedLoad {
+            force_n: force_mn * 1e-3,
+            map,
+        });
+    }
+    Ok(loads)
+}
+
+/// Pairs (experiment image index, simulated load) whose forces agree within the tolerance; each
+/// experiment image takes the nearest simulated force.
+fn match_loads(
+    series: &Series,
+    simulated: &[SimulatedLoad],
+    tolerance: f64,
+) -> Result<Vec<(usize, SimulatedLoad)>> {
+    let mut pairs = Vec::new();
+    for (i, image) in series.images.iter().enumerate() {
+        let Some(f) = image.force_n else { continue };
+        let nearest = simulated
+            .iter()
+            .min_by(|a, b| (a.force_n - f).abs().total_cmp(&(b.force_n - f).abs()));
+        if let Some(s) = nearest.filter(|s| (s.force_n / f - 1.0).abs() <= tolerance) {
+            pairs.push((
+                i,
+                SimulatedLoad {
+                    force_n: s.force_n,
+                    map: s.map.clone(),
+                },
+            ));
+        }
+    }
+    if pairs.is_empty() {
+        let list = |v: Vec<f64>| {
+            v.iter()
+                .map(|f| format!("{:.4}", f * 1e3))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        return Err(Error::InvalidArgument(format!(
+            "the simulation and the experiment have no common load within {:.1} %: experiment {} mN, simulation {} mN",
+            tolerance * 100.0,
+            list(series.images.iter().filter_map(|i| i.force_n).collect()),
+            list(simulated.iter().map(|s| s.force_n).collect()),
+        )));
+    }
+    Ok(pairs)
+}
+
+fn experiment_pixel(series: &Series, request: &CompareRequest) -> Result<(f64, f64)> {
+    let first = &series.files[0];
+    pixel_size_or(first.pixel_size, request.pixel_size_m)
+        .map(|p| (p.x_m, p.y_m))
+        .ok_or_else(|| {
+            Error::bad_input(
+                Location::file(&first.path),
+                "no pixel size in the file's metadata; give one with --pixel-size (e.g. 200nm)",
+            )
+        })
+}
+
+fn prepare(
+    request: &CompareRequest,
+    series: &Series,
+    index: usize,
+    sim: SimulatedLoad,
+    pixel: (f64, f64),
+) -> Result<Prepared> {
+    let image = &series.images[index];
+    let plane = TiffReader::open(&image.path)?.read_page(image.page, series.channel)?;
+    let (w, h) = (plane.width, plane.height);
+    let map = read_image(&sim.map, None, None)?;
+    let px = map.require_pixel_size()?;
+    let at = Location::file(&sim.map);
+    let grid = Grid::new(map.values.clone(), map.width, map.height, px.x_m, px.y_m)
+        .map_err(|e| Error::bad_input(at.clone(), e.to_string()))?;
+    let raw_area_m2 = grid.integral();
+    let rendered = microscope_image(&grid, request.psf_fwhm_m, pixel)
+        .map_err(|e| Error::bad_input(at.clone(), e.to_string()))?;
+    if rendered.width > w || rendered.height > h {
+        return Err(Error::bad_input(
+            at,
+            format!(
+                "the simulated region ({}×{} micrograph pixels) is larger than the micrograph ({w}×{h}); crop the simulation",
+                rendered.width, rendered.height
+            ),
+        ));
+    }
+    let (canvas, frame) = centred(&rendered, w, h);
+    let experiment = plane.to_f64();
+    let (transform, shift) = register(
+        &experiment,
+        &canvas,
+        (w, h),
+        request.upsample,
+        request.dihedral,
+    )
+    .map_err(|e| Error::bad_input(Location::page(&image.path, image.page), e.to_string()))?;
+    let align = |img: &[f64]| {
+        let (t, _, _) = transform.apply(img, w, h);
+        translate(&t, (w, h), (-shift.dx, -shift.dy), 0.0)
+    };
+    let simulated = align(&canvas);
+    let footprint = align(&frame).iter().map(|&v| v > 0.999).collect();
+    Ok(Prepared {
+        force_n: image.force_n.unwrap_or(f64::NAN),
+        sim,
+        micrograph: (image.path.clone(), image.page),
+        size: (w, h),
+        experiment,
+        simulated,
+        footprint,
+        transform,
+        shift,
+        raw_area_m2,
+    })
+}
+
+/// `grid` centred on a zero canvas of `w × h`, and the indicator of where it lies.
+fn centred(grid: &Grid, w: usize, h: usize) -> (Vec<f64>, Vec<f64>) {
+    let (x0, y0) = ((w - grid.width) / 2, (h - grid.height) / 2);
+    let mut canvas = vec![0.0; w * h];
+    let mut frame = vec![0.0; w * h];
+    for y in 0..grid.height {
+        for x in 0..grid.width {
+            canvas[(y + y0) * w + x + x0] = grid.values[y * grid.width + x];
+            frame[(y + y0) * w + x + x0] = 1.0;
+        }
+    }
+    (canvas, frame)
+}
+
+fn inside_footprint(p: &Prepared) -> Vec<f64> {
+    p.simulated
+        .iter()
+        .zip(&p.footprint)
+        .filter(|(_, &inside)| inside)
+        .map(|(&v, _)| v)
+        .collect()
+}
+
+/// (|A|, |B|, |A∩B|) over the footprint.
+fn overlap(p: &Prepared, t_exp: f64, t_sim: f64) -> (usize, usize, usize) {
+    let mut counts = (0, 0, 0);
+    for ((e, s), &inside) in p.experiment.iter().zip(&p.simulated).zip(&p.footprint) {
+        if inside {
+            let (a, b) = (*e > t_exp, *s > t_sim);
+            counts.0 += usize::from(a);
+            counts.1 += usize::from(b);
+            counts.2 += usize::from(a && b);
+        }
+    }
+    counts
+}
+
+/// Dice from (|A|, |B|, |A∩B|); 1 when both are empty (identical empty maps).
+fn dice((a, b, both): (usize, usize, usize)) -> f64 {
+    if a + b == 0 {
+        1.0
+    } else {
+        2.0 * both as f64 / (a + b) as f64
+    }
+}
+
+fn score(p: &Prepared, t_exp: f64, t_sim: f64, pixel: (f64, f64)) -> Result<LoadComparison> {
+    let counts = overlap(p, t_exp, t_sim);
+    let d = dice(counts);
+    let pixel_area = pixel.0 * pixel.1;
+    let masked = |img: &[f64]| -> Vec<f64> {
+        img.iter()
+            .zip(&p.footprint)
+            .map(|(&v, &inside)| if inside { v } else { f64::NAN })
+            .collect()
+    };
+    let (width, height) = p.size;
+    let max_lag = 0.5 * (width as f64 * pixel.0).min(height as f64 * pixel.1);
+    let acf = |label: &str, img: &[f64]| {
+        AcfCurve::of_grid(label, &masked(img), (width, height), pixel, max_lag).ok()
+    };
+    let (acf_exp, acf_sim) = (
+        acf("experiment", &p.experiment),
+        acf("simulation", &p.simulated),
+    );
+    let inside = |img: &[f64]| -> Vec<f64> {
+        img.iter()
+            .zip(&p.footprint)
+            .filter(|(_, &i)| i)
+            .map(|(&v, _)| v)
+            .collect()
+    };
+    let intensity = IntensityScale::fit(&inside(&p.simulated), &inside(&p.experiment)).unwrap_or(
+        IntensityScale {
+            gain: 1.0,
+            offset: 0.0,
+        },
+    );
+    Ok(LoadComparison {
+        force_n: p.force_n,
+        simulated_force_n: p.sim.force_n,
+        micrograph: p.micrograph.clone(),
+        simulated_map: p.sim.map.clone(),
+        transform: p.transform,
+        shift_px: (-p.shift.dx, -p.shift.dy),
+        correlation_peak: p.shift.peak,
+        experiment_area_m2: counts.0 as f64 * pixel_area,
+        simulated_area_m2: counts.1 as f64 * pixel_area,
+        simulated_raw_area_m2: p.raw_area_m2,
+        dice: d,
+        jaccard: d / (2.0 - d),
+        dice_threshold_pm10: (
+            dice(overlap(p, 0.9 * t_exp, t_sim)),
+            dice(overlap(p, 1.1 * t_exp, t_sim)),
+        ),
+        acf_rms_distance: acf_exp
+            .as_ref()
+            .zip(acf_sim.as_ref())
+            .and_then(|(a, b)| a.rms_distance(b)),
+        xi_1e_m: (
+            acf_exp.and_then(|c| c.xi_1e_m),
+            acf_sim.and_then(|c| c.xi_1e_m),
+        ),
+        intensity,
+    })
+}
+
+/// Micrograph | simulated image on the micrograph's grey scale, the experiment's contact edges
+/// in green on both (Fig. 2a style).
+fn panel(p: &Prepared, load: &LoadComparison, t_exp: f64) -> Result<Vec<u8>> {
+    let (w, h) = p.size;
+    let mask: Vec<bool> = p.experiment.iter().map(|&v| v > t_exp).collect();
+    let simulated: Vec<f64> = p
+        .simulated
+        .iter()
+        .zip(&p.footprint)
+        .map(|(&v, &inside)| {
+            if inside {
+                load.intensity.apply(v)
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    let scale = (512 / w.max(h)).clamp(1, 4);
+    edge_panels_png(&[&p.experiment, &simulated], w, h, &mask, scale)
+}
+
+fn compare_csv(loads: &[LoadComparison], pixel: (f64, f64)) -> Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let csv_err = |e: csv::Error| Error::InvalidArgument(format!("CSV: {e}"));
+    w.write_record([
+        "force_mN",
+        "simulated_force_mN",
+        "transform",
+        "shift_x_px",
+        "shift_y_px",
+        "shift_x_um",
+        "shift_y_um",
+        "correlation_peak",
+        "experiment_area_um2",
+        "simulated_area_um2",
+        "simulated_raw_area_um2",
+        "area_ratio",
+        "dice",
+        "jaccard",
+        "dice_threshold_minus10pct",
+        "dice_threshold_plus10pct",
+        "acf_rms_distance",
+        "experiment_xi_1e_um",
+        "simulated_xi_1e_um",
+        "intensity_gain",
+        "intensity_offset",
+        "micrograph",
+        "simulated_map",
+    ])
+    .map_err(csv_err)?;
+    let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.6}"));
+    for l in loads {
+        w.write_record([
+            format!("{:.6}", l.force_n * 1e3),
+            format!("{:.6}", l.simulated_force_n * 1e3),
+            l.transform.name(),
+            format!("{:.3}", l.shift_px.0),
+            format!("{:.3}", l.shift_px.1),
+            format!("{:.4}", l.shift_px.0 * pixel.0 * 1e6),
+            format!("{:.4}", l.shift_px.1 * pixel.1 * 1e6),
+            format!("{:.4}", l.correlation_peak),
+            format!("{:.4}", l.experiment_area_m2 * 1e12),
+            format!("{:.4}", l.simulated_area_m2 * 1e12),
+            format!("{:.4}", l.simulated_raw_area_m2 * 1e12),
+            opt((l.experiment_area_m2 > 0.0).then(|| l.simulated_area_m2 / l.experiment_area_m2)),
+            format!("{:.5}", l.dice),
+            format!("{:.5}", l.jaccard),
+            format!("{:.5}", l.dice_threshold_pm10.0),
+            format!("{:.5}", l.dice_threshold_pm10.1),
+            opt(l.acf_rms_distance),
+            opt(l.xi_1e_m.0.map(|v| v * 1e6)),
+            opt(l.xi_1e_m.1.map(|v| v * 1e6)),
+            format!("{:.4}", l.intensity.gain),
+            format!("{:.4}", l.intensity.offset),
+            format!("{}:page {}", l.micrograph.0.display(), l.micrograph.1),
+            l.simulated_map.display().to_string(),
+        ])
+        .map_err(csv_err)?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
+    String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
+}
+
+fn input_files(request: &CompareRequest, series: &Series) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = series.files.iter().map(|f| f.path.clone()).collect();
+    if let Some(m) = &series.manifest {
+        files.push(m.clone());
+    }
+    files.push(request.simulation.join("areas.csv"));
+    files
+}
+
+fn summary_json(
+    request: &CompareRequest,
+    loads: &[LoadComparison],
+    (t_exp, t_sim): (f64, f64),
+    warnings: &[String],
+) -> Value {
+    let per_load: Vec<Value> = loads
+        .iter()
+        .map(|l| {
+            json!({
+                "force_mN": l.force_n * 1e3,
+                "simulated_force_mN": l.simulated_force_n * 1e3,
+                "transform": l.transform.name(),
+                "shift_x_px": l.shift_px.0,
+                "shift_y_px": l.shift_px.1,
+                "correlation_peak": l.correlation_peak,
+                "experiment_area_um2": l.experiment_area_m2 * 1e12,
+                "simulated_area_um2": l.simulated_area_m2 * 1e12,
+                "simulated_raw_area_um2": l.simulated_raw_area_m2 * 1e12,
+                "dice": l.dice,
+                "jaccard": l.jaccard,
+                "acf_rms_distance": l.acf_rms_distance,
+            })
+        })
+        .collect();
+    let mean = |f: &dyn Fn(&LoadComparison) -> f64| {
+        loads.iter().map(f).sum::<f64>() / loads.len().max(1) as f64
+    };
+    json!({
+        "contactscope_version": env!("CARGO_PKG_VERSION"),
+        "command_line": request.command_line,
+        "simulation": request.simulation.display().to_string(),
+        "psf_fwhm_nm": request.psf_fwhm_m * 1e9,
+        "experiment_threshold": t_exp,
+        "simulated_threshold": t_sim,
+        "dihedral_search": request.dihedral,
+        "upsample": request.upsample,
+        "force_tolerance_pct": request.force_tolerance * 100.0,
+        "loads_matched": loads.len(),
+        "dice_mean": mean(&|l| l.dice),
+        "jaccard_mean": mean(&|l| l.jaccard),
+        "method": {
+            "simulated_image": "contact map (g = 0) blurred by a Gaussian PSF on the simulation grid, integrated over micrograph pixels (area fraction), centred on a micrograph-sized canvas",
+            "registration": "phase correlation with Hann window, upsampled-DFT sub-pixel refinement",
+            "thresholds": "experiment: exact Otsu over all micrographs of the series; simulation: Otsu over all blurred simulated images (4096 bins)",
+            "scores": "on the region covered by the simulation after registration",
+            "acf_rms_distance": "RMS difference of the radially averaged intensity autocorrelations, lags up to half the smaller micrograph side",
+        },
+        "loads": per_load,
+        "warnings": warnings,
+    })
+}
