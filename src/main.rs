@@ -10,6 +10,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
 use contactscope::compare::{self as comparison, CompareRequest, ExperimentInput};
+use contactscope::optics::newton::{self as newton_rings, NewtonOptions, NewtonRequest, Phase};
 use contactscope::pipeline::{self, AnalyzeRequest};
 use contactscope::solver::cg::SolverOptions;
 use contactscope::solver::job::{self, ModelChoice, SimulateRequest};
@@ -59,6 +60,43 @@ enum Command {
     Autocorr(AutocorrArgs),
     /// Compare simulated contact maps with micrographs load by load (blur, register, score).
     Compare(CompareArgs),
+    /// Detection gap from Newton rings in a reflection image and the fluorescent contact.
+    Newton(NewtonArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PhaseArg {
+    /// Maxima at (m + ½)λ/(2n), dark contact (paper Eq. 1; n_sphere > n_medium).
+    Half,
+    /// Maxima at mλ/(2n), bright contact (n_sphere < n_medium, e.g. PTFE).
+    Zero,
+}
+
+#[derive(clap::Args)]
+struct NewtonArgs {
+    /// Reflection image with Newton rings (single-page TIFF).
+    reflection: PathBuf,
+    /// Fluorescence image of the contact, same field and size.
+    #[arg(long = "contact")]
+    contact: PathBuf,
+    /// Pixel size (overrides metadata): 200nm or 200x210nm.
+    #[arg(long)]
+    pixel_size: Option<String>,
+    /// Illumination wavelength.
+    #[arg(long, default_value = "488nm")]
+    wavelength: String,
+    /// Refractive index of the medium in the gap (formamide 1.447).
+    #[arg(long, default_value_t = 1.447)]
+    medium_index: f64,
+    /// Number of line profiles through the centre, evenly spread over 180°.
+    #[arg(long, default_value_t = 20)]
+    profiles: usize,
+    /// Phase of the reflection maxima.
+    #[arg(long, value_enum, default_value = "half")]
+    phase: PhaseArg,
+    /// Output folder.
+    #[arg(long, default_value = "contactscope-out/newton")]
+    out: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -378,6 +416,7 @@ fn main() -> ExitCode {
         Command::Topography(args) => topography(args),
         Command::Autocorr(args) => autocorr(args),
         Command::Compare(args) => compare(args),
+        Command::Newton(args) => newton(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -1050,5 +1089,59 @@ fn compare(args: CompareArgs) -> Result<()> {
         outcome.written.len(),
         args.out.display()
     );
+    Ok(())
+}
+
+fn newton(args: NewtonArgs) -> Result<()> {
+    let request = NewtonRequest {
+        reflection: args.reflection,
+        fluorescence: args.contact,
+        pixel_size_m: args
+            .pixel_size
+            .as_deref()
+            .map(units::parse_pixel_size)
+            .transpose()
+            .context("--pixel-size")?,
+        options: NewtonOptions {
+            wavelength_m: units::parse_positive(&args.wavelength, Dimension::Length)
+                .context("--wavelength")?,
+            medium_index: args.medium_index,
+            profiles: args.profiles,
+            phase: match args.phase {
+                PhaseArg::Half => Phase::Half,
+                PhaseArg::Zero => Phase::Zero,
+            },
+            ..NewtonOptions::default()
+        },
+        out_dir: args.out,
+        command_line: std::env::args().collect(),
+    };
+    let outcome = newton_rings::run_newton(&request)?;
+    let a = &outcome.analysis;
+    let sd = |s: Option<f64>, scale: f64| s.map_or("n/a".into(), |v| format!("{:.2}", v * scale));
+    println!(
+        "detection gap: {:.2} ± {} nm over {} of {} profiles",
+        a.detection_gap_m.mean * 1e9,
+        sd(a.detection_gap_m.sd, 1e9),
+        a.used().count(),
+        a.profiles.len()
+    );
+    println!(
+        "edge radius {:.3} µm; Hertz fit a = {:.3} µm, R = {:.1} µm",
+        a.edge_radius_m.mean * 1e6,
+        a.contact_radius_m.mean * 1e6,
+        a.sphere_radius_m.mean * 1e6
+    );
+    for p in a.profiles.iter().filter(|p| p.skipped.is_some()) {
+        eprintln!(
+            "contactscope: warning: profile {} ({:.1}°) skipped: {}",
+            p.index,
+            p.angle_deg,
+            p.skipped.as_deref().unwrap_or_default()
+        );
+    }
+    for path in &outcome.written {
+        println!("wrote {}", path.display());
+    }
     Ok(())
 }

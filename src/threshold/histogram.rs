@@ -103,6 +103,16 @@ impl Histogram {
         Ok(h)
     }
 
+    /// A float histogram from counts already binned with `binning` (one count per bin).
+    pub fn from_float_counts(binning: FloatBinning, mut counts: Vec<u64>) -> Self {
+        counts.resize(binning.bins, 0);
+        Histogram {
+            binning: Binning::Float(binning),
+            counts,
+            non_finite: 0,
+        }
+    }
+
     /// The binning.
     pub fn binning(&self) -> Binning {
         self.binning

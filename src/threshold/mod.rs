@@ -143,9 +143,10 @@ impl Threshold {
     }
 }
 
-/// Exact Otsu threshold of float values pooled from several images, with [`FLOAT_BINS`] equal
-/// bins over their finite range as for float images; contact is value > t. `what` names the
-/// data in the error for constant values.
+/// Exact Otsu threshold of values pooled from several images; contact is value > t. Whole
+/// numbers within a 16-bit span get one bin per level (as integer images in `analyze`), other
+/// data [`FLOAT_BINS`] equal bins over the finite range. `what` names the data in the error for
+/// constant values.
 pub fn otsu_of_values(images: &[&[f64]], what: &str) -> Result<f64> {
     let finite = || {
         images
@@ -157,24 +158,31 @@ pub fn otsu_of_values(images: &[&[f64]], what: &str) -> Result<f64> {
     let (lo, hi) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
     });
-    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
+    // hi ≤ lo also covers data without finite values (±∞ from the fold).
+    if hi <= lo {
         return Err(Error::ConstantData {
             what: what.to_string(),
             value: lo,
         });
     }
-    let binning = FloatBinning::new(lo, hi, FLOAT_BINS)?;
-    let mut counts = vec![0u64; FLOAT_BINS];
-    for v in finite() {
-        if let Some(i) = binning.index(v as f32) {
-            counts[i] += 1;
+    let integer = finite().all(|v| v.fract() == 0.0) && hi - lo < 65536.0 && lo >= -32768.0;
+    let hist = if integer {
+        let mut counts = vec![0u64; (hi - lo) as usize + 1];
+        for v in finite() {
+            counts[(v - lo) as usize] += 1;
         }
-    }
-    let k = otsu::otsu_split(&counts).ok_or_else(|| Error::ConstantData {
-        what: what.to_string(),
-        value: lo,
-    })?;
-    Ok(binning.upper_edge(k))
+        Histogram::from_counts(lo as i32, &counts)?
+    } else {
+        let binning = FloatBinning::new(lo, hi, FLOAT_BINS)?;
+        let mut counts = vec![0u64; FLOAT_BINS];
+        for v in finite() {
+            if let Some(i) = binning.index(v as f32) {
+                counts[i] += 1;
+            }
+        }
+        Histogram::from_float_counts(binning, counts)
+    };
+    Threshold::otsu(&hist, what).map(|t| t.value)
 }
 
 #[cfg(test)]
@@ -187,6 +195,9 @@ mod tests {
         let t = otsu_of_values(&[&a, &b], "test").unwrap();
         assert!(t > 0.12 && t < 0.88, "{t}");
         assert!(otsu_of_values(&[&[0.5, 0.5, f64::NAN]], "flat").is_err());
+        // Whole numbers: one bin per level, t is a level of the lower class.
+        let t = otsu_of_values(&[&[100.0, 101.0, 100.0, 900.0, 901.0]], "levels").unwrap();
+        assert!((101.0..900.0).contains(&t) && t.fract() == 0.0, "{t}");
     }
     use super::*;
     use crate::stack::Plane;
