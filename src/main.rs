@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
+use contactscope::optics::psf::{self, PsfRequest};
 use contactscope::pipeline::{self, AnalyzeRequest};
 use contactscope::solver::cg::SolverOptions;
 use contactscope::solver::job::{self, ModelChoice, SimulateRequest};
@@ -53,6 +54,8 @@ enum Command {
     Surface(SurfaceArgs),
     /// Print a topography's size, pixel size and roughness statistics.
     Topography(TopographyArgs),
+    /// Measure the microscope PSF on a bead image or z stack (radial Gaussian fits, FWHM).
+    Psf(PsfArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -295,6 +298,24 @@ struct SynthArgs {
 }
 
 #[derive(clap::Args)]
+struct PsfArgs {
+    /// Bead image or z stack (TIFF; every page of the chosen channel).
+    input: PathBuf,
+    /// Pixel size (overrides metadata), e.g. 101nm; must be square.
+    #[arg(long)]
+    pixel_size: Option<String>,
+    /// Bead diameter, e.g. 100nm: turns on the finite-bead correction σ² − a²/5.
+    #[arg(long)]
+    bead_diameter: Option<String>,
+    /// Channel of multi-channel files.
+    #[arg(long)]
+    channel: Option<usize>,
+    /// Output folder.
+    #[arg(long, default_value = "contactscope-out/psf")]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
 struct DemoArgs {
     /// Output folder.
     #[arg(long, default_value = "contactscope-out/demo")]
@@ -312,6 +333,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate(args),
         Command::Surface(args) => surface(args),
         Command::Topography(args) => topography(args),
+        Command::Psf(args) => psf(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -862,4 +884,59 @@ fn topography(args: TopographyArgs) -> Result<()> {
 
 fn topo_detrend_name(arg: DetrendArg) -> &'static str {
     detrend_of(arg).name()
+}
+
+fn psf(args: PsfArgs) -> Result<()> {
+    let request = PsfRequest {
+        input: args.input.clone(),
+        channel: args.channel,
+        pixel_size_m: args
+            .pixel_size
+            .as_deref()
+            .map(units::parse_pixel_size)
+            .transpose()
+            .context("--pixel-size")?,
+        bead_diameter_m: optional_length(&args.bead_diameter, "--bead-diameter")?,
+        out_dir: args.out.clone(),
+        command_line: std::env::args().collect(),
+    };
+    let outcome = psf::run_psf(&request)?;
+    let r = &outcome.report;
+    let s = &r.summary;
+    println!(
+        "{}: {} plane(s), pixel {:.2} nm ({}), {} bead candidate(s), {} used",
+        args.input.display(),
+        r.planes,
+        r.pixel_size.x_m * 1e9,
+        r.pixel_size.source.describe(),
+        r.beads.len(),
+        s.beads_used
+    );
+    for (i, b) in r.beads.iter().enumerate() {
+        if let Some(why) = &b.skip {
+            println!(
+                "  bead {i} at ({}, {}) plane {}: skipped, {why}",
+                b.candidate.x, b.candidate.y, b.candidate.plane
+            );
+        }
+    }
+    let sd = |v: Option<f64>| v.map_or("n/a (one bead)".to_string(), |v| format!("{v:.1}"));
+    let fwhm = s.sigma_m.scaled(1e9 * psf::FWHM_PER_SIGMA);
+    let sigma = s.sigma_m.scaled(1e9);
+    let corrected = if r.bead_diameter_m.is_some() {
+        " (bead-corrected)"
+    } else {
+        ""
+    };
+    println!(
+        "FWHM = {:.1} ± {} nm, σ = {:.1} ± {} nm{corrected}",
+        fwhm.mean,
+        sd(fwhm.sd),
+        sigma.mean,
+        sd(sigma.sd)
+    );
+    for path in &outcome.written {
+        println!("wrote {}", path.display());
+    }
+    Ok(())
 }
