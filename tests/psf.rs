@@ -49,6 +49,12 @@ fn b15_fwhm_per_sigma() {
 fn b15_noise_free_spot_gives_sigma_and_centre_to_1e3_px() {
     let fit = fit_b15(&b15_spot());
     let g = &fit.gauss2d;
+    println!(
+        "noise-free: radial σ − 2 = {:.2e}, 2-D σx − 2 = {:.2e}, centre error {:.2e} px",
+        fit.radial.sigma_px - 2.0,
+        g.sigma_x_px - 2.0,
+        (g.x_px - CENTRE.0).hypot(g.y_px - CENTRE.1)
+    );
     assert!(
         (fit.radial.sigma_px - 2.0).abs() < 1e-3,
         "radial σ {}",
@@ -83,6 +89,7 @@ fn b15_poisson_noise_at_peak_1000_gives_sigma_within_2_percent() {
         let fit = fit_b15(&noisy);
         let radial = fit.radial.sigma_px;
         let (sx, sy) = (fit.gauss2d.sigma_x_px, fit.gauss2d.sigma_y_px);
+        println!("Poisson seed {seed}: radial σ {radial:.4}, 2-D σx {sx:.4}, σy {sy:.4} px");
         assert!(
             (radial / 2.0 - 1.0).abs() < 0.02,
             "seed {seed}: radial σ {radial}"
@@ -180,6 +187,13 @@ fn check_recovery(s: &SyntheticBeads, report: &PsfReport) {
         .count();
     assert_eq!(report.summary.beads_used, isolated);
     let sigma_nm = report.summary.sigma_m.mean * 1e9;
+    println!(
+        "{} plane(s): mean σ {sigma_nm:.3} nm ({:+.3} % vs 191 nm), sd {:.3} nm, {} used",
+        report.planes,
+        100.0 * (sigma_nm / 191.0 - 1.0),
+        report.summary.sigma_m.sd.unwrap_or(f64::NAN) * 1e9,
+        report.summary.beads_used
+    );
     assert!(
         (sigma_nm / 191.0 - 1.0).abs() < 0.01,
         "mean σ {sigma_nm} nm"
@@ -464,7 +478,7 @@ fn real_pycudadecon_bead_stack() {
     let json = json_of(&out.join("psf.json"));
     assert!(json["beads_used"].as_u64().unwrap() >= 1, "{json}");
     let fwhm = json["fwhm_nm_mean"].as_f64().unwrap();
-    // A light-sheet/widefield bead PSF: between the diffraction limit and a micron.
+    // Physically sensible: above the ~150 nm a visible-light objective can reach, below a micron.
     assert!((150.0..1000.0).contains(&fwhm), "FWHM {fwhm} nm");
     assert_eq!(json["planes"], 61);
     let (header, rows) = common::read_csv(&out.join("beads.csv"));

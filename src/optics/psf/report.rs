@@ -247,7 +247,10 @@ fn profiles_chart(report: &PsfReport) -> Chart {
                 used.len()
             )
         } else {
-            format!("PSF from beads: radial profiles ({shown} beads)")
+            format!(
+                "PSF from beads: radial profiles ({shown} bead{})",
+                if shown == 1 { "" } else { "s" }
+            )
         },
         x_label: "radius r (nm)".into(),
         y_label: "normalised intensity (I − c)/I0".into(),
