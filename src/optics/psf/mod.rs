@@ -24,11 +24,15 @@ mod detect;
 mod fit;
 mod lm;
 mod report;
+mod skip;
 mod synth;
 
 pub use detect::{detect, Candidate, DetectOptions, Detection};
 pub use fit::{fit_spot, Gauss2dFit, Grid, RadialFit, SpotFailure, SpotFit, SpotOptions};
 pub use report::{run_psf, PsfOutcome, PsfRequest};
+pub use skip::SkipReason;
+
+use skip::{implausible, pre_fit_skip};
 pub use synth::{synth_beads, BeadKind, BeadParams, BeadTruth, Sampling, SyntheticBeads};
 
 use crate::error::{Error, Location, Result};
@@ -70,81 +74,6 @@ impl Default for PsfOptions {
             bin_px: 0.5,
             bead_diameter_m: None,
             saturation_level: None,
-        }
-    }
-}
-
-/// Why a candidate does not enter the summary.
-#[derive(Debug, Clone, PartialEq)]
-pub enum SkipReason {
-    /// The window does not fit inside the image.
-    AtEdge,
-    /// Another candidate lies inside the window.
-    Crowded {
-        /// Distance to the nearest such candidate, pixels.
-        distance_px: f64,
-    },
-    /// A plateau at the saturation level.
-    Saturated {
-        /// Window pixels at or above the level.
-        pixels: usize,
-        /// The level.
-        level: f64,
-    },
-    /// The brightest plane is the first or last of the stack.
-    FocusAtStackEnd {
-        /// That plane.
-        plane: usize,
-    },
-    /// A fit failed or did not converge.
-    FitFailed(String),
-    /// The fitted σ is outside the plausible range for this window.
-    Implausible {
-        /// Fitted σ, pixels.
-        sigma_px: f64,
-    },
-    /// The imaged spot is narrower than the bead itself, so no correction is possible.
-    SmallerThanBead {
-        /// Fitted σ, pixels.
-        sigma_px: f64,
-    },
-}
-
-impl std::fmt::Display for SkipReason {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            SkipReason::AtEdge => write!(f, "at the image edge (window does not fit)"),
-            SkipReason::Crowded { distance_px } => {
-                write!(f, "crowded (another candidate {distance_px:.1} px away)")
-            }
-            SkipReason::Saturated { pixels, level } => {
-                write!(f, "saturated ({pixels} pixels at {level})")
-            }
-            SkipReason::FocusAtStackEnd { plane } => {
-                write!(f, "focus at the stack end (plane {plane})")
-            }
-            SkipReason::FitFailed(why) => write!(f, "fit failed ({why})"),
-            SkipReason::Implausible { sigma_px } => {
-                write!(f, "implausible sigma ({sigma_px:.3} px)")
-            }
-            SkipReason::SmallerThanBead { sigma_px } => {
-                write!(f, "spot narrower than the bead (sigma {sigma_px:.3} px)")
-            }
-        }
-    }
-}
-
-impl SkipReason {
-    /// A short machine-readable key (`crowded`, `saturated`, …).
-    pub fn key(&self) -> &'static str {
-        match self {
-            SkipReason::AtEdge => "edge",
-            SkipReason::Crowded { .. } => "crowded",
-            SkipReason::Saturated { .. } => "saturated",
-            SkipReason::FocusAtStackEnd { .. } => "focus-at-stack-end",
-            SkipReason::FitFailed(_) => "fit-failed",
-            SkipReason::Implausible { .. } => "implausible-sigma",
-            SkipReason::SmallerThanBead { .. } => "smaller-than-bead",
         }
     }
 }
@@ -239,6 +168,7 @@ pub fn measure_psf(images: &[Image], opts: &PsfOptions) -> Result<PsfReport> {
         .ok_or_else(|| Error::InvalidArgument("no image to measure a PSF on".into()))?;
     let at = || Location::file(&first.path);
     let pixel_size = square_pixel_size(first)?;
+    check_planes(images)?;
     let planes: Vec<&[f64]> = images.iter().map(|im| im.values.as_slice()).collect();
     let (width, height) = (first.width, first.height);
     let detection = detect(&planes, width, height, &opts.detect);
@@ -294,6 +224,32 @@ fn square_pixel_size(image: &Image) -> Result<PixelSize> {
         ));
     }
     Ok(px)
+}
+
+/// Planes must share one shape and hold finite values (the smoothing and the fits need both).
+fn check_planes(images: &[Image]) -> Result<()> {
+    let first = &images[0];
+    for im in images {
+        let at = || Location::page(&im.path, im.page);
+        if (im.width, im.height) != (first.width, first.height)
+            || im.values.len() != im.width * im.height
+        {
+            return Err(Error::bad_input(
+                at(),
+                format!(
+                    "plane is {}×{} px but the first is {}×{}; psf needs one shape per stack",
+                    im.width, im.height, first.width, first.height
+                ),
+            ));
+        }
+        if im.values.iter().any(|v| !v.is_finite()) {
+            return Err(Error::bad_input(
+                at(),
+                "NaN or infinite values; psf needs finite data",
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn half_window(detection: &Detection, opts: &PsfOptions) -> usize {
@@ -382,50 +338,6 @@ fn measure_bead(
     bead
 }
 
-/// Skips that need no fit: edge, crowding, saturation, focus outside the stack.
-fn pre_fit_skip(
-    grid: Grid,
-    c: &Candidate,
-    all: &[Candidate],
-    half: usize,
-    planes: usize,
-    opts: &PsfOptions,
-) -> Option<SkipReason> {
-    if c.x < half || c.y < half || c.x + half >= grid.width || c.y + half >= grid.height {
-        return Some(SkipReason::AtEdge);
-    }
-    let nearest = all
-        .iter()
-        .filter(|o| {
-            (o.x, o.y) != (c.x, c.y) && o.x.abs_diff(c.x) <= half && o.y.abs_diff(c.y) <= half
-        })
-        .map(|o| (o.x as f64 - c.x as f64).hypot(o.y as f64 - c.y as f64))
-        .min_by(f64::total_cmp);
-    if let Some(distance_px) = nearest {
-        return Some(SkipReason::Crowded { distance_px });
-    }
-    if let Some(level) = opts.saturation_level {
-        let pixels = window_pixels(grid, c, half).filter(|&v| v >= level).count();
-        // One pixel at full scale can be a bright bead's true peak; a plateau cannot.
-        if pixels >= 2 {
-            return Some(SkipReason::Saturated { pixels, level });
-        }
-    }
-    if planes >= 3 && (c.plane == 0 || c.plane == planes - 1) {
-        return Some(SkipReason::FocusAtStackEnd { plane: c.plane });
-    }
-    None
-}
-
-fn window_pixels<'a>(grid: Grid<'a>, c: &Candidate, half: usize) -> impl Iterator<Item = f64> + 'a {
-    let (x0, y0, side) = (c.x - half, c.y - half, 2 * half + 1);
-    (y0..y0 + side).flat_map(move |y| {
-        grid.values[y * grid.width + x0..y * grid.width + x0 + side]
-            .iter()
-            .copied()
-    })
-}
-
 fn raw_peak(grid: Grid, x: usize, y: usize) -> f64 {
     let mut best = f64::NEG_INFINITY;
     for yy in y.saturating_sub(1)..=(y + 1).min(grid.height - 1) {
@@ -434,23 +346,6 @@ fn raw_peak(grid: Grid, x: usize, y: usize) -> f64 {
         }
     }
     best
-}
-
-/// σ must be resolvable (≥ 0.3 px) and small enough that the window holds ±2.5 σ.
-fn implausible(fit: &SpotFit, half: usize) -> Option<SkipReason> {
-    let upper = half as f64 / 2.5;
-    let g = &fit.gauss2d;
-    [fit.radial.sigma_px, g.sigma_x_px, g.sigma_y_px]
-        .into_iter()
-        .find(|s| !(0.3..=upper).contains(s))
-        .map(|sigma_px| SkipReason::Implausible { sigma_px })
-        .or_else(|| {
-            let amplitudes_positive = fit.radial.amplitude > 0.0 && g.amplitude > 0.0;
-            let centred =
-                (g.x_px - fit.centroid_px.0).hypot(g.y_px - fit.centroid_px.1) < half as f64 / 2.0;
-            (!(amplitudes_positive && centred))
-                .then(|| SkipReason::FitFailed("negative amplitude or centre off the spot".into()))
-        })
 }
 
 /// σ_psf = √(σ_img² − a²/5), a = D/2; `None` if the spot is narrower than the bead.
@@ -479,4 +374,54 @@ fn summarise(beads: &[BeadMeasurement], pixel_m: f64) -> Option<PsfSummary> {
         sigma_x_m: stats(&|b| Some(b.fit.as_ref()?.gauss2d.sigma_x_px * pixel_m)),
         sigma_y_m: stats(&|b| Some(b.fit.as_ref()?.gauss2d.sigma_y_px * pixel_m)),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stack::PixelSizeSource;
+
+    fn image(width: usize, height: usize, value: f64, page: usize) -> Image {
+        Image {
+            values: vec![value; width * height],
+            width,
+            height,
+            pixel_size: Some(PixelSize {
+                x_m: 1e-7,
+                y_m: 1e-7,
+                source: PixelSizeSource::CommandLine,
+            }),
+            path: "s.tif".into(),
+            page,
+        }
+    }
+
+    #[test]
+    fn mixed_shapes_and_nan_are_refused() {
+        let opts = PsfOptions::default();
+        let err = measure_psf(&[image(8, 8, 1.0, 0), image(9, 8, 1.0, 1)], &opts).unwrap_err();
+        assert!(
+            err.to_string().contains("page 1") && err.to_string().contains("9×8"),
+            "{err}"
+        );
+        let err = measure_psf(&[image(8, 8, f64::NAN, 0)], &opts).unwrap_err();
+        assert!(err.to_string().contains("NaN"), "{err}");
+        let mut wide = image(8, 8, 1.0, 0);
+        wide.pixel_size.as_mut().unwrap().y_m = 2e-7;
+        assert!(measure_psf(&[wide], &opts)
+            .unwrap_err()
+            .to_string()
+            .contains("square"));
+    }
+
+    #[test]
+    fn correction_and_mean_sd() {
+        let s = corrected_sigma(191e-9, Some(100e-9)).unwrap();
+        assert!((s * s - (191e-9f64.powi(2) - 500e-18)).abs() < 1e-24);
+        assert_eq!(corrected_sigma(10e-9, Some(100e-9)), None);
+        assert_eq!(corrected_sigma(5.0, None), Some(5.0));
+        let m = MeanSd::of(&[1.0, 2.0, 3.0]);
+        assert_eq!((m.mean, m.sd), (2.0, Some(1.0)));
+        assert_eq!(MeanSd::of(&[4.0]).sd, None);
+    }
 }
