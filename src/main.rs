@@ -11,6 +11,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
 use contactscope::compare::{self as comparison, CompareRequest, ExperimentInput};
 use contactscope::optics::newton::{self as newton_rings, NewtonOptions, NewtonRequest, Phase};
+use contactscope::optics::psf::{self, PsfRequest};
 use contactscope::pipeline::{self, AnalyzeRequest};
 use contactscope::solver::cg::SolverOptions;
 use contactscope::solver::job::{self, ModelChoice, SimulateRequest};
@@ -62,6 +63,8 @@ enum Command {
     Compare(CompareArgs),
     /// Detection gap from Newton rings in a reflection image and the fluorescent contact.
     Newton(NewtonArgs),
+    /// Measure the microscope PSF on a bead image or z stack (radial Gaussian fits, FWHM).
+    Psf(PsfArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -96,6 +99,24 @@ struct NewtonArgs {
     phase: PhaseArg,
     /// Output folder.
     #[arg(long, default_value = "contactscope-out/newton")]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct PsfArgs {
+    /// Bead image or z stack (TIFF; every page of the chosen channel).
+    input: PathBuf,
+    /// Pixel size (overrides metadata), e.g. 101nm; must be square.
+    #[arg(long)]
+    pixel_size: Option<String>,
+    /// Bead diameter, e.g. 100nm: turns on the finite-bead correction σ² − a²/5.
+    #[arg(long)]
+    bead_diameter: Option<String>,
+    /// Channel of multi-channel files.
+    #[arg(long)]
+    channel: Option<usize>,
+    /// Output folder.
+    #[arg(long, default_value = "contactscope-out/psf")]
     out: PathBuf,
 }
 
@@ -417,6 +438,7 @@ fn main() -> ExitCode {
         Command::Autocorr(args) => autocorr(args),
         Command::Compare(args) => compare(args),
         Command::Newton(args) => newton(args),
+        Command::Psf(args) => psf(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -1140,6 +1162,61 @@ fn newton(args: NewtonArgs) -> Result<()> {
             p.skipped.as_deref().unwrap_or_default()
         );
     }
+    for path in &outcome.written {
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn psf(args: PsfArgs) -> Result<()> {
+    let request = PsfRequest {
+        input: args.input.clone(),
+        channel: args.channel,
+        pixel_size_m: args
+            .pixel_size
+            .as_deref()
+            .map(units::parse_pixel_size)
+            .transpose()
+            .context("--pixel-size")?,
+        bead_diameter_m: optional_length(&args.bead_diameter, "--bead-diameter")?,
+        out_dir: args.out.clone(),
+        command_line: std::env::args().collect(),
+    };
+    let outcome = psf::run_psf(&request)?;
+    let r = &outcome.report;
+    let s = &r.summary;
+    println!(
+        "{}: {} plane(s), pixel {:.2} nm ({}), {} bead candidate(s), {} used",
+        args.input.display(),
+        r.planes,
+        r.pixel_size.x_m * 1e9,
+        r.pixel_size.source.describe(),
+        r.beads.len(),
+        s.beads_used
+    );
+    for (i, b) in r.beads.iter().enumerate() {
+        if let Some(why) = &b.skip {
+            println!(
+                "  bead {i} at ({}, {}) plane {}: skipped, {why}",
+                b.candidate.x, b.candidate.y, b.candidate.plane
+            );
+        }
+    }
+    let sd = |v: Option<f64>| v.map_or("n/a (one bead)".to_string(), |v| format!("{v:.1}"));
+    let fwhm = s.sigma_m.scaled(1e9 * psf::FWHM_PER_SIGMA);
+    let sigma = s.sigma_m.scaled(1e9);
+    let corrected = if r.bead_diameter_m.is_some() {
+        " (bead-corrected)"
+    } else {
+        ""
+    };
+    println!(
+        "FWHM = {:.1} ± {} nm, σ = {:.1} ± {} nm{corrected}",
+        fwhm.mean,
+        sd(fwhm.sd),
+        sigma.mean,
+        sd(sigma.sd)
+    );
     for path in &outcome.written {
         println!("wrote {}", path.display());
     }

@@ -3,3 +3,4 @@
 //! (Weber et al. 2018, Methods: Microscopy, Comparison with experiments; `docs/conventions.md`).
 pub mod blur;
 pub mod newton;
+pub mod psf;
