@@ -53,6 +53,17 @@ pub struct CompareRequest {
     pub pixel_size_m: Option<(f64, f64)>,
     /// Output folder of `contactscope simulate` (areas.csv + load_NNN_contact.tif).
     pub simulation: PathBuf,
+    /// PSF, registration and load matching.
+    pub settings: CompareSettings,
+    /// Output folder.
+    pub out_dir: PathBuf,
+    /// The command line, for the JSON.
+    pub command_line: Vec<String>,
+}
+
+/// How simulated maps are imaged, registered and matched to micrographs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CompareSettings {
     /// PSF FWHM, m.
     pub psf_fwhm_m: f64,
     /// Try the 8 dihedral transforms (mirror and 90° rotations) when registering.
@@ -61,10 +72,49 @@ pub struct CompareRequest {
     pub upsample: usize,
     /// Largest relative force difference for two loads to match.
     pub force_tolerance: f64,
-    /// Output folder.
-    pub out_dir: PathBuf,
-    /// The command line, for the JSON.
-    pub command_line: Vec<String>,
+}
+
+/// The experiment side, read once: the series, its global Otsu threshold and pixel size.
+#[derive(Debug, Clone)]
+pub struct Micrographs {
+    /// The series with forces.
+    pub series: Series,
+    /// One exact Otsu threshold over the series (grey levels); contact is value > t.
+    pub threshold: f64,
+    /// Pixel size (x, y), m.
+    pub pixel_m: (f64, f64),
+    /// Notes from reading and thresholding.
+    pub warnings: Vec<String>,
+}
+
+impl Micrographs {
+    /// Read the series, its forces and pixel size, and threshold it.
+    pub fn load(
+        experiment: &ExperimentInput,
+        channel: Option<usize>,
+        pixel_size_m: Option<(f64, f64)>,
+    ) -> Result<Self> {
+        let series = experiment_series(experiment, channel)?;
+        let (threshold, _, warnings) = global_threshold(&series, &|_, _, _| {})?;
+        let pixel_m = experiment_pixel(&series, pixel_size_m)?;
+        Ok(Micrographs {
+            series,
+            threshold: threshold.value,
+            pixel_m,
+            warnings,
+        })
+    }
+}
+
+/// One simulated contact map (1 = contact) at one force, in memory.
+#[derive(Debug, Clone)]
+pub struct SimulatedMap {
+    /// Normal force, N.
+    pub force_n: f64,
+    /// The map with its pixel size.
+    pub map: Grid,
+    /// Where it came from (a file, or a model and parameter), for tables.
+    pub source: String,
 }
 
 /// Scores of one matched load.
@@ -76,8 +126,8 @@ pub struct LoadComparison {
     pub simulated_force_n: f64,
     /// Micrograph file and page.
     pub micrograph: (PathBuf, usize),
-    /// Simulated contact map file.
-    pub simulated_map: PathBuf,
+    /// Where the simulated map came from.
+    pub simulated_map: String,
     /// Transform applied to the simulated image.
     pub transform: Dihedral,
     /// Translation applied after the transform, micrograph pixels (x, y).
@@ -132,16 +182,12 @@ pub fn fwhm_from_psf_json(path: &Path) -> Result<f64> {
     }
 }
 
-/// One simulated load: force and contact map file.
-struct SimulatedLoad {
+/// A matched pair, registered, before thresholding.
+#[derive(Debug, Clone)]
+pub struct Prepared {
     force_n: f64,
-    map: PathBuf,
-}
-
-/// A matched pair before thresholding.
-struct Prepared {
-    force_n: f64,
-    sim: SimulatedLoad,
+    simulated_force_n: f64,
+    source: String,
     micrograph: (PathBuf, usize),
     /// Micrograph (width, height), pixels.
     size: (usize, usize),
@@ -159,21 +205,68 @@ const WEAK_PEAK: f64 = 0.05;
 /// Run `compare`: match loads, render, register, threshold, score, and write `compare.csv`,
 /// `compare.json` and one `panel_NNN.png` per matched load (all or nothing).
 pub fn run_compare(request: &CompareRequest) -> Result<CompareOutcome> {
-    let series = experiment_series(request)?;
-    let simulated = simulated_loads(&request.simulation)?;
-    let pairs = match_loads(&series, &simulated, request.force_tolerance)?;
-    let (threshold, _, mut warnings) = global_threshold(&series, &|_, _, _| {})?;
-    let pixel = experiment_pixel(&series, request)?;
-    let mut prepared = Vec::new();
-    for (image, sim) in pairs {
-        prepared.push(prepare(request, &series, image, sim, pixel)?);
+    let micrographs =
+        Micrographs::load(&request.experiment, request.channel, request.pixel_size_m)?;
+    let simulated = simulated_maps(&request.simulation)?;
+    let Comparison {
+        loads,
+        prepared,
+        simulated_threshold: sim_threshold,
+        warnings,
+    } = compare_maps(&micrographs, &simulated, &request.settings)?;
+    let threshold = micrographs.threshold;
+    let pixel = micrographs.pixel_m;
+    let staging = Staging::new(&request.out_dir, &input_files(request, &micrographs.series))?;
+    staging.write("compare.csv", compare_csv(&loads, pixel)?.as_bytes())?;
+    for (i, p) in prepared.iter().enumerate() {
+        staging.write(
+            &format!("panel_{:03}.png", i + 1),
+            &panel(p, &loads[i], threshold)?,
+        )?;
     }
+    let summary = summary_json(request, &loads, (threshold, sim_threshold), &warnings);
+    let text = serde_json::to_string_pretty(&summary)
+        .map_err(|e| Error::InvalidArgument(format!("JSON: {e}")))?;
+    staging.write("compare.json", text.as_bytes())?;
+    Ok(CompareOutcome {
+        loads,
+        thresholds: (threshold, sim_threshold),
+        written: staging.commit()?,
+        warnings,
+    })
+}
+
+/// The result of [`compare_maps`].
+pub struct Comparison {
+    /// Scores per matched load, in experiment order.
+    pub loads: Vec<LoadComparison>,
+    /// The registered pairs, for panels.
+    pub prepared: Vec<Prepared>,
+    /// Otsu threshold of the blurred simulated maps (covered fraction).
+    pub simulated_threshold: f64,
+    /// Notes for the user.
+    pub warnings: Vec<String>,
+}
+
+/// Match, render, register, threshold and score. Errors when no load matches.
+pub fn compare_maps(
+    micrographs: &Micrographs,
+    simulated: &[SimulatedMap],
+    settings: &CompareSettings,
+) -> Result<Comparison> {
+    let pairs = match_loads(&micrographs.series, simulated, settings.force_tolerance)?;
+    let mut warnings = micrographs.warnings.clone();
+    let prepared: Vec<Prepared> = pairs
+        .into_iter()
+        .map(|(image, sim)| prepare(settings, micrographs, image, sim))
+        .collect::<Result<_>>()?;
     let sim_sets: Vec<Vec<f64>> = prepared.iter().map(inside_footprint).collect();
     let refs: Vec<&[f64]> = sim_sets.iter().map(Vec::as_slice).collect();
     let sim_threshold = otsu_of_values(&refs, "the blurred simulated maps")?;
+    let pixel = micrographs.pixel_m;
     let loads: Vec<LoadComparison> = prepared
         .iter()
-        .map(|p| score(p, threshold.value, sim_threshold, pixel))
+        .map(|p| score(p, micrographs.threshold, sim_threshold, pixel))
         .collect::<Result<_>>()?;
     for l in &loads {
         if l.correlation_peak < WEAK_PEAK {
@@ -184,28 +277,16 @@ pub fn run_compare(request: &CompareRequest) -> Result<CompareOutcome> {
             ));
         }
     }
-    let staging = Staging::new(&request.out_dir, &input_files(request, &series))?;
-    staging.write("compare.csv", compare_csv(&loads, pixel)?.as_bytes())?;
-    for (i, p) in prepared.iter().enumerate() {
-        staging.write(
-            &format!("panel_{:03}.png", i + 1),
-            &panel(p, &loads[i], threshold.value)?,
-        )?;
-    }
-    let summary = summary_json(request, &loads, (threshold.value, sim_threshold), &warnings);
-    let text = serde_json::to_string_pretty(&summary)
-        .map_err(|e| Error::InvalidArgument(format!("JSON: {e}")))?;
-    staging.write("compare.json", text.as_bytes())?;
-    Ok(CompareOutcome {
+    Ok(Comparison {
         loads,
-        thresholds: (threshold.value, sim_threshold),
-        written: staging.commit()?,
+        prepared,
+        simulated_threshold: sim_threshold,
         warnings,
     })
 }
 
-fn experiment_series(request: &CompareRequest) -> Result<Series> {
-    match &request.experiment {
+fn experiment_series(experiment: &ExperimentInput, channel: Option<usize>) -> Result<Series> {
+    match experiment {
         ExperimentInput::Manifest(path) => {
             let manifest = if path.is_dir() {
                 path.join("manifest.csv")
@@ -218,10 +299,10 @@ fn experiment_series(request: &CompareRequest) -> Result<Series> {
                     "no manifest: give a manifest CSV (file, page, force_mN) or a folder holding manifest.csv, or TIFF files with --forces",
                 ));
             }
-            series::from_manifest(&manifest, request.channel)
+            series::from_manifest(&manifest, channel)
         }
         ExperimentInput::Files { inputs, forces_n } => {
-            let mut s = series::from_files(inputs, request.channel)?;
+            let mut s = series::from_files(inputs, channel)?;
             series::assign_forces(&mut s, forces_n)?;
             Ok(s)
         }
@@ -229,7 +310,7 @@ fn experiment_series(request: &CompareRequest) -> Result<Series> {
 }
 
 /// The loads of a `simulate` output folder: `areas.csv` rows and `load_NNN_contact.tif`.
-fn simulated_loads(dir: &Path) -> Result<Vec<SimulatedLoad>> {
+pub fn simulated_maps(dir: &Path) -> Result<Vec<SimulatedMap>> {
     let table = dir.join("areas.csv");
     let at = Location::file(&table);
     let text = std::fs::read_to_string(&table).map_err(|e| {
@@ -267,21 +348,30 @@ fn simulated_loads(dir: &Path) -> Result<Vec<SimulatedLoad>> {
                 "contact map listed in areas.csv is missing",
             ));
         }
-        loads.push(SimulatedLoad {
-            force_n: force_mn * 1e-3,
-            map,
-        });
+        loads.push(read_map(&map, force_mn * 1e-3)?);
     }
     Ok(loads)
 }
 
+fn read_map(path: &Path, force_n: f64) -> Result<SimulatedMap> {
+    let image = read_image(path, None, None)?;
+    let px = image.require_pixel_size()?;
+    let map = Grid::new(image.values, image.width, image.height, px.x_m, px.y_m)
+        .map_err(|e| Error::bad_input(Location::file(path), e.to_string()))?;
+    Ok(SimulatedMap {
+        force_n,
+        map,
+        source: path.display().to_string(),
+    })
+}
+
 /// Pairs (experiment image index, simulated load) whose forces agree within the tolerance; each
 /// experiment image takes the nearest simulated force.
-fn match_loads(
+fn match_loads<'a>(
     series: &Series,
-    simulated: &[SimulatedLoad],
+    simulated: &'a [SimulatedMap],
     tolerance: f64,
-) -> Result<Vec<(usize, SimulatedLoad)>> {
+) -> Result<Vec<(usize, &'a SimulatedMap)>> {
     let mut pairs = Vec::new();
     for (i, image) in series.images.iter().enumerate() {
         let Some(f) = image.force_n else { continue };
@@ -289,13 +379,7 @@ fn match_loads(
             .iter()
             .min_by(|a, b| (a.force_n - f).abs().total_cmp(&(b.force_n - f).abs()));
         if let Some(s) = nearest.filter(|s| (s.force_n / f - 1.0).abs() <= tolerance) {
-            pairs.push((
-                i,
-                SimulatedLoad {
-                    force_n: s.force_n,
-                    map: s.map.clone(),
-                },
-            ));
+            pairs.push((i, s));
         }
     }
     if pairs.is_empty() {
@@ -315,9 +399,9 @@ fn match_loads(
     Ok(pairs)
 }
 
-fn experiment_pixel(series: &Series, request: &CompareRequest) -> Result<(f64, f64)> {
+fn experiment_pixel(series: &Series, pixel_size_m: Option<(f64, f64)>) -> Result<(f64, f64)> {
     let first = &series.files[0];
-    pixel_size_or(first.pixel_size, request.pixel_size_m)
+    pixel_size_or(first.pixel_size, pixel_size_m)
         .map(|p| (p.x_m, p.y_m))
         .ok_or_else(|| {
             Error::bad_input(
@@ -328,26 +412,22 @@ fn experiment_pixel(series: &Series, request: &CompareRequest) -> Result<(f64, f
 }
 
 fn prepare(
-    request: &CompareRequest,
-    series: &Series,
+    settings: &CompareSettings,
+    micrographs: &Micrographs,
     index: usize,
-    sim: SimulatedLoad,
-    pixel: (f64, f64),
+    sim: &SimulatedMap,
 ) -> Result<Prepared> {
+    let series = &micrographs.series;
     let image = &series.images[index];
     let plane = TiffReader::open(&image.path)?.read_page(image.page, series.channel)?;
     let (w, h) = (plane.width, plane.height);
-    let map = read_image(&sim.map, None, None)?;
-    let px = map.require_pixel_size()?;
-    let at = Location::file(&sim.map);
-    let grid = Grid::new(map.values.clone(), map.width, map.height, px.x_m, px.y_m)
-        .map_err(|e| Error::bad_input(at.clone(), e.to_string()))?;
-    let raw_area_m2 = grid.integral();
-    let rendered = microscope_image(&grid, request.psf_fwhm_m, pixel)
-        .map_err(|e| Error::bad_input(at.clone(), e.to_string()))?;
+    let at = || Location::file(&sim.source);
+    let raw_area_m2 = sim.map.integral();
+    let rendered = microscope_image(&sim.map, settings.psf_fwhm_m, micrographs.pixel_m)
+        .map_err(|e| Error::bad_input(at(), e.to_string()))?;
     if rendered.width > w || rendered.height > h {
         return Err(Error::bad_input(
-            at,
+            at(),
             format!(
                 "the simulated region ({}×{} micrograph pixels) is larger than the micrograph ({w}×{h}); crop the simulation",
                 rendered.width, rendered.height
@@ -360,8 +440,8 @@ fn prepare(
         &experiment,
         &canvas,
         (w, h),
-        request.upsample,
-        request.dihedral,
+        settings.upsample,
+        settings.dihedral,
     )
     .map_err(|e| Error::bad_input(Location::page(&image.path, image.page), e.to_string()))?;
     let align = |img: &[f64]| {
@@ -372,7 +452,8 @@ fn prepare(
     let footprint = align(&frame).iter().map(|&v| v > 0.999).collect();
     Ok(Prepared {
         force_n: image.force_n.unwrap_or(f64::NAN),
-        sim,
+        simulated_force_n: sim.force_n,
+        source: sim.source.clone(),
         micrograph: (image.path.clone(), image.page),
         size: (w, h),
         experiment,
@@ -464,9 +545,9 @@ fn score(p: &Prepared, t_exp: f64, t_sim: f64, pixel: (f64, f64)) -> Result<Load
     );
     Ok(LoadComparison {
         force_n: p.force_n,
-        simulated_force_n: p.sim.force_n,
+        simulated_force_n: p.simulated_force_n,
         micrograph: p.micrograph.clone(),
-        simulated_map: p.sim.map.clone(),
+        simulated_map: p.source.clone(),
         transform: p.transform,
         shift_px: (-p.shift.dx, -p.shift.dy),
         correlation_peak: p.shift.peak,
@@ -566,7 +647,7 @@ fn compare_csv(loads: &[LoadComparison], pixel: (f64, f64)) -> Result<String> {
             format!("{:.4}", l.intensity.gain),
             format!("{:.4}", l.intensity.offset),
             format!("{}:page {}", l.micrograph.0.display(), l.micrograph.1),
-            l.simulated_map.display().to_string(),
+            l.simulated_map.clone(),
         ])
         .map_err(csv_err)?;
     }
@@ -617,12 +698,12 @@ fn summary_json(
         "contactscope_version": env!("CARGO_PKG_VERSION"),
         "command_line": request.command_line,
         "simulation": request.simulation.display().to_string(),
-        "psf_fwhm_nm": request.psf_fwhm_m * 1e9,
+        "psf_fwhm_nm": request.settings.psf_fwhm_m * 1e9,
         "experiment_threshold": t_exp,
         "simulated_threshold": t_sim,
-        "dihedral_search": request.dihedral,
-        "upsample": request.upsample,
-        "force_tolerance_pct": request.force_tolerance * 100.0,
+        "dihedral_search": request.settings.dihedral,
+        "upsample": request.settings.upsample,
+        "force_tolerance_pct": request.settings.force_tolerance * 100.0,
         "loads_matched": loads.len(),
         "dice_mean": mean(&|l| l.dice),
         "jaccard_mean": mean(&|l| l.jaccard),

@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
-use contactscope::compare::{self as comparison, CompareRequest, ExperimentInput};
+use contactscope::compare::{self as comparison, CompareRequest, CompareSettings, ExperimentInput};
 use contactscope::optics::newton::{self as newton_rings, NewtonOptions, NewtonRequest, Phase};
 use contactscope::optics::psf::{self, PsfRequest};
 use contactscope::pipeline::{self, AnalyzeRequest};
@@ -1075,10 +1075,12 @@ fn compare(args: CompareArgs) -> Result<()> {
             .transpose()
             .context("--pixel-size")?,
         simulation: args.simulation.clone(),
-        psf_fwhm_m,
-        dihedral: args.dihedral,
-        upsample: args.upsample,
-        force_tolerance: fraction(&args.force_tolerance, "--force-tolerance")?,
+        settings: CompareSettings {
+            psf_fwhm_m,
+            dihedral: args.dihedral,
+            upsample: args.upsample,
+            force_tolerance: fraction(&args.force_tolerance, "--force-tolerance")?,
+        },
         out_dir: args.out.clone(),
         command_line: std::env::args().collect(),
     };
