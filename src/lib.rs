@@ -56,6 +56,7 @@ pub mod analysis;
 pub mod compare;
 pub mod error;
 pub mod fit;
+pub mod fitting;
 pub mod hertz;
 pub mod measure;
 pub mod optics;

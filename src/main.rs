@@ -10,6 +10,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
 use contactscope::compare::{self as comparison, CompareRequest, CompareSettings, ExperimentInput};
+use contactscope::fitting::job::{self as fit_job, FitRequest, Sweep, SweepMicrographs};
+use contactscope::fitting::{Family, Search};
 use contactscope::optics::newton::{self as newton_rings, NewtonOptions, NewtonRequest, Phase};
 use contactscope::optics::psf::{self, PsfRequest};
 use contactscope::pipeline::{self, AnalyzeRequest};
@@ -61,6 +63,8 @@ enum Command {
     Autocorr(AutocorrArgs),
     /// Compare simulated contact maps with micrographs load by load (blur, register, score).
     Compare(CompareArgs),
+    /// Fit the hardening coefficient k (and p_Y, and score elastic and GT) to a measured area–load curve.
+    FitHardening(FitArgs),
     /// Detection gap from Newton rings in a reflection image and the fluorescent contact.
     Newton(NewtonArgs),
     /// Measure the microscope PSF on a bead image or z stack (radial Gaussian fits, FWHM).
@@ -117,6 +121,54 @@ struct PsfArgs {
     channel: Option<usize>,
     /// Output folder.
     #[arg(long, default_value = "contactscope-out/psf")]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct FitArgs {
+    /// areas.csv of `contactscope analyze` (force_mN, area_um2).
+    #[arg(long)]
+    experiment: PathBuf,
+    #[command(flatten)]
+    input: TopographyInput,
+    /// Sphere radius added to a flattened map (and the GT sphere), e.g. 290um.
+    #[arg(long)]
+    radius: Option<String>,
+    /// Contact modulus E*, e.g. 3.7GPa.
+    #[arg(long)]
+    modulus: String,
+    /// Models to fit or score, comma-separated.
+    #[arg(long, default_value = "gt,elastic,hardness,hardening")]
+    models: String,
+    /// Search range for k.
+    #[arg(long, default_value = "0.1..100MPa/nm")]
+    k_range: String,
+    /// Search range for the penetration hardness p_Y.
+    #[arg(long, default_value = "10MPa..10GPa")]
+    hardness_range: String,
+    /// Parameter sweep: k=1..10MPa/nm:10 (evenly spaced), k=1,2,4MPa/nm, or hardness=….
+    #[arg(long)]
+    sweep: Option<String>,
+    /// Micrographs for Dice in the sweep: a manifest CSV or a folder with manifest.csv.
+    #[arg(long)]
+    micrographs: Option<PathBuf>,
+    /// PSF FWHM for Dice in the sweep (e.g. 450nm).
+    #[arg(long)]
+    psf_fwhm: Option<String>,
+    /// Micrograph pixel size override (e.g. 200nm).
+    #[arg(long)]
+    micrograph_pixel_size: Option<String>,
+    /// Periodic boundaries (nominally flat periodic maps).
+    #[arg(long)]
+    periodic: bool,
+    /// CG relative tolerance.
+    #[arg(long, default_value_t = 1e-8)]
+    tolerance: f64,
+    /// CG iteration limit per load.
+    #[arg(long, default_value_t = 5000)]
+    max_iterations: usize,
+    /// Output folder.
+    #[arg(long, default_value = "contactscope-out/fit")]
     out: PathBuf,
 }
 
@@ -437,6 +489,7 @@ fn main() -> ExitCode {
         Command::Topography(args) => topography(args),
         Command::Autocorr(args) => autocorr(args),
         Command::Compare(args) => compare(args),
+        Command::FitHardening(args) => fit_hardening(args),
         Command::Newton(args) => newton(args),
         Command::Psf(args) => psf(args),
     };
@@ -1222,5 +1275,141 @@ fn psf(args: PsfArgs) -> Result<()> {
     for path in &outcome.written {
         println!("wrote {}", path.display());
     }
+    Ok(())
+}
+
+fn fit_searches(args: &FitArgs) -> Result<Vec<(Family, Search)>> {
+    let k = units::parse_range(&args.k_range, &|t| {
+        units::parse_ratio(t, Dimension::Pressure, Dimension::Length)
+    })
+    .context("--k-range")?;
+    let p = units::parse_range(&args.hardness_range, &|t| {
+        units::parse_positive(t, Dimension::Pressure)
+    })
+    .context("--hardness-range")?;
+    Ok(vec![
+        (
+            Family::Hardening,
+            Search {
+                range: k,
+                ..Search::default_for(Family::Hardening)
+            },
+        ),
+        (
+            Family::Hardness,
+            Search {
+                range: p,
+                ..Search::default_for(Family::Hardness)
+            },
+        ),
+    ])
+}
+
+fn sweep_micrographs(args: &FitArgs) -> Result<Option<SweepMicrographs>> {
+    let Some(path) = &args.micrographs else {
+        return Ok(None);
+    };
+    let fwhm = args
+        .psf_fwhm
+        .as_deref()
+        .context("--micrographs needs --psf-fwhm")?;
+    Ok(Some(SweepMicrographs {
+        experiment: ExperimentInput::Manifest(path.clone()),
+        channel: None,
+        pixel_size_m: args
+            .micrograph_pixel_size
+            .as_deref()
+            .map(units::parse_pixel_size)
+            .transpose()
+            .context("--micrograph-pixel-size")?,
+        settings: CompareSettings {
+            psf_fwhm_m: units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+            dihedral: false,
+            upsample: 20,
+            force_tolerance: 0.01,
+        },
+    }))
+}
+
+fn fit_hardening(args: FitArgs) -> Result<()> {
+    let families = args
+        .models
+        .split(',')
+        .map(Family::parse)
+        .collect::<std::result::Result<Vec<_>, _>>()
+        .context("--models")?;
+    let sweep = args
+        .sweep
+        .as_deref()
+        .map(Sweep::parse)
+        .transpose()
+        .context("--sweep")?;
+    if args.micrographs.is_some() && sweep.is_none() {
+        bail!("--micrographs scores a --sweep; give one");
+    }
+    let request = FitRequest {
+        experiment: args.experiment.clone(),
+        topography: args.input.path.clone(),
+        pixel_size_m: args
+            .input
+            .pixel_size
+            .as_deref()
+            .map(units::parse_pixel_size)
+            .transpose()
+            .context("--pixel-size")?,
+        height_unit_m: optional_length(&args.input.height_unit, "--height-unit")?,
+        detrend: detrend_of(args.input.detrend),
+        radius_m: optional_length(&args.radius, "--radius")?,
+        e_star_pa: units::parse_positive(&args.modulus, Dimension::Pressure)
+            .context("--modulus")?,
+        periodic: args.periodic,
+        families,
+        searches: fit_searches(&args)?,
+        sweep,
+        micrographs: sweep_micrographs(&args)?,
+        options: SolverOptions {
+            max_iterations: args.max_iterations,
+            tolerance: args.tolerance,
+            monitor: None,
+        },
+        out_dir: args.out.clone(),
+        command_line: std::env::args().collect(),
+    };
+    let outcome = fit_job::run_fit(&request)?;
+    for w in &outcome.warnings {
+        eprintln!("contactscope: warning: {w}");
+    }
+    println!("{:>10} {:>22} {:>10}", "model", "parameter", "misfit");
+    for fit in &outcome.fits {
+        let parameter = match (fit.family, fit.best.parameter) {
+            (Family::Hardening, Some(k)) => format!(
+                "k = {:.3} ± {} MPa/nm",
+                k * 1e-15,
+                fit.parameter_se
+                    .map_or("?".into(), |s| format!("{:.3}", s * 1e-15))
+            ),
+            (Family::Hardness, Some(p)) => format!(
+                "p_Y = {:.1} ± {} MPa",
+                p * 1e-6,
+                fit.parameter_se
+                    .map_or("?".into(), |s| format!("{:.1}", s * 1e-6))
+            ),
+            _ => "—".into(),
+        };
+        println!(
+            "{:>10} {:>22} {:>10.4}",
+            fit.family.name(),
+            parameter,
+            fit.best.misfit
+        );
+    }
+    if let Some(best) = outcome.best() {
+        println!("best model: {}", best.family.name());
+    }
+    println!(
+        "wrote {} files to {}",
+        outcome.written.len(),
+        args.out.display()
+    );
     Ok(())
 }

@@ -212,6 +212,61 @@ pub fn parse_loads(text: &str) -> Result<Vec<f64>> {
     Ok(values)
 }
 
+/// A bare number (no unit) takes the unit written after the last item, so `1..10MPa/nm:10` and
+/// `1,2,4MPa/nm` mean what they say.
+fn with_unit_of(item: &str, last: &str) -> String {
+    let (number, unit) = split_number(item);
+    if unit.is_empty() {
+        format!("{number}{}", split_number(last).1)
+    } else {
+        item.trim().to_string()
+    }
+}
+
+/// Values parsed by `parse_one`: a list `1,2,4MPa/nm` or an evenly spaced range
+/// `1..10MPa/nm:10` (10 values from 1 to 10, equal steps). Bare numbers take the last item's unit.
+pub fn parse_value_list(text: &str, parse_one: &dyn Fn(&str) -> Result<f64>) -> Result<Vec<f64>> {
+    if let Some((from, rest)) = text.split_once("..") {
+        let (to, count) = rest.split_once(':').ok_or_else(|| {
+            Error::InvalidArgument(format!("range '{text}' needs a count, e.g. 1..10MPa/nm:10"))
+        })?;
+        let n: usize = count
+            .trim()
+            .parse()
+            .map_err(|_| Error::InvalidArgument(format!("'{count}' in '{text}' is not a count")))?;
+        let (a, b) = (parse_one(&with_unit_of(from, to))?, parse_one(to)?);
+        if n < 2 || b <= a {
+            return Err(Error::InvalidArgument(format!(
+                "range '{text}' needs start < end and at least 2 values"
+            )));
+        }
+        return Ok((0..n)
+            .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
+            .collect());
+    }
+    let items: Vec<&str> = text.split(',').collect();
+    let last = items.last().copied().unwrap_or_default();
+    items
+        .iter()
+        .map(|item| parse_one(&with_unit_of(item, last)))
+        .collect()
+}
+
+/// A range `lo..hi` of values parsed by `parse_one` (`0.1..100MPa/nm`); requires lo < hi.
+pub fn parse_range(text: &str, parse_one: &dyn Fn(&str) -> Result<f64>) -> Result<(f64, f64)> {
+    let (from, to) = text.split_once("..").ok_or_else(|| {
+        Error::InvalidArgument(format!("'{text}' is not a range such as 0.1..100MPa/nm"))
+    })?;
+    let (a, b) = (parse_one(&with_unit_of(from, to))?, parse_one(to)?);
+    if a < b {
+        Ok((a, b))
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "range '{text}' needs start < end"
+        )))
+    }
+}
+
 /// Parse a ratio of two quantities, e.g. a hardening modulus `4MPa/nm` (returned in Pa/m).
 pub fn parse_ratio(text: &str, numerator: Dimension, denominator: Dimension) -> Result<f64> {
     let (top, bottom) = text.split_once('/').ok_or_else(|| {
@@ -264,6 +319,23 @@ pub fn format_length(metres: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn value_lists_and_ranges_carry_the_last_unit() {
+        let k = |t: &str| parse_ratio(t, Dimension::Pressure, Dimension::Length);
+        let v = parse_value_list("1..10MPa/nm:10", &k).unwrap();
+        assert_eq!(v.len(), 10);
+        assert!(
+            (v[0] - 1e15).abs() < 1.0 && (v[9] - 1e16).abs() < 10.0 && (v[1] - 2e15).abs() < 1.0
+        );
+        let v = parse_value_list("1,2,4MPa/nm", &k).unwrap();
+        assert!((v[2] - 4e15).abs() < 1.0);
+        let p = |t: &str| parse_positive(t, Dimension::Pressure);
+        assert_eq!(parse_range("10MPa..10GPa", &p).unwrap(), (1e7, 1e10));
+        assert_eq!(parse_range("100..300MPa", &p).unwrap(), (1e8, 3e8));
+        assert!(parse_range("3..1MPa", &p).is_err());
+        assert!(parse_value_list("1..10MPa/nm", &k).is_err());
+    }
     use approx::assert_relative_eq;
 
     #[test]
