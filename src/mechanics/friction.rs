@@ -21,13 +21,15 @@
 //! # Slip detection ([`detect_slip`])
 //! The paper defines static friction as "the maximal friction force at the onset of slip"
 //! (Fig. 3b caption), not the largest value anywhere in the trace. The force is smoothed by a
-//! centred moving average; the noise level σ is estimated robustly from second differences
-//! (MAD/0.6745/√6, insensitive to the loading slope and to isolated steps). Walking forward, the
-//! slip is the first running maximum after which the smoothed force falls by more than
-//! D = max(k·σ, f·range) and stays below that level for a few samples (a one-sample dropout is
-//! not a slip). F_s is the least-squares line through the raw samples just before the peak,
-//! evaluated at the peak (a denoised maximum); the kinetic friction is the median raw force after
-//! the slip transient (from the first minimum of the smoothed force after the drop to the end).
+//! centred running median (edge-preserving; outliers up to h samples long vanish); the noise
+//! level σ is estimated robustly from second differences (MAD/0.6745/√6, insensitive to the
+//! loading slope and to isolated steps). Walking forward, the slip is the first running maximum
+//! after which the smoothed force falls by more than D = max(k·σ, f·range) and whose median over
+//! the next 4h + 1 samples stays below that level (a short dropout is not a slip). The onset is
+//! the last raw sample before the steep part of the drop; F_s is the least-squares line through
+//! the raw samples up to the onset, evaluated there (a denoised maximum). The kinetic friction
+//! is the median raw force after the slip transient (from the first minimum of the smoothed force
+//! after the drop to the end).
 
 use std::path::{Path, PathBuf};
 
@@ -235,7 +237,7 @@ fn friction_column(table: &Table, rotation_radius_m: Option<f64>) -> Result<Vec<
 /// loading ramp.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SlipOptions {
-    /// Half-width of the centred moving average, samples (window 2h + 1).
+    /// Half-width h of the centred running median, samples (window 2h + 1).
     pub smoothing_half_width: usize,
     /// k: the drop must exceed k noise levels σ.
     pub drop_noise_levels: f64,
@@ -276,8 +278,8 @@ pub struct Slip {
 }
 
 /// Find the onset of slip in `force_n` sampled at increasing `x` (see the module documentation).
-/// `None` when no drop larger than D follows any maximum, or when fewer than
-/// [`SlipOptions::smoothing_half_width`]·2 + 3 samples follow the transient.
+/// `None` when no sustained drop larger than D follows any maximum, or when fewer than
+/// 2h + 3 samples follow the transient (h = [`SlipOptions::smoothing_half_width`]).
 pub fn detect_slip(x: &[f64], force_n: &[f64], opts: &SlipOptions) -> Option<Slip> {
     let n = force_n.len().min(x.len());
     if n < MIN_SAMPLES {
@@ -285,33 +287,43 @@ pub fn detect_slip(x: &[f64], force_n: &[f64], opts: &SlipOptions) -> Option<Sli
     }
     let f = &force_n[..n];
     let h = opts.smoothing_half_width;
-    let smooth = moving_average(f, h);
+    let smooth = running_median(f, h);
     let noise = noise_level(f);
     let (lo, hi) = min_max(&smooth);
     let drop = (opts.drop_noise_levels * noise).max(opts.min_drop_fraction * (hi - lo));
     if drop <= 0.0 {
         return None;
     }
-    let (peak_smooth, dropped_at) = first_sustained_drop(&smooth, drop, 2 * h + 1)?;
-    // The smoothed peak lags the raw one by up to h samples on either side.
-    let window = peak_smooth.saturating_sub(h)..(peak_smooth + 2 * h + 1).min(dropped_at + 1);
-    let peak = window
-        .clone()
-        .max_by(|&a, &b| f[a].total_cmp(&f[b]))
-        .unwrap_or(peak_smooth);
+    let (peak_smooth, dropped_at) = first_sustained_drop(&smooth, drop, 4 * h + 1)?;
+    let onset = drop_onset(f, peak_smooth.saturating_sub(h), dropped_at, 4.0 * noise);
     let kinetic_from = first_local_min(&smooth, dropped_at);
     if n - kinetic_from < 2 * h + 3 {
         return None;
     }
     Some(Slip {
-        index: peak,
-        x: x[peak],
-        static_friction_n: line_value_at(x, f, peak, opts.peak_fit_samples),
+        index: onset,
+        x: x[onset],
+        static_friction_n: line_value_at(x, f, onset, opts.peak_fit_samples),
         kinetic_friction_n: median(&f[kinetic_from..]),
         kinetic_from,
         noise_n: noise,
         drop_threshold_n: drop,
     })
+}
+
+/// The last sample before the drop: the steepest raw step down in `from..to`, walked back over
+/// the preceding steps that also fall by more than `step` (a drop spread over several samples).
+/// On a creeping, nearly flat top the raw maximum is decided by noise; the drop is not.
+fn drop_onset(f: &[f64], from: usize, to: usize, step: f64) -> usize {
+    let to = to.min(f.len() - 1);
+    let Some(mut k) = (from..to).max_by(|&a, &b| (f[a] - f[a + 1]).total_cmp(&(f[b] - f[b + 1])))
+    else {
+        return from;
+    };
+    while k > from && f[k - 1] - f[k] > step.max(0.0) {
+        k -= 1;
+    }
+    k
 }
 
 /// (index of the running maximum, index where the drop was confirmed) for the first drop below
@@ -358,13 +370,12 @@ fn line_value_at(x: &[f64], f: &[f64], end: usize, samples: usize) -> f64 {
     mf + sxf / sxx * (x[end] - mx)
 }
 
-/// Centred moving average of half-width `h`, truncated at the ends.
-fn moving_average(f: &[f64], h: usize) -> Vec<f64> {
+/// Centred running median of half-width `h`, truncated at the ends: it keeps the slip step
+/// sharp and removes outliers up to `h` samples long (a moving average would smear a dropout
+/// into a drop).
+fn running_median(f: &[f64], h: usize) -> Vec<f64> {
     (0..f.len())
-        .map(|i| {
-            let w = &f[i.saturating_sub(h)..(i + h + 1).min(f.len())];
-            w.iter().sum::<f64>() / w.len() as f64
-        })
+        .map(|i| median(&f[i.saturating_sub(h)..(i + h + 1).min(f.len())]))
         .collect()
 }
 
@@ -1008,7 +1019,7 @@ fn summary_json(request: &FrictionRequest, outcome: &FrictionOutcome) -> Value {
             "force_tolerance_pct": request.force_tolerance * 100.0,
         },
         "method": {
-            "static_friction": "denoised force at the onset of slip: the first running maximum of the moving-average force after which it drops by more than max(k*noise, f*range) for several samples; line fit through the raw samples before the peak, evaluated at the peak",
+            "static_friction": "denoised force at the onset of slip: the first running maximum of the running-median force after which its median over 4h+1 samples stays more than max(k*noise, f*range) lower; onset = last raw sample before the steep part of the drop; line fit through the raw samples up to the onset, evaluated there",
             "kinetic_friction": "median raw force from the first minimum after the slip drop to the end of the trace",
             "noise": "1.4826*MAD of second differences / sqrt(6)",
             "smoothing_half_width": request.slip.smoothing_half_width,
