@@ -1100,7 +1100,7 @@ fn compare(args: CompareArgs) -> Result<()> {
 }
 
 fn friction_cmd(args: FrictionArgs) -> Result<()> {
-    let force = |text: &Option<String>, flag: &str, dim: Dimension| -> Result<Option<f64>> {
+    let quantity = |text: &Option<String>, flag: &str, dim: Dimension| -> Result<Option<f64>> {
         text.as_deref()
             .map(|t| units::parse_positive(t, dim))
             .transpose()
@@ -1108,8 +1108,8 @@ fn friction_cmd(args: FrictionArgs) -> Result<()> {
     };
     let request = FrictionRequest {
         traces: args.traces.clone(),
-        normal_force_n: force(&args.normal_force, "--normal-force", Dimension::Force)?,
-        rotation_radius_m: force(
+        normal_force_n: quantity(&args.normal_force, "--normal-force", Dimension::Force)?,
+        rotation_radius_m: quantity(
             &args.rotation_radius,
             "--rotation-radius",
             Dimension::Length,
