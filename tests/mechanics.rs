@@ -11,7 +11,7 @@ use common::{column, read_csv, run, stderr, stdout};
 use contactscope::hertz;
 use contactscope::mechanics::friction::{
     detect_slip, read_trace, run_friction, synthetic_trace, trace_csv, CsvLayout, FrictionRequest,
-    SlipOptions, SyntheticTrace, TraceParams, XAxis,
+    SlipCriterion, SlipOptions, SyntheticTrace, TraceParams, XAxis,
 };
 use contactscope::mechanics::squeeze::{fit_hertz, read_squeeze, run_hertz, HertzRequest};
 use rand::SeedableRng;
@@ -186,6 +186,37 @@ fn later_spike_and_dropout_do_not_fool_the_detector() {
             slip.index
         );
         assert!((slip.static_friction_n / 10e-3 - 1.0).abs() < 0.02);
+    }
+}
+
+/// Without a drop (F_k = F_s, no stick-slip, as the paper reports at 1 µm/s) the slip is where
+/// the loading slope collapses: F_s within 1 %, onset within 10 samples, over 10 seeds.
+#[test]
+fn a_plateau_without_drop_slips_where_the_slope_collapses() {
+    for seed in 0..10 {
+        let p = TraceParams {
+            kinetic_friction_n: 10e-3,
+            wiggle_n: 0.0,
+            slip_samples: 1,
+            ..params(10e-3, seed)
+        };
+        let t = synthetic_trace(&p);
+        let slip = detect_slip(&t.displacement_m, &t.friction_n, &SlipOptions::default()).unwrap();
+        assert_eq!(slip.criterion, SlipCriterion::Plateau);
+        assert!(
+            slip.index.abs_diff(t.slip_index) <= 10,
+            "seed {seed}: {} vs {}",
+            slip.index,
+            t.slip_index
+        );
+        assert!(
+            (slip.static_friction_n / 10e-3 - 1.0).abs() < 0.01,
+            "seed {seed}"
+        );
+        assert!(
+            (slip.kinetic_friction_n / 10e-3 - 1.0).abs() < 0.01,
+            "seed {seed}"
+        );
     }
 }
 

@@ -30,6 +30,10 @@
 //! the raw samples up to the onset, evaluated there (a denoised maximum). The kinetic friction
 //! is the median raw force after the slip transient (from the first minimum of the smoothed force
 //! after the drop to the end).
+//!
+//! A trace without a drop that bends into a plateau (no stick-slip, F_s = F_k) slips where the
+//! loading slope collapses below a tenth of its value on the ramp (see `docs/mechanics.md`); its
+//! criterion is reported as `plateau`. A trace with neither is an error, never a guess.
 
 use std::path::{Path, PathBuf};
 
@@ -275,11 +279,33 @@ pub struct Slip {
     pub noise_n: f64,
     /// Drop D that counted as slip, N.
     pub drop_threshold_n: f64,
+    /// How the slip was recognised.
+    pub criterion: SlipCriterion,
 }
 
-/// Find the onset of slip in `force_n` sampled at increasing `x` (see the module documentation).
-/// `None` when no sustained drop larger than D follows any maximum, or when fewer than
-/// 2h + 3 samples follow the transient (h = [`SlipOptions::smoothing_half_width`]).
+/// How a slip was recognised.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SlipCriterion {
+    /// The force dropped from a maximum (static above kinetic friction).
+    Drop,
+    /// No drop: the loading slope collapsed into a plateau (F_s = F_k).
+    Plateau,
+}
+
+impl SlipCriterion {
+    /// Name in tables and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            SlipCriterion::Drop => "drop",
+            SlipCriterion::Plateau => "plateau",
+        }
+    }
+}
+
+/// Find the onset of slip in `force_n` sampled at increasing `x` (see the module documentation):
+/// the first sustained drop, or else the point where the loading slope collapses into a plateau.
+/// `None` when neither is found, or when fewer than 2h + 3 samples follow the transient
+/// (h = [`SlipOptions::smoothing_half_width`]).
 pub fn detect_slip(x: &[f64], force_n: &[f64], opts: &SlipOptions) -> Option<Slip> {
     let n = force_n.len().min(x.len());
     if n < MIN_SAMPLES {
@@ -294,21 +320,89 @@ pub fn detect_slip(x: &[f64], force_n: &[f64], opts: &SlipOptions) -> Option<Sli
     if drop <= 0.0 {
         return None;
     }
-    let (peak_smooth, dropped_at) = first_sustained_drop(&smooth, drop, 4 * h + 1)?;
-    let onset = drop_onset(f, peak_smooth.saturating_sub(h), dropped_at, 4.0 * noise);
-    let kinetic_from = first_local_min(&smooth, dropped_at);
-    if n - kinetic_from < 2 * h + 3 {
+    let signal = Signal {
+        x: &x[..n],
+        f,
+        smooth,
+        noise,
+        drop,
+        h,
+    };
+    match first_sustained_drop(&signal.smooth, drop, 4 * h + 1) {
+        Some((peak, dropped_at)) => drop_slip(&signal, peak, dropped_at, opts),
+        None => plateau_slip(&signal),
+    }
+}
+
+/// A trace prepared for slip detection.
+struct Signal<'a> {
+    x: &'a [f64],
+    f: &'a [f64],
+    smooth: Vec<f64>,
+    noise: f64,
+    drop: f64,
+    h: usize,
+}
+
+impl Signal<'_> {
+    fn slip(&self, index: usize, static_n: f64, kinetic_from: usize, how: SlipCriterion) -> Slip {
+        Slip {
+            index,
+            x: self.x[index],
+            static_friction_n: static_n,
+            kinetic_friction_n: median(&self.f[kinetic_from..]),
+            kinetic_from,
+            noise_n: self.noise,
+            drop_threshold_n: self.drop,
+            criterion: how,
+        }
+    }
+}
+
+fn drop_slip(s: &Signal, peak: usize, dropped_at: usize, opts: &SlipOptions) -> Option<Slip> {
+    let onset = drop_onset(s.f, peak.saturating_sub(s.h), dropped_at, 4.0 * s.noise);
+    let kinetic_from = first_local_min(&s.smooth, dropped_at);
+    if s.f.len() - kinetic_from < 2 * s.h + 3 {
         return None;
     }
-    Some(Slip {
-        index: onset,
-        x: x[onset],
-        static_friction_n: line_value_at(x, f, onset, opts.peak_fit_samples),
-        kinetic_friction_n: median(&f[kinetic_from..]),
-        kinetic_from,
-        noise_n: noise,
-        drop_threshold_n: drop,
-    })
+    let static_n = line_value_at(s.x, s.f, onset, opts.peak_fit_samples);
+    Some(s.slip(onset, static_n, kinetic_from, SlipCriterion::Drop))
+}
+
+/// Slope below this fraction of the loading slope counts as sliding.
+const PLATEAU_SLOPE: f64 = 0.1;
+
+/// No drop: slip where the loading slope collapses. The loading slope k₀ is the median
+/// centred-difference slope (over ±5h samples) while the force is between 20 % and 60 % of its
+/// range; the plateau starts at the first sample above 60 % from which the slope stays below
+/// 0.1·k₀ for 5h samples. F_s = F_k there; the onset is where the smoothed force first comes
+/// within max(2σ, 0.5 %) of the plateau level.
+fn plateau_slip(s: &Signal) -> Option<Slip> {
+    let n = s.f.len();
+    let w = 5 * s.h.max(1);
+    let (lo, hi) = min_max(&s.smooth);
+    if hi - lo < 2.0 * s.drop || n < 4 * w {
+        return None;
+    }
+    let level_at = |frac: f64| lo + frac * (hi - lo);
+    let slope = |i: usize| (s.smooth[i + w] - s.smooth[i - w]) / (s.x[i + w] - s.x[i - w]);
+    let ramp: Vec<f64> = (w..n - w)
+        .filter(|&i| (level_at(0.2)..=level_at(0.6)).contains(&s.smooth[i]))
+        .map(slope)
+        .collect();
+    let k0 = median(&ramp);
+    if ramp.len() < 3 || k0.is_nan() || k0 <= 0.0 {
+        return None;
+    }
+    let corner = (w..n - 2 * w).find(|&i| {
+        s.smooth[i] >= level_at(0.6) && (i..i + w).all(|j| slope(j) < PLATEAU_SLOPE * k0)
+    })?;
+    let level = median(&s.f[corner..corner + 2 * w]);
+    let near = (2.0 * s.noise).max(0.005 * level.abs());
+    let onset = (0..=corner)
+        .find(|&j| s.smooth[j] >= level - near)
+        .unwrap_or(corner);
+    Some(s.slip(onset, level, corner, SlipCriterion::Plateau))
 }
 
 /// The last sample before the drop: the steepest raw step down in `from..to`, walked back over
@@ -807,6 +901,12 @@ fn analyse_trace(
             "no slip found: the friction force never drops clearly below a preceding maximum (or the trace ends during the drop)",
         )
     })?;
+    if slip.criterion == SlipCriterion::Plateau {
+        warnings.push(format!(
+            "{}: no drop after the peak; slip taken where the loading slope collapses (plateau), so static = kinetic friction",
+            path.display()
+        ));
+    }
     Ok(TraceResult {
         file: path.to_path_buf(),
         x_axis: trace.x_axis,
@@ -918,7 +1018,12 @@ pub fn results_csv(traces: &[TraceResult]) -> Result<String> {
         "kinetic_friction_mN".into(),
     ];
     header.extend(axes.iter().map(|a| a.slip_column().to_string()));
-    header.extend(["mu_static".into(), "mu_kinetic".into(), "noise_mN".into()]);
+    header.extend([
+        "mu_static".into(),
+        "mu_kinetic".into(),
+        "noise_mN".into(),
+        "slip_criterion".into(),
+    ]);
     if with_area {
         header.extend(["area_um2".into(), "shear_stress_MPa".into()]);
     }
@@ -953,6 +1058,7 @@ fn result_row(t: &TraceResult, axes: &[XAxis], with_area: bool) -> Vec<String> {
         format!("{:.6}", t.mu_static()),
         format!("{:.6}", t.mu_kinetic()),
         format!("{:.6}", t.slip.noise_n * 1e3),
+        t.slip.criterion.name().to_string(),
     ]);
     if with_area {
         match t.area_m2 {
@@ -991,6 +1097,7 @@ fn summary_json(request: &FrictionRequest, outcome: &FrictionOutcome) -> Value {
                 "slip_at": t.x_axis.to_column_unit(t.slip.x),
                 "slip_at_unit": t.x_axis.slip_column().trim_start_matches("slip_at_"),
                 "slip_sample": t.slip.index,
+                "slip_criterion": t.slip.criterion.name(),
                 "mu_static": t.mu_static(),
                 "mu_kinetic": t.mu_kinetic(),
                 "noise_mN": t.slip.noise_n * 1e3,
@@ -1019,7 +1126,7 @@ fn summary_json(request: &FrictionRequest, outcome: &FrictionOutcome) -> Value {
             "force_tolerance_pct": request.force_tolerance * 100.0,
         },
         "method": {
-            "static_friction": "denoised force at the onset of slip: the first running maximum of the running-median force after which its median over 4h+1 samples stays more than max(k*noise, f*range) lower; onset = last raw sample before the steep part of the drop; line fit through the raw samples up to the onset, evaluated there",
+            "static_friction": "denoised force at the onset of slip: the first running maximum of the running-median force after which its median over 4h+1 samples stays more than max(k*noise, f*range) lower; onset = last raw sample before the steep part of the drop; line fit through the raw samples up to the onset, evaluated there; without a drop, where the centred slope over +-5h samples stays below 0.1 of the loading slope (criterion plateau, F_s = F_k)",
             "kinetic_friction": "median raw force from the first minimum after the slip drop to the end of the trace",
             "noise": "1.4826*MAD of second differences / sqrt(6)",
             "smoothing_half_width": request.slip.smoothing_half_width,
