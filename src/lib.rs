@@ -16,6 +16,7 @@
 //! 6. [`report`], [`plot`], [`output`] — CSV, JSON and PNG/SVG outputs, written atomically;
 //!    [`pipeline`] runs the whole `analyze` job.
 //! 7. [`synth`] — a seeded generator of realistic load series with known ground truth.
+//! 8. [`mechanics`] — rheometer friction traces (F = τ·A) and squeeze tests (Hertz E*).
 //!
 //! ```
 //! use contactscope::measure::measure;
@@ -59,6 +60,7 @@ pub mod fit;
 pub mod fitting;
 pub mod hertz;
 pub mod measure;
+pub mod mechanics;
 pub mod optics;
 pub mod output;
 pub mod pipeline;

@@ -12,6 +12,8 @@ use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
 use contactscope::compare::{self as comparison, CompareRequest, CompareSettings, ExperimentInput};
 use contactscope::fitting::job::{self as fit_job, FitRequest, Sweep, SweepMicrographs};
 use contactscope::fitting::{Family, Search};
+use contactscope::mechanics::friction::{self, FrictionRequest, SlipOptions};
+use contactscope::mechanics::squeeze::{self, HertzRequest};
 use contactscope::optics::newton::{self as newton_rings, NewtonOptions, NewtonRequest, Phase};
 use contactscope::optics::psf::{self, PsfRequest};
 use contactscope::pipeline::{self, AnalyzeRequest};
@@ -69,6 +71,10 @@ enum Command {
     Newton(NewtonArgs),
     /// Measure the microscope PSF on a bead image or z stack (radial Gaussian fits, FWHM).
     Psf(PsfArgs),
+    /// Static and kinetic friction from rheometer traces; τ of F = τ·A with measured areas.
+    Friction(FrictionArgs),
+    /// Contact modulus E* from a squeeze test of one sphere between two plates (Hertz).
+    Hertz(HertzArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -169,6 +175,44 @@ struct FitArgs {
     max_iterations: usize,
     /// Output folder.
     #[arg(long, default_value = "contactscope-out/fit")]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct FrictionArgs {
+    /// Trace CSVs: time_s | displacement_um | angle_rad, friction_mN | friction_N | torque_mNm |
+    /// torque_Nm, optional normal_force_mN | normal_force_N.
+    #[arg(required = true)]
+    traces: Vec<PathBuf>,
+    /// Normal force for traces without a normal-force column (e.g. 40mN).
+    #[arg(long)]
+    normal_force: Option<String>,
+    /// Rotation radius of the sphere on the rheometer plate, turns torque into force (e.g. 5mm).
+    #[arg(long)]
+    rotation_radius: Option<String>,
+    /// areas.csv from `contactscope analyze` (force_mN, area_um2), for F = τ·A.
+    #[arg(long)]
+    areas: Option<PathBuf>,
+    /// Largest relative difference between a trace's normal force and an area row (e.g. 2%).
+    #[arg(long, default_value = "2%")]
+    force_tolerance: String,
+    /// Output folder.
+    #[arg(long, default_value = "contactscope-out/friction")]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct HertzArgs {
+    /// Squeeze CSV: force_mN | force_N and displacement_um (total plate displacement 2δ).
+    input: PathBuf,
+    /// Sphere radius (e.g. 290um).
+    #[arg(long)]
+    radius: String,
+    /// Loads at which to predict the Hertz contact radius (default: the measured forces).
+    #[arg(long)]
+    loads: Option<String>,
+    /// Output folder.
+    #[arg(long, default_value = "contactscope-out/hertz")]
     out: PathBuf,
 }
 
@@ -491,6 +535,8 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare(args),
         Command::FitHardening(args) => fit_hardening(args),
         Command::Newton(args) => newton(args),
+        Command::Friction(args) => friction_cmd(args),
+        Command::Hertz(args) => hertz_cmd(args),
         Command::Psf(args) => psf(args),
     };
     match result {
@@ -1405,6 +1451,121 @@ fn fit_hardening(args: FitArgs) -> Result<()> {
     }
     if let Some(best) = outcome.best() {
         println!("best model: {}", best.family.name());
+    }
+    println!(
+        "wrote {} files to {}",
+        outcome.written.len(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn friction_cmd(args: FrictionArgs) -> Result<()> {
+    let quantity = |text: &Option<String>, flag: &str, dim: Dimension| -> Result<Option<f64>> {
+        text.as_deref()
+            .map(|t| units::parse_positive(t, dim))
+            .transpose()
+            .with_context(|| flag.to_string())
+    };
+    let request = FrictionRequest {
+        traces: args.traces.clone(),
+        normal_force_n: quantity(&args.normal_force, "--normal-force", Dimension::Force)?,
+        rotation_radius_m: quantity(
+            &args.rotation_radius,
+            "--rotation-radius",
+            Dimension::Length,
+        )?,
+        areas: args.areas.clone(),
+        force_tolerance: fraction(&args.force_tolerance, "--force-tolerance")?,
+        slip: SlipOptions::default(),
+        out_dir: args.out.clone(),
+        command_line: std::env::args().collect(),
+    };
+    let outcome = friction::run_friction(&request)?;
+    for w in &outcome.warnings {
+        eprintln!("contactscope: warning: {w}");
+    }
+    println!(
+        "{:>9} {:>9} {:>9} {:>12} {:>7} {:>7}  file",
+        "N_mN", "F_s_mN", "F_k_mN", "slip_at", "μ_s", "μ_k"
+    );
+    for t in &outcome.traces {
+        let slip = t.x_axis.to_column_unit(t.slip.x);
+        let unit = t.x_axis.slip_column().trim_start_matches("slip_at_");
+        println!(
+            "{:>9.3} {:>9.4} {:>9.4} {:>12} {:>7.4} {:>7.4}  {}",
+            t.normal_force_n * 1e3,
+            t.slip.static_friction_n * 1e3,
+            t.slip.kinetic_friction_n * 1e3,
+            format!("{slip:.4} {unit}"),
+            t.mu_static(),
+            t.mu_kinetic(),
+            t.file.display()
+        );
+    }
+    if let Some(fit) = &outcome.shear {
+        let se = fit
+            .tau_se_pa
+            .map_or(String::new(), |s| format!(" ± {:.2}", s * 1e-6));
+        let r2 = fit.r_squared.map_or("—".into(), |r| format!("{r:.4}"));
+        println!("F_s = τ·A: τ = {:.2}{se} MPa (R² {r2})", fit.tau_pa * 1e-6);
+    }
+    if let Some(m) = &outcome.mu_trend {
+        let se = m
+            .exponent_se
+            .map_or(String::new(), |s| format!(" ± {s:.3}"));
+        let verdict = match m.varies {
+            Some(true) => "μ depends on N (not Amontons)",
+            Some(false) => "μ constant within the scatter",
+            None => "too few loads to judge",
+        };
+        println!(
+            "μ_s ∝ N^m: m = {:.3}{se}, spread {:.1} %: {verdict}",
+            m.exponent,
+            m.relative_spread * 100.0
+        );
+    }
+    println!(
+        "wrote {} files to {}",
+        outcome.written.len(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn hertz_cmd(args: HertzArgs) -> Result<()> {
+    let request = HertzRequest {
+        input: args.input.clone(),
+        radius_m: units::parse_positive(&args.radius, Dimension::Length).context("--radius")?,
+        loads_n: args
+            .loads
+            .as_deref()
+            .map(units::parse_loads)
+            .transpose()
+            .context("--loads")?,
+        out_dir: args.out.clone(),
+        command_line: std::env::args().collect(),
+    };
+    let outcome = squeeze::run_hertz(&request)?;
+    let fit = &outcome.fit;
+    println!(
+        "E* = {:.4} ± {:.4} GPa (R² {:.5}, {} points, fit through the origin)",
+        fit.e_star_pa * 1e-9,
+        fit.e_star_se_pa * 1e-9,
+        fit.r_squared,
+        outcome.points.len()
+    );
+    if let Some(free) = &outcome.offset_fit {
+        println!(
+            "with a free contact point: E* = {:.4} ± {:.4} GPa, offset {:.4} µm of plate displacement",
+            free.e_star_pa * 1e-9,
+            free.e_star_se_pa * 1e-9,
+            2.0 * free.offset_m * 1e6
+        );
+    }
+    println!("{:>10} {:>12}", "load_mN", "a_Hertz_µm");
+    for (p, a) in &outcome.predicted {
+        println!("{:>10.3} {:>12.4}", p * 1e3, a * 1e6);
     }
     println!(
         "wrote {} files to {}",

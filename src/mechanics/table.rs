@@ -1,0 +1,144 @@
+//! Small numeric CSV tables whose column names carry the unit (`force_mN`, `torque_Nm`): the one
+//! reader shared by the mechanics inputs, so that every missing or misspelt column is reported
+//! the same way, naming the file and the columns it does have.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Location, Result};
+
+/// A CSV file read into memory: trimmed header names and raw records.
+pub(crate) struct Table {
+    path: PathBuf,
+    header: Vec<String>,
+    rows: Vec<csv::StringRecord>,
+}
+
+impl Table {
+    /// Read `path`; an unreadable file or a malformed CSV is an error naming the file.
+    pub(crate) fn read(path: &Path) -> Result<Table> {
+        let at = || Location::file(path);
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .comment(Some(b'#'))
+            .from_path(path)
+            .map_err(|e| csv_error(path, e))?;
+        let header = reader
+            .headers()
+            .map_err(|e| csv_error(path, e))?
+            .iter()
+            .map(String::from)
+            .collect();
+        let rows = reader
+            .records()
+            .collect::<std::result::Result<Vec<_>, _>>()
+            .map_err(|e| Error::bad_input(at(), format!("not a readable CSV: {e}")))?;
+        Ok(Table {
+            path: path.to_path_buf(),
+            header,
+            rows,
+        })
+    }
+
+    /// The file, for error messages.
+    pub(crate) fn location(&self) -> Location {
+        Location::file(&self.path)
+    }
+
+    /// Column names as found.
+    pub(crate) fn header(&self) -> &[String] {
+        &self.header
+    }
+
+    /// Number of data rows.
+    pub(crate) fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// The one column among `candidates` that is present, `None` if none is. Two of them at once
+    /// (`friction_mN` and `friction_N`) are ambiguous and an error.
+    pub(crate) fn one_of<'a>(&self, candidates: &[&'a str]) -> Result<Option<&'a str>> {
+        let present: Vec<&'a str> = candidates
+            .iter()
+            .copied()
+            .filter(|c| self.header.iter().any(|h| h == c))
+            .collect();
+        match present.as_slice() {
+            [] => Ok(None),
+            [one] => Ok(Some(one)),
+            many => Err(Error::bad_input(
+                self.location(),
+                format!(
+                    "columns {} say the same thing; keep one",
+                    many.join(" and ")
+                ),
+            )),
+        }
+    }
+
+    /// The error for a required column that is not there.
+    pub(crate) fn missing(&self, what: &str, accepted: &[&str]) -> Error {
+        Error::bad_input(
+            self.location(),
+            format!(
+                "no {what} column (accepted: {}); columns found: {}",
+                accepted.join(", "),
+                self.found()
+            ),
+        )
+    }
+
+    /// The header as a readable list.
+    pub(crate) fn found(&self) -> String {
+        if self.header.is_empty() {
+            "none".into()
+        } else {
+            self.header.join(", ")
+        }
+    }
+
+    /// Column `name` as finite numbers times `factor`; an empty or non-numeric cell is an error
+    /// naming its line (the header is line 1).
+    pub(crate) fn numbers(&self, name: &str, factor: f64) -> Result<Vec<f64>> {
+        let i = self
+            .header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| self.missing(name, &[name]))?;
+        self.rows
+            .iter()
+            .enumerate()
+            .map(|(k, row)| {
+                let cell = row.get(i).unwrap_or("");
+                match cell.parse::<f64>() {
+                    Ok(v) if v.is_finite() => Ok(v * factor),
+                    _ => Err(Error::bad_input(
+                        self.location(),
+                        format!(
+                            "line {}, column {name}: {cell:?} is not a finite number",
+                            line_of(row, k)
+                        ),
+                    )),
+                }
+            })
+            .collect()
+    }
+
+    /// File line of data row `k` (for messages).
+    pub(crate) fn line(&self, k: usize) -> u64 {
+        self.rows.get(k).map_or(k as u64 + 2, |r| line_of(r, k))
+    }
+}
+
+fn line_of(row: &csv::StringRecord, k: usize) -> u64 {
+    row.position().map_or(k as u64 + 2, |p| p.line())
+}
+
+fn csv_error(path: &Path, e: csv::Error) -> Error {
+    match e.into_kind() {
+        csv::ErrorKind::Io(source) => Error::io(path, source),
+        other => Error::bad_input(
+            Location::file(path),
+            format!("not a readable CSV: {other:?}"),
+        ),
+    }
+}
