@@ -199,6 +199,43 @@ pub struct Prepared {
     raw_area_m2: f64,
 }
 
+impl Prepared {
+    /// Micrograph (width, height), pixels.
+    pub fn size(&self) -> (usize, usize) {
+        self.size
+    }
+
+    /// The micrograph's values, row-major.
+    pub fn micrograph(&self) -> &[f64] {
+        &self.experiment
+    }
+
+    /// The registered simulated image on the micrograph's grey scale of `load`, NaN outside the
+    /// simulated region.
+    pub fn simulated_on_scale(&self, load: &LoadComparison) -> Vec<f64> {
+        self.simulated
+            .iter()
+            .zip(&self.footprint)
+            .map(|(&v, &inside)| {
+                if inside {
+                    load.intensity.apply(v)
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect()
+    }
+
+    /// Micrograph values inside the simulated region, NaN outside.
+    pub fn micrograph_in_region(&self) -> Vec<f64> {
+        self.experiment
+            .iter()
+            .zip(&self.footprint)
+            .map(|(&v, &inside)| if inside { v } else { f64::NAN })
+            .collect()
+    }
+}
+
 /// Below this correlation peak a registration is reported as doubtful.
 const WEAK_PEAK: f64 = 0.05;
 
@@ -213,6 +250,7 @@ pub fn run_compare(request: &CompareRequest) -> Result<CompareOutcome> {
         prepared,
         simulated_threshold: sim_threshold,
         warnings,
+        ..
     } = compare_maps(&micrographs, &simulated, &request.settings)?;
     let threshold = micrographs.threshold;
     let pixel = micrographs.pixel_m;
@@ -237,6 +275,7 @@ pub fn run_compare(request: &CompareRequest) -> Result<CompareOutcome> {
 }
 
 /// The result of [`compare_maps`].
+#[derive(Debug, Clone)]
 pub struct Comparison {
     /// Scores per matched load, in experiment order.
     pub loads: Vec<LoadComparison>,
@@ -244,6 +283,8 @@ pub struct Comparison {
     pub prepared: Vec<Prepared>,
     /// Otsu threshold of the blurred simulated maps (covered fraction).
     pub simulated_threshold: f64,
+    /// The micrographs' series threshold (grey levels); contact is value > t.
+    pub experiment_threshold: f64,
     /// Notes for the user.
     pub warnings: Vec<String>,
 }
@@ -281,6 +322,7 @@ pub fn compare_maps(
         loads,
         prepared,
         simulated_threshold: sim_threshold,
+        experiment_threshold: micrographs.threshold,
         warnings,
     })
 }
@@ -577,18 +619,7 @@ fn score(p: &Prepared, t_exp: f64, t_sim: f64, pixel: (f64, f64)) -> Result<Load
 fn panel(p: &Prepared, load: &LoadComparison, t_exp: f64) -> Result<Vec<u8>> {
     let (w, h) = p.size;
     let mask: Vec<bool> = p.experiment.iter().map(|&v| v > t_exp).collect();
-    let simulated: Vec<f64> = p
-        .simulated
-        .iter()
-        .zip(&p.footprint)
-        .map(|(&v, &inside)| {
-            if inside {
-                load.intensity.apply(v)
-            } else {
-                f64::NAN
-            }
-        })
-        .collect();
+    let simulated = p.simulated_on_scale(load);
     let scale = (512 / w.max(h)).clamp(1, 4);
     edge_panels_png(&[&p.experiment, &simulated], w, h, &mask, scale)
 }

@@ -55,6 +55,7 @@
 
 pub mod analysis;
 pub mod compare;
+pub mod demo;
 pub mod error;
 pub mod fit;
 pub mod fitting;

@@ -10,8 +10,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
 use contactscope::compare::{self as comparison, CompareRequest, CompareSettings, ExperimentInput};
+use contactscope::demo::DemoParams;
 use contactscope::fitting::job::{self as fit_job, FitRequest, Sweep, SweepMicrographs};
-use contactscope::fitting::{Family, Search};
+use contactscope::fitting::{Family, Imaging, Search};
 use contactscope::mechanics::friction::{self, FrictionRequest, SlipOptions};
 use contactscope::mechanics::squeeze::{self, HertzRequest};
 use contactscope::optics::newton::{self as newton_rings, NewtonOptions, NewtonRequest, Phase};
@@ -161,9 +162,14 @@ struct FitArgs {
     /// PSF FWHM for Dice in the sweep (e.g. 450nm).
     #[arg(long)]
     psf_fwhm: Option<String>,
-    /// Micrograph pixel size override (e.g. 200nm).
+    /// Micrograph pixel size (e.g. 200nm): overrides the micrographs' metadata, and sets the
+    /// image grid for --imaged-areas.
     #[arg(long)]
     micrograph_pixel_size: Option<String>,
+    /// Count simulated areas as the microscope sees them (blur with --psf-fwhm onto
+    /// --micrograph-pixel-size pixels, Otsu), like areas measured on micrographs.
+    #[arg(long)]
+    imaged_areas: bool,
     /// Periodic boundaries (nominally flat periodic maps).
     #[arg(long)]
     periodic: bool,
@@ -515,9 +521,15 @@ struct SynthArgs {
 
 #[derive(clap::Args)]
 struct DemoArgs {
-    /// Output folder.
+    /// Report folder (an earlier demo report there is replaced).
     #[arg(long, default_value = "contactscope-out/demo")]
     out: PathBuf,
+    /// The reduced demo of the test suite (smaller maps, fewer loads).
+    #[arg(long)]
+    small: bool,
+    /// No stage messages.
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 fn main() -> ExitCode {
@@ -807,57 +819,45 @@ fn synth_series(args: SynthArgs) -> Result<()> {
 }
 
 /// Where the bundled series lives (next to Cargo.toml).
-fn bundled_series() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/synthetic-series")
-}
-
 fn demo(args: DemoArgs) -> Result<()> {
-    let dir = bundled_series();
-    let manifest = dir.join("manifest.csv");
-    if !manifest.exists() {
-        bail!(
-            "bundled series not found at {}; regenerate it with `contactscope synth-series --out {}`",
-            dir.display(),
-            dir.display()
-        );
-    }
-    println!(
-        "demo: analysing the bundled synthetic load series {}",
-        dir.display()
-    );
-    let request = AnalyzeRequest {
-        series: series::from_manifest(&manifest, None)?,
-        options: AnalysisOptions {
-            hertz: Some(HertzParams {
-                radius_m: 290e-6,
-                modulus_pa: 3.7e9,
-            }),
-            ..AnalysisOptions::default()
-        },
-        out_dir: args.out.clone(),
-        overlays: true,
-        save_masks: false,
-        command_line: std::env::args().collect(),
+    let params = if args.small {
+        DemoParams::reduced()
+    } else {
+        DemoParams::standard()
     };
-    let outcome = run_with_progress(&request, false)?;
-    print_outcome(&outcome, &args.out);
-    let truth = contactscope::synth::read_truth(&dir.join("truth.csv"))?;
-    println!("\nground truth of the generator (truth.csv) against the measurement:");
+    let start = std::time::Instant::now();
+    let quiet = args.quiet;
+    let progress = |stage: &str| {
+        if !quiet {
+            eprintln!("[{:>5.1} s] {stage}", start.elapsed().as_secs_f64());
+        }
+    };
+    let outcome = contactscope::demo::run_demo(&args.out, &params, &progress)?;
     println!(
-        "{:>10} {:>14} {:>14} {:>9}",
-        "force_mN", "true_area_µm²", "measured_µm²", "error_%"
+        "{:<32} {:>12} {:>22} {:>8}  by",
+        "quantity", "truth", "recovered", "error"
     );
-    for (row, true_area) in outcome.report.rows.iter().zip(truth) {
+    for r in &outcome.recovered {
+        let unc = r
+            .uncertainty
+            .map_or(String::new(), |u| format!(" ± {u:.3}"));
         println!(
-            "{:>10.3} {:>14.2} {:>14.2} {:>9.2}",
-            row.force_mn.unwrap_or(f64::NAN),
-            true_area,
-            row.area,
-            (row.area / true_area - 1.0) * 100.0
+            "{:<32} {:>12} {:>22} {:>7.1}%  {}",
+            r.quantity,
+            format!("{:.3} {}", r.truth, r.unit),
+            format!("{:.3}{unc}", r.recovered),
+            100.0 * r.relative_error(),
+            r.by
         );
     }
-    println!("\ntable: {}", args.out.join("areas.csv").display());
-    println!("plot:  {}", args.out.join("area_vs_load.png").display());
+    for (model, dice) in &outcome.dice {
+        println!("mean Dice against the micrographs, {model}: {dice:.3}");
+    }
+    println!(
+        "report: {} ({:.1} s)",
+        outcome.index.display(),
+        start.elapsed().as_secs_f64()
+    );
     Ok(())
 }
 
@@ -1377,6 +1377,19 @@ fn sweep_micrographs(args: &FitArgs) -> Result<Option<SweepMicrographs>> {
     }))
 }
 
+fn fit_imaging(args: &FitArgs) -> Result<Option<Imaging>> {
+    if !args.imaged_areas {
+        return Ok(None);
+    }
+    let (Some(fwhm), Some(pixel)) = (&args.psf_fwhm, &args.micrograph_pixel_size) else {
+        bail!("--imaged-areas needs --psf-fwhm and --micrograph-pixel-size");
+    };
+    Ok(Some(Imaging {
+        fwhm_m: units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+        pixel_m: units::parse_pixel_size(pixel).context("--micrograph-pixel-size")?,
+    }))
+}
+
 fn fit_hardening(args: FitArgs) -> Result<()> {
     let families = args
         .models
@@ -1413,6 +1426,7 @@ fn fit_hardening(args: FitArgs) -> Result<()> {
         searches: fit_searches(&args)?,
         sweep,
         micrographs: sweep_micrographs(&args)?,
+        imaging: fit_imaging(&args)?,
         options: SolverOptions {
             max_iterations: args.max_iterations,
             tolerance: args.tolerance,

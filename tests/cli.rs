@@ -76,37 +76,6 @@ fn assert_clean_failure(out: &std::process::Output, needle: &str, out_dir: &Path
 }
 
 #[test]
-fn demo_runs_on_the_bundled_series() {
-    let dir = tempfile::tempdir().unwrap();
-    let out_dir = dir.path().join("demo");
-    let out = run(&["demo", "--out", s(&out_dir)]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let text = stdout(&out);
-    assert!(text.contains("ground truth"), "{text}");
-    assert!(text.contains("areas.csv") && text.contains("area_vs_load.png"));
-    for f in [
-        "areas.csv",
-        "summary.json",
-        "area_vs_load.png",
-        "area_vs_load.svg",
-    ] {
-        assert!(out_dir.join(f).exists(), "{f}");
-    }
-    assert_eq!(
-        fs::read_dir(&out_dir)
-            .unwrap()
-            .filter(|e| e
-                .as_ref()
-                .unwrap()
-                .file_name()
-                .to_string_lossy()
-                .starts_with("overlay_"))
-            .count(),
-        8
-    );
-}
-
-#[test]
 fn analyze_a_directory_with_forces() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("data");

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
-use super::{fit_parameter, Evaluation, Family, Measured, ModelBody, ModelFit, Search};
+use super::{fit_parameter, Evaluation, Family, Imaging, Measured, ModelBody, ModelFit, Search};
 use crate::compare::{compare_maps, CompareSettings, ExperimentInput, Micrographs, SimulatedMap};
 use crate::error::{Error, Location, Result};
 use crate::optics::blur::Grid;
@@ -106,6 +106,8 @@ pub struct FitRequest {
     pub micrographs: Option<SweepMicrographs>,
     /// Solver limits.
     pub options: SolverOptions<'static>,
+    /// Count simulated areas as imaged (blur, resample, Otsu) instead of raw g = 0 pixels.
+    pub imaging: Option<Imaging>,
     /// Output folder.
     pub out_dir: PathBuf,
     /// The command line.
@@ -277,6 +279,7 @@ fn model_body(request: &FitRequest) -> Result<ModelBody> {
         e_star_pa: request.e_star_pa,
         periodic: request.periodic,
         options: request.options,
+        imaging: request.imaging,
     })
 }
 
@@ -620,6 +623,14 @@ fn summary_json(
         "measured": {
             "force_mN": measured.forces_n.iter().map(|f| f * 1e3).collect::<Vec<_>>(),
             "area_um2": measured.areas_m2.iter().map(|a| a * 1e12).collect::<Vec<_>>(),
+        },
+        "simulated_areas": match &request.imaging {
+            Some(i) => json!({
+                "counted": "as imaged: blurred by the PSF, integrated onto micrograph pixels, one Otsu threshold per simulated series",
+                "psf_fwhm_nm": i.fwhm_m * 1e9,
+                "pixel_size_nm": [i.pixel_m.0 * 1e9, i.pixel_m.1 * 1e9],
+            }),
+            None => json!({ "counted": "raw: simulation pixels with g = 0 (p > 0)" }),
         },
         "method": "least squares in log area: misfit = RMS of ln(A_sim/A_exp) over the measured loads; one-parameter models by a parallel log grid then golden-section search on ln(parameter); SE by Gauss-Newton at the optimum; hardening has p_Y0 = 0 as in the paper",
         "models": models,

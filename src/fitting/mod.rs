@@ -16,12 +16,14 @@ pub mod job;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::optics::blur::{microscope_image, Grid};
 use crate::solver::cg::SolverOptions;
 use crate::solver::gt::{gt_bearing_area, gt_profile, GtParams};
 use crate::solver::halfspace::Boundary;
 use crate::solver::simulate::{sweep, Model, Setup};
 use crate::surface::stats::SurfaceStats;
 use crate::surface::Topography;
+use crate::threshold::otsu_of_values;
 
 /// A model family as fitted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -124,6 +126,44 @@ pub struct ModelBody {
     pub periodic: bool,
     /// CG limits.
     pub options: SolverOptions<'static>,
+    /// Count simulated areas as the microscope would see them (blur, resample, threshold), so
+    /// they compare like with like with areas measured on micrographs; raw g = 0 areas otherwise.
+    pub imaging: Option<Imaging>,
+}
+
+/// How simulated maps are imaged before their area is counted (methods.md §7.1: apply the same
+/// blur-and-threshold procedure to simulated maps as to micrographs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Imaging {
+    /// PSF FWHM, m.
+    pub fwhm_m: f64,
+    /// Micrograph pixel size (x, y), m.
+    pub pixel_m: (f64, f64),
+}
+
+impl Imaging {
+    /// Areas of the maps of one load series as imaged: each map blurred and integrated onto
+    /// micrograph pixels, one Otsu threshold over the whole series (as for micrographs), then
+    /// pixels above it × pixel area.
+    pub fn areas(&self, maps: &[Vec<f64>], body: &Topography) -> Result<Vec<f64>> {
+        let images: Vec<Grid> = maps
+            .iter()
+            .map(|m| {
+                let grid = Grid::new(m.clone(), body.nx(), body.ny(), body.dx_m, body.dy_m)?;
+                microscope_image(&grid, self.fwhm_m, self.pixel_m)
+            })
+            .collect::<Result<_>>()?;
+        let values: Vec<&[f64]> = images.iter().map(|g| g.values.as_slice()).collect();
+        let Ok(t) = otsu_of_values(&values, "the imaged simulated maps") else {
+            // Every imaged map is uniform (no contact anywhere): no area.
+            return Ok(vec![0.0; maps.len()]);
+        };
+        let pixel_area = self.pixel_m.0 * self.pixel_m.1;
+        Ok(images
+            .iter()
+            .map(|g| g.values.iter().filter(|&&v| v > t).count() as f64 * pixel_area)
+            .collect())
+    }
 }
 
 /// Measured area–load points, SI units, sorted by force.
@@ -213,20 +253,22 @@ impl ModelBody {
             options: self.options,
         };
         let steps = sweep(&setup, loads_n, &|_, _| {})?;
-        let areas = steps.iter().map(|s| s.area_m2).collect();
-        let maps = keep_maps.then(|| {
-            steps
-                .iter()
-                .map(|s| {
-                    s.solution
-                        .pressure
-                        .iter()
-                        .map(|&p| f64::from(u8::from(p > 0.0)))
-                        .collect()
-                })
-                .collect()
-        });
-        Ok((areas, maps, steps.iter().any(|s| s.edge_contact)))
+        let edge = steps.iter().any(|s| s.edge_contact);
+        let maps: Vec<Vec<f64>> = steps
+            .iter()
+            .map(|s| {
+                s.solution
+                    .pressure
+                    .iter()
+                    .map(|&p| f64::from(u8::from(p > 0.0)))
+                    .collect()
+            })
+            .collect();
+        let areas = match &self.imaging {
+            Some(imaging) => imaging.areas(&maps, &self.body)?,
+            None => steps.iter().map(|s| s.area_m2).collect(),
+        };
+        Ok((areas, keep_maps.then_some(maps), edge))
     }
 
     fn evaluate_gt(&self, loads_n: &[f64], keep_maps: bool) -> Result<ModelAreas> {
@@ -246,9 +288,10 @@ impl ModelBody {
             let profile = gt_profile(&params, force)?;
             let map = gt_bearing_area(&self.roughness, &profile, None)?;
             areas.push(map.area_m2);
-            if keep_maps {
-                maps.push(map.mask.iter().map(|&m| f64::from(u8::from(m))).collect());
-            }
+            maps.push(map.mask.iter().map(|&m| f64::from(u8::from(m))).collect());
+        }
+        if let Some(imaging) = &self.imaging {
+            areas = imaging.areas(&maps, &self.roughness)?;
         }
         Ok((areas, keep_maps.then_some(maps), false))
     }
