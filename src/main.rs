@@ -609,12 +609,7 @@ fn analyze(args: AnalyzeArgs) -> Result<()> {
     };
     let options = AnalysisOptions {
         method: Method::parse(&args.threshold)?,
-        pixel_size_override: args
-            .pixel_size
-            .as_deref()
-            .map(units::parse_pixel_size)
-            .transpose()
-            .context("--pixel-size")?,
+        pixel_size_override: optional_pixel_size(&args.pixel_size, "--pixel-size")?,
         hertz,
         memory_budget: args.memory_mib << 20,
     };
@@ -869,6 +864,19 @@ fn detrend_of(arg: DetrendArg) -> Detrend {
     }
 }
 
+fn optional_pixel_size(text: &Option<String>, flag: &str) -> Result<Option<(f64, f64)>> {
+    text.as_deref()
+        .map(units::parse_pixel_size)
+        .transpose()
+        .with_context(|| flag.to_string())
+}
+
+fn print_warnings(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("contactscope: warning: {w}");
+    }
+}
+
 fn optional_length(text: &Option<String>, flag: &str) -> Result<Option<f64>> {
     text.as_deref()
         .map(|t| units::parse_positive(t, Dimension::Length).with_context(|| flag.to_string()))
@@ -920,13 +928,7 @@ fn simulate(args: SimulateArgs) -> Result<()> {
     }
     let request = SimulateRequest {
         topography: args.input.path.clone(),
-        pixel_size_m: args
-            .input
-            .pixel_size
-            .as_deref()
-            .map(units::parse_pixel_size)
-            .transpose()
-            .context("--pixel-size")?,
+        pixel_size_m: optional_pixel_size(&args.input.pixel_size, "--pixel-size")?,
         height_unit_m: optional_length(&args.input.height_unit, "--height-unit")?,
         detrend: detrend_of(args.input.detrend),
         radius_m: optional_length(&args.radius, "--radius")?,
@@ -959,9 +961,7 @@ fn simulate(args: SimulateArgs) -> Result<()> {
     );
     bar.finish_and_clear();
     let outcome = outcome?;
-    for w in &outcome.warnings {
-        eprintln!("contactscope: warning: {w}");
-    }
+    print_warnings(&outcome.warnings);
     println!(
         "topography: h_rms = {:.4} nm, h'_rms = {:.5}, h''_rms = {:.5} 1/µm",
         outcome.stats.h_rms_m * 1e9,
@@ -1036,11 +1036,7 @@ fn surface(args: SurfaceArgs) -> Result<()> {
 fn topography(args: TopographyArgs) -> Result<()> {
     let mut topo = read_topography(
         &args.file,
-        args.pixel_size
-            .as_deref()
-            .map(units::parse_pixel_size)
-            .transpose()
-            .context("--pixel-size")?,
+        optional_pixel_size(&args.pixel_size, "--pixel-size")?,
         optional_length(&args.height_unit, "--height-unit")?,
     )?;
     topo.detrend(detrend_of(args.detrend));
@@ -1094,20 +1090,13 @@ fn autocorr(args: AutocorrArgs) -> Result<()> {
     let request = AutocorrRequest {
         inputs: args.inputs.clone(),
         channel: args.channel,
-        pixel_size_m: args
-            .pixel_size
-            .as_deref()
-            .map(units::parse_pixel_size)
-            .transpose()
-            .context("--pixel-size")?,
+        pixel_size_m: optional_pixel_size(&args.pixel_size, "--pixel-size")?,
         max_lag_m: optional_length(&args.max_lag, "--max-lag")?,
         out_dir: args.out.clone(),
         command_line: std::env::args().collect(),
     };
     let outcome = run_autocorr(&request)?;
-    for w in &outcome.warnings {
-        eprintln!("contactscope: warning: {w}");
-    }
+    print_warnings(&outcome.warnings);
     let um = |m: Option<f64>| m.map_or("—".to_string(), |v| format!("{:.3}", v * 1e6));
     println!("{:>12} {:>14}  image", "ξ_1/e (µm)", "first zero (µm)");
     for c in &outcome.curves {
@@ -1167,12 +1156,7 @@ fn compare(args: CompareArgs) -> Result<()> {
     let request = CompareRequest {
         experiment,
         channel: args.channel,
-        pixel_size_m: args
-            .pixel_size
-            .as_deref()
-            .map(units::parse_pixel_size)
-            .transpose()
-            .context("--pixel-size")?,
+        pixel_size_m: optional_pixel_size(&args.pixel_size, "--pixel-size")?,
         simulation: args.simulation.clone(),
         settings: CompareSettings {
             psf_fwhm_m,
@@ -1184,9 +1168,7 @@ fn compare(args: CompareArgs) -> Result<()> {
         command_line: std::env::args().collect(),
     };
     let outcome = comparison::run_compare(&request)?;
-    for w in &outcome.warnings {
-        eprintln!("contactscope: warning: {w}");
-    }
+    print_warnings(&outcome.warnings);
     println!(
         "thresholds: experiment {:.1}, simulation {:.4} (blurred contact fraction)",
         outcome.thresholds.0, outcome.thresholds.1
@@ -1219,12 +1201,7 @@ fn newton(args: NewtonArgs) -> Result<()> {
     let request = NewtonRequest {
         reflection: args.reflection,
         fluorescence: args.contact,
-        pixel_size_m: args
-            .pixel_size
-            .as_deref()
-            .map(units::parse_pixel_size)
-            .transpose()
-            .context("--pixel-size")?,
+        pixel_size_m: optional_pixel_size(&args.pixel_size, "--pixel-size")?,
         options: NewtonOptions {
             wavelength_m: units::parse_positive(&args.wavelength, Dimension::Length)
                 .context("--wavelength")?,
@@ -1273,12 +1250,7 @@ fn psf(args: PsfArgs) -> Result<()> {
     let request = PsfRequest {
         input: args.input.clone(),
         channel: args.channel,
-        pixel_size_m: args
-            .pixel_size
-            .as_deref()
-            .map(units::parse_pixel_size)
-            .transpose()
-            .context("--pixel-size")?,
+        pixel_size_m: optional_pixel_size(&args.pixel_size, "--pixel-size")?,
         bead_diameter_m: optional_length(&args.bead_diameter, "--bead-diameter")?,
         out_dir: args.out.clone(),
         command_line: std::env::args().collect(),
@@ -1362,12 +1334,7 @@ fn sweep_micrographs(args: &FitArgs) -> Result<Option<SweepMicrographs>> {
     Ok(Some(SweepMicrographs {
         experiment: ExperimentInput::Manifest(path.clone()),
         channel: None,
-        pixel_size_m: args
-            .micrograph_pixel_size
-            .as_deref()
-            .map(units::parse_pixel_size)
-            .transpose()
-            .context("--micrograph-pixel-size")?,
+        pixel_size_m: optional_pixel_size(&args.micrograph_pixel_size, "--micrograph-pixel-size")?,
         settings: CompareSettings {
             psf_fwhm_m: units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
             dihedral: false,
@@ -1409,13 +1376,7 @@ fn fit_hardening(args: FitArgs) -> Result<()> {
     let request = FitRequest {
         experiment: args.experiment.clone(),
         topography: args.input.path.clone(),
-        pixel_size_m: args
-            .input
-            .pixel_size
-            .as_deref()
-            .map(units::parse_pixel_size)
-            .transpose()
-            .context("--pixel-size")?,
+        pixel_size_m: optional_pixel_size(&args.input.pixel_size, "--pixel-size")?,
         height_unit_m: optional_length(&args.input.height_unit, "--height-unit")?,
         detrend: detrend_of(args.input.detrend),
         radius_m: optional_length(&args.radius, "--radius")?,
@@ -1436,9 +1397,7 @@ fn fit_hardening(args: FitArgs) -> Result<()> {
         command_line: std::env::args().collect(),
     };
     let outcome = fit_job::run_fit(&request)?;
-    for w in &outcome.warnings {
-        eprintln!("contactscope: warning: {w}");
-    }
+    print_warnings(&outcome.warnings);
     println!("{:>10} {:>22} {:>10}", "model", "parameter", "misfit");
     for fit in &outcome.fits {
         let parameter = match (fit.family, fit.best.parameter) {
@@ -1496,9 +1455,7 @@ fn friction_cmd(args: FrictionArgs) -> Result<()> {
         command_line: std::env::args().collect(),
     };
     let outcome = friction::run_friction(&request)?;
-    for w in &outcome.warnings {
-        eprintln!("contactscope: warning: {w}");
-    }
+    print_warnings(&outcome.warnings);
     println!(
         "{:>9} {:>9} {:>9} {:>12} {:>7} {:>7}  file",
         "N_mN", "F_s_mN", "F_k_mN", "slip_at", "μ_s", "μ_k"
