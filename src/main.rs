@@ -26,7 +26,7 @@ use contactscope::stack::series::{self, Series};
 use contactscope::stack::tiff::TiffReader;
 use contactscope::stack::write::Compression;
 use contactscope::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
-use contactscope::surface::io::{read_topography, write_gsf, write_npy};
+use contactscope::surface::io::{read_topography, write_gsf, write_npy, TopographySource};
 use contactscope::surface::stats::SurfaceStats;
 use contactscope::surface::Detrend;
 use contactscope::synth::{self, Layout, SynthParams};
@@ -864,6 +864,15 @@ fn detrend_of(arg: DetrendArg) -> Detrend {
     }
 }
 
+fn topography_source(input: &TopographyInput) -> Result<TopographySource> {
+    Ok(TopographySource {
+        path: input.path.clone(),
+        pixel_size_m: optional_pixel_size(&input.pixel_size, "--pixel-size")?,
+        height_unit_m: optional_length(&input.height_unit, "--height-unit")?,
+        detrend: detrend_of(input.detrend),
+    })
+}
+
 fn optional_pixel_size(text: &Option<String>, flag: &str) -> Result<Option<(f64, f64)>> {
     text.as_deref()
         .map(units::parse_pixel_size)
@@ -927,10 +936,7 @@ fn simulate(args: SimulateArgs) -> Result<()> {
         bail!("--hardening applies to --model hardening only");
     }
     let request = SimulateRequest {
-        topography: args.input.path.clone(),
-        pixel_size_m: optional_pixel_size(&args.input.pixel_size, "--pixel-size")?,
-        height_unit_m: optional_length(&args.input.height_unit, "--height-unit")?,
-        detrend: detrend_of(args.input.detrend),
+        topography: topography_source(&args.input)?,
         radius_m: optional_length(&args.radius, "--radius")?,
         e_star_pa: units::parse_positive(&args.modulus, Dimension::Pressure)
             .context("--modulus")?,
@@ -1375,10 +1381,7 @@ fn fit_hardening(args: FitArgs) -> Result<()> {
     }
     let request = FitRequest {
         experiment: args.experiment.clone(),
-        topography: args.input.path.clone(),
-        pixel_size_m: optional_pixel_size(&args.input.pixel_size, "--pixel-size")?,
-        height_unit_m: optional_length(&args.input.height_unit, "--height-unit")?,
-        detrend: detrend_of(args.input.detrend),
+        topography: topography_source(&args.input)?,
         radius_m: optional_length(&args.radius, "--radius")?,
         e_star_pa: units::parse_positive(&args.modulus, Dimension::Pressure)
             .context("--modulus")?,

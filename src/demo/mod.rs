@@ -44,7 +44,7 @@ use crate::solver::simulate::{sweep, Model, Setup};
 use crate::stack::series;
 use crate::stack::write::encode_u16_stack;
 use crate::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
-use crate::surface::io::write_npy;
+use crate::surface::io::{write_npy, TopographySource};
 use crate::surface::Topography;
 use crate::synth::{render_micrograph, MicrographParams};
 use crate::threshold::Method;
@@ -582,10 +582,12 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
     };
     let outcome = run_fit(&FitRequest {
         experiment: work.join("analysis").join("areas.csv"),
-        topography: data.join("topography.npy"),
-        pixel_size_m: Some((p.sim_pixel_m, p.sim_pixel_m)),
-        height_unit_m: None,
-        detrend: crate::surface::Detrend::None,
+        topography: TopographySource {
+            path: data.join("topography.npy"),
+            pixel_size_m: Some((p.sim_pixel_m, p.sim_pixel_m)),
+            height_unit_m: None,
+            detrend: crate::surface::Detrend::None,
+        },
         radius_m: Some(p.radius_m),
         e_star_pa: p.e_star_pa,
         periodic: false,

@@ -14,9 +14,8 @@ use crate::optics::blur::Grid;
 use crate::output::Staging;
 use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::solver::cg::SolverOptions;
-use crate::surface::io::read_topography;
+use crate::surface::io::TopographySource;
 use crate::surface::stats::SurfaceStats;
-use crate::surface::Detrend;
 use crate::units::{self, Dimension};
 
 /// A parameter sweep: one family, explicit values (Pa or Pa/m).
@@ -82,14 +81,8 @@ pub struct SweepMicrographs {
 pub struct FitRequest {
     /// `areas.csv` of `analyze` (columns `force_mN`, `area_um2`).
     pub experiment: PathBuf,
-    /// Height map.
-    pub topography: PathBuf,
-    /// Pixel size override (x, y), m.
-    pub pixel_size_m: Option<(f64, f64)>,
-    /// Height unit override, m.
-    pub height_unit_m: Option<f64>,
-    /// Detrending.
-    pub detrend: Detrend,
+    /// Height map, read and detrended as stated.
+    pub topography: TopographySource,
     /// Sphere radius added to the map (and the GT sphere), m.
     pub radius_m: Option<f64>,
     /// Contact modulus E*, Pa.
@@ -260,12 +253,7 @@ pub fn read_measured(path: &Path) -> Result<Measured> {
 }
 
 fn model_body(request: &FitRequest) -> Result<ModelBody> {
-    let mut roughness = read_topography(
-        &request.topography,
-        request.pixel_size_m,
-        request.height_unit_m,
-    )?;
-    roughness.detrend(request.detrend);
+    let roughness = request.topography.read()?;
     let stats = SurfaceStats::finite_differences(&roughness)?;
     let mut body = roughness.clone();
     if let Some(r) = request.radius_m {
@@ -389,7 +377,7 @@ fn dice_per_load(
 }
 
 fn inputs(request: &FitRequest) -> Vec<PathBuf> {
-    vec![request.experiment.clone(), request.topography.clone()]
+    vec![request.experiment.clone(), request.topography.path.clone()]
 }
 
 /// Parameter in display units: MPa for hardness, MPa/nm for hardening.
@@ -612,7 +600,7 @@ fn summary_json(
         "contactscope_version": env!("CARGO_PKG_VERSION"),
         "command_line": request.command_line,
         "experiment": request.experiment.display().to_string(),
-        "topography": request.topography.display().to_string(),
+        "topography": request.topography.path.display().to_string(),
         "radius_um": request.radius_m.map(|r| r * 1e6),
         "contact_modulus_GPa": request.e_star_pa * 1e-9,
         "roughness": {

@@ -12,9 +12,9 @@ use crate::measure::patches::count_patches;
 use crate::output::Staging;
 use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::stack::write::encode_f32_stack;
-use crate::surface::io::read_topography;
+use crate::surface::io::TopographySource;
 use crate::surface::stats::SurfaceStats;
-use crate::surface::{Detrend, Topography};
+use crate::surface::Topography;
 
 use super::cg::{Monitor, SolverOptions};
 use super::gt::{gt_bearing_area, gt_profile, GtParams};
@@ -43,14 +43,8 @@ impl ModelChoice {
 /// Everything `simulate` needs, already validated by the caller.
 #[derive(Debug, Clone)]
 pub struct SimulateRequest {
-    /// Height map file.
-    pub topography: PathBuf,
-    /// Pixel size override (x, y), m.
-    pub pixel_size_m: Option<(f64, f64)>,
-    /// Height unit override, m per file unit.
-    pub height_unit_m: Option<f64>,
-    /// Detrending applied to the map before anything else.
-    pub detrend: Detrend,
+    /// Height map, read and detrended as stated.
+    pub topography: TopographySource,
     /// Sphere radius to add to a flattened map (and the GT sphere), m.
     pub radius_m: Option<f64>,
     /// Contact modulus E*, Pa.
@@ -118,14 +112,12 @@ pub fn run_simulate(
     progress: SimulateProgress,
     monitor: Option<Monitor>,
 ) -> Result<SimulateOutcome> {
-    let mut roughness = read_topography(
-        &request.topography,
-        request.pixel_size_m,
-        request.height_unit_m,
-    )?;
-    roughness.detrend(request.detrend);
+    let roughness = request.topography.read()?;
     let stats = SurfaceStats::finite_differences(&roughness)?;
-    let staging = Staging::new(&request.out_dir, std::slice::from_ref(&request.topography))?;
+    let staging = Staging::new(
+        &request.out_dir,
+        std::slice::from_ref(&request.topography.path),
+    )?;
     let (loads, warnings) = match request.model {
         ModelChoice::GreenwoodTripp => run_gt(request, &roughness, &stats, &staging, progress)?,
         ModelChoice::HalfSpace(model) => {
@@ -441,12 +433,12 @@ fn summary_json(
         "contactscope_version": env!("CARGO_PKG_VERSION"),
         "command_line": request.command_line,
         "topography": {
-            "path": request.topography.display().to_string(),
+            "path": request.topography.path.display().to_string(),
             "nx": roughness.nx(),
             "ny": roughness.ny(),
             "pixel_size_x_nm": roughness.dx_m * 1e9,
             "pixel_size_y_nm": roughness.dy_m * 1e9,
-            "detrend": request.detrend.name(),
+            "detrend": request.topography.detrend.name(),
             "h_rms_nm": stats.h_rms_m * 1e9,
             "h_prime_rms": stats.h_prime_rms,
             "h_double_prime_rms_per_um": stats.h_double_prime_rms_per_m * 1e-6,

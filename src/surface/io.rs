@@ -23,7 +23,7 @@ mod npy;
 mod text;
 mod wsxm;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use ndarray::Array2;
 
@@ -32,7 +32,7 @@ use crate::stack::metadata::length_unit_factor;
 use crate::stack::tiff::TiffReader;
 use crate::stack::{SampleType, Samples};
 
-use super::Topography;
+use super::{Detrend, Topography};
 
 pub use gsf::{read_gsf, write_gsf};
 pub use nanoscope::read_nanoscope;
@@ -44,6 +44,28 @@ pub use wsxm::read_wsxm;
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "npy", "tif", "tiff", "gsf", "txt", "csv", "dat", "top", "di", "spm", "001",
 ];
+
+/// A height-map file with how to read and level it: what `simulate` and `fit-hardening` take.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopographySource {
+    /// The file.
+    pub path: PathBuf,
+    /// Pixel size override (x, y), m.
+    pub pixel_size_m: Option<(f64, f64)>,
+    /// Height unit override, m per stored unit.
+    pub height_unit_m: Option<f64>,
+    /// Detrending applied after reading.
+    pub detrend: Detrend,
+}
+
+impl TopographySource {
+    /// Read the file ([`read_topography`]) and detrend it.
+    pub fn read(&self) -> Result<Topography> {
+        let mut topography = read_topography(&self.path, self.pixel_size_m, self.height_unit_m)?;
+        topography.detrend(self.detrend);
+        Ok(topography)
+    }
+}
 
 /// Read a height map, choosing the reader by the file extension (table in the module docs).
 /// `pixel_size_m` = (x, y) in metres overrides the file's; `height_unit_m` gives metres per
