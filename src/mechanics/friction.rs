@@ -991,7 +991,7 @@ fn write_outputs(request: &FrictionRequest, outcome: &FrictionOutcome) -> Result
     staging.write("summary.json", text.as_bytes())?;
     staging.write(
         "friction_vs_load.png",
-        &load_chart(&outcome.traces).to_png()?,
+        &load_chart(&outcome.traces, outcome.shear.as_ref()).to_png()?,
     )?;
     staging.write("mu_vs_load.png", &mu_chart(&outcome.traces).to_png()?)?;
     if let Some(fit) = &outcome.shear {
@@ -1147,7 +1147,9 @@ fn summary_json(request: &FrictionRequest, outcome: &FrictionOutcome) -> Value {
     })
 }
 
-fn load_chart(traces: &[TraceResult]) -> Chart {
+/// Friction against normal force (Fig. 3b of the paper), with τ·A at each load's measured area
+/// when τ was fitted.
+fn load_chart(traces: &[TraceResult], shear: Option<&ShearFit>) -> Chart {
     let pts = |f: fn(&Slip) -> f64| {
         traces
             .iter()
@@ -1170,7 +1172,26 @@ fn load_chart(traces: &[TraceResult]) -> Chart {
                 xy: pts(|s| s.kinetic_friction_n),
             },
         ],
-        curves: Vec::new(),
+        curves: shear
+            .map(|fit| tau_area_curve(traces, fit))
+            .into_iter()
+            .collect(),
+    }
+}
+
+/// τ·A at the traces' areas, in order of normal force.
+fn tau_area_curve(traces: &[TraceResult], fit: &ShearFit) -> Curve {
+    let mut xy: Vec<(f64, f64)> = traces
+        .iter()
+        .filter_map(|t| {
+            t.area_m2
+                .map(|a| (t.normal_force_n * 1e3, fit.tau_pa * a * 1e3))
+        })
+        .collect();
+    xy.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Curve {
+        label: format!("τ·A, τ = {:.1} MPa", fit.tau_pa * 1e-6),
+        xy,
     }
 }
 
