@@ -259,6 +259,7 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
         comparisons: &comparisons,
         measured: &measured,
         truth_areas_m2: &truth.areas_m2,
+        fits: &fit.fits,
     };
     html::write_report(work, &facts)?;
     Ok(DemoOutcome {
@@ -570,6 +571,7 @@ fn friction(
 /// The fitted parameters of the demo's model fit.
 struct FitResult {
     k: Recovered,
+    fits: Vec<crate::fitting::ModelFit>,
     k_pa_per_m: f64,
     hardness_pa: f64,
 }
@@ -627,6 +629,7 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
         },
         k_pa_per_m: k,
         hardness_pa: hardness,
+        fits: outcome.fits.clone(),
     })
 }
 
