@@ -26,7 +26,7 @@ use crate::compare::{
 };
 use crate::error::{Error, Result};
 use crate::fitting::job::{run_fit, FitRequest};
-use crate::fitting::{Family, Imaging, Search};
+use crate::fitting::{Family, Imaging, ModelBody, Search};
 use crate::mechanics::friction::{
     self, CsvLayout, FrictionRequest, SlipOptions, TraceParams, XAxis,
 };
@@ -651,20 +651,12 @@ fn compare_models(
         upsample: 20,
         force_tolerance: 0.01,
     };
-    let body = crate::fitting::ModelBody {
-        roughness: roughness.clone(),
-        body: {
-            let mut b = roughness.clone();
-            b.add_sphere(p.radius_m)?;
-            b
-        },
-        stats: crate::surface::stats::SurfaceStats::finite_differences(roughness)?,
-        radius_m: Some(p.radius_m),
-        e_star_pa: p.e_star_pa,
-        periodic: false,
-        options: solver_options(),
-        imaging: None,
-    };
+    let body = ModelBody::new(
+        roughness.clone(),
+        Some(p.radius_m),
+        p.e_star_pa,
+        solver_options(),
+    )?;
     let models = [
         ("Greenwood–Tripp", Family::GreenwoodTripp, None),
         ("elastic", Family::Elastic, None),

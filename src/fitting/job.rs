@@ -253,22 +253,15 @@ pub fn read_measured(path: &Path) -> Result<Measured> {
 }
 
 fn model_body(request: &FitRequest) -> Result<ModelBody> {
-    let roughness = request.topography.read()?;
-    let stats = SurfaceStats::finite_differences(&roughness)?;
-    let mut body = roughness.clone();
-    if let Some(r) = request.radius_m {
-        body.add_sphere(r)?;
-    }
-    Ok(ModelBody {
-        roughness,
-        body,
-        stats,
-        radius_m: request.radius_m,
-        e_star_pa: request.e_star_pa,
-        periodic: request.periodic,
-        options: request.options,
-        imaging: request.imaging,
-    })
+    let mut body = ModelBody::new(
+        request.topography.read()?,
+        request.radius_m,
+        request.e_star_pa,
+        request.options,
+    )?;
+    body.periodic = request.periodic;
+    body.imaging = request.imaging;
+    Ok(body)
 }
 
 fn fit_family(

@@ -215,6 +215,31 @@ impl Measured {
 }
 
 impl ModelBody {
+    /// A free-boundary body from detrended roughness: the sphere (if any) is added for the
+    /// half-space models, the statistics feed GT; raw g = 0 areas (set `imaging` to change).
+    pub fn new(
+        roughness: Topography,
+        radius_m: Option<f64>,
+        e_star_pa: f64,
+        options: SolverOptions<'static>,
+    ) -> Result<Self> {
+        let stats = SurfaceStats::finite_differences(&roughness)?;
+        let mut body = roughness.clone();
+        if let Some(r) = radius_m {
+            body.add_sphere(r)?;
+        }
+        Ok(ModelBody {
+            roughness,
+            body,
+            stats,
+            radius_m,
+            e_star_pa,
+            periodic: false,
+            options,
+            imaging: None,
+        })
+    }
+
     /// Contact areas (and maps when `keep_maps`) at `loads_n` (increasing) for one model.
     pub fn evaluate(
         &self,
