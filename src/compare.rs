@@ -18,6 +18,7 @@ use serde_json::{json, Value};
 
 use crate::analysis::global_threshold;
 use crate::error::{Error, Location, Result};
+use crate::measure::distance::squared_distance;
 use crate::optics::blur::{microscope_image, Grid, IntensityScale};
 use crate::output::Staging;
 use crate::plot::edge_panels_png;
@@ -146,6 +147,9 @@ pub struct LoadComparison {
     pub jaccard: f64,
     /// Dice with the experiment's threshold lowered and raised by 10 %.
     pub dice_threshold_pm10: (f64, f64),
+    /// Mean distance between the two contact edges (symmetric: the average of the mean distance
+    /// from each edge pixel of one map to the nearest edge pixel of the other), m.
+    pub edge_distance_m: Option<f64>,
     /// RMS difference of the radially averaged autocorrelations over common lags.
     pub acf_rms_distance: Option<f64>,
     /// Correlation lengths ξ_1/e of experiment and simulation, m.
@@ -544,6 +548,53 @@ fn overlap(p: &Prepared, t_exp: f64, t_sim: f64) -> (usize, usize, usize) {
     counts
 }
 
+/// Contact pixels of a thresholded image inside the compared region.
+fn contact_in_region(img: &[f64], footprint: &[bool], t: f64) -> Vec<bool> {
+    img.iter()
+        .zip(footprint)
+        .map(|(&v, &inside)| inside && v > t)
+        .collect()
+}
+
+/// Contact pixels with a non-contact 4-neighbour inside the image.
+fn edges(mask: &[bool], (w, h): (usize, usize)) -> Vec<bool> {
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            mask[i]
+                && ((x > 0 && !mask[i - 1])
+                    || (x + 1 < w && !mask[i + 1])
+                    || (y > 0 && !mask[i - w])
+                    || (y + 1 < h && !mask[i + w]))
+        })
+        .collect()
+}
+
+/// Symmetric mean distance between the contact edges of experiment and simulation (m), `None`
+/// if either has no edge.
+fn edge_distance(p: &Prepared, t_exp: f64, t_sim: f64, pixel: (f64, f64)) -> Option<f64> {
+    let a = edges(
+        &contact_in_region(&p.experiment, &p.footprint, t_exp),
+        p.size,
+    );
+    let b = edges(
+        &contact_in_region(&p.simulated, &p.footprint, t_sim),
+        p.size,
+    );
+    let mean_to = |from: &[bool], to: &[bool]| -> Option<f64> {
+        let d2 = squared_distance(to, p.size.0, p.size.1, pixel);
+        let d: Vec<f64> = from
+            .iter()
+            .zip(&d2)
+            .filter(|(&e, _)| e)
+            .map(|(_, v)| v.sqrt())
+            .collect();
+        (!d.is_empty() && d.iter().all(|v| v.is_finite()))
+            .then(|| d.iter().sum::<f64>() / d.len() as f64)
+    };
+    Some(0.5 * (mean_to(&a, &b)? + mean_to(&b, &a)?))
+}
+
 /// Dice from (|A|, |B|, |A∩B|); 1 when both are empty (identical empty maps).
 fn dice((a, b, both): (usize, usize, usize)) -> f64 {
     if a + b == 0 {
@@ -602,6 +653,7 @@ fn score(p: &Prepared, t_exp: f64, t_sim: f64, pixel: (f64, f64)) -> Result<Load
             dice(overlap(p, 0.9 * t_exp, t_sim)),
             dice(overlap(p, 1.1 * t_exp, t_sim)),
         ),
+        edge_distance_m: edge_distance(p, t_exp, t_sim, pixel),
         acf_rms_distance: acf_exp
             .as_ref()
             .zip(acf_sim.as_ref())
@@ -644,6 +696,7 @@ fn compare_csv(loads: &[LoadComparison], pixel: (f64, f64)) -> Result<String> {
         "jaccard",
         "dice_threshold_minus10pct",
         "dice_threshold_plus10pct",
+        "edge_distance_um",
         "acf_rms_distance",
         "experiment_xi_1e_um",
         "simulated_xi_1e_um",
@@ -672,6 +725,7 @@ fn compare_csv(loads: &[LoadComparison], pixel: (f64, f64)) -> Result<String> {
             format!("{:.5}", l.jaccard),
             format!("{:.5}", l.dice_threshold_pm10.0),
             format!("{:.5}", l.dice_threshold_pm10.1),
+            opt(l.edge_distance_m.map(|d| d * 1e6)),
             opt(l.acf_rms_distance),
             opt(l.xi_1e_m.0.map(|v| v * 1e6)),
             opt(l.xi_1e_m.1.map(|v| v * 1e6)),
@@ -718,6 +772,7 @@ fn summary_json(
                 "simulated_raw_area_um2": l.simulated_raw_area_m2 * 1e12,
                 "dice": l.dice,
                 "jaccard": l.jaccard,
+                "edge_distance_um": l.edge_distance_m.map(|d| d * 1e6),
                 "acf_rms_distance": l.acf_rms_distance,
             })
         })
@@ -743,9 +798,58 @@ fn summary_json(
             "registration": "phase correlation with Hann window, upsampled-DFT sub-pixel refinement",
             "thresholds": "experiment: exact Otsu over all micrographs of the series; simulation: Otsu over all blurred simulated images (4096 bins)",
             "scores": "on the region covered by the simulation after registration",
+            "edge_distance_um": "mean of the two mean distances from each contact-edge pixel to the other map's nearest edge pixel (exact Euclidean distance transform)",
             "acf_rms_distance": "RMS difference of the radially averaged intensity autocorrelations, lags up to half the smaller micrograph side",
         },
         "loads": per_load,
         "warnings": warnings,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bands(a: std::ops::Range<usize>, b: std::ops::Range<usize>) -> Prepared {
+        let (w, h) = (16, 6);
+        let band = |r: &std::ops::Range<usize>| -> Vec<f64> {
+            (0..w * h)
+                .map(|i| f64::from(u8::from(r.contains(&(i % w)))))
+                .collect()
+        };
+        Prepared {
+            force_n: 1.0,
+            simulated_force_n: 1.0,
+            source: "test".into(),
+            micrograph: (PathBuf::from("m.tif"), 0),
+            size: (w, h),
+            experiment: band(&a),
+            simulated: band(&b),
+            footprint: vec![true; w * h],
+            transform: Dihedral::IDENTITY,
+            shift: Shift {
+                dx: 0.0,
+                dy: 0.0,
+                peak: 1.0,
+            },
+            raw_area_m2: 0.0,
+        }
+    }
+
+    #[test]
+    fn edge_distance_of_shifted_bands_is_the_shift() {
+        // Full-height bands: the edges are the band's first and last columns only.
+        let p = bands(5..10, 7..12);
+        let d = edge_distance(&p, 0.5, 0.5, (0.5, 1.0)).unwrap();
+        assert!((d - 1.0).abs() < 1e-12, "{d}"); // 2 px × 0.5 m
+        let same = bands(5..10, 5..10);
+        assert_eq!(edge_distance(&same, 0.5, 0.5, (1.0, 1.0)), Some(0.0));
+        assert_eq!(
+            edge_distance(&bands(5..10, 0..0), 0.5, 0.5, (1.0, 1.0)),
+            None
+        );
+        let counts = overlap(&p, 0.5, 0.5);
+        assert_eq!(counts, (30, 30, 18));
+        assert!((dice(counts) - 0.6).abs() < 1e-12);
+    }
 }

@@ -150,6 +150,12 @@ fn recovers_the_offset_and_overlaps_the_simulation() {
             "load {i}: area ratio {ratio}"
         );
         assert!(col("acf_rms_distance")[i] < 0.1, "load {i}: ACF distance");
+        // Edges agree to about a micrograph pixel (200 nm).
+        let edge = col("edge_distance_um")[i];
+        assert!(
+            edge > 0.0 && edge < 0.3,
+            "load {i}: edge distance {edge} µm"
+        );
         assert!(out.join(format!("panel_{:03}.png", i + 1)).is_file());
     }
     assert!(rows

@@ -4,6 +4,7 @@
 //! Methods: Microscopy); the conversion to µm² happens in [`crate::analysis`], where the pixel
 //! size is known. Patches are 8-connected regions of contact pixels.
 
+pub mod distance;
 pub mod patches;
 
 use serde::Serialize;
