@@ -238,7 +238,7 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
     progress("hertz: squeeze test");
     recovered.push(hertz(work, &data, p)?);
     progress("friction: rheometer traces");
-    recovered.push(friction(work, &data, p, &truth, &measured)?);
+    recovered.push(friction(work, &data, p, &measured)?);
 
     progress("fit-hardening: all four models against the measured curve");
     let fit = fit(work, &data, p)?;
@@ -514,7 +514,6 @@ fn friction(
     work: &Path,
     data: &Path,
     p: &DemoParams,
-    _truth: &Truth,
     measured: &[(f64, f64)],
 ) -> Result<Recovered> {
     let dir = data.join("friction");
