@@ -336,7 +336,15 @@ fn fit_profile(result: &mut ProfileResult, o: &NewtonOptions) {
         return;
     };
     result.detection_gap_m = Some(fit.gap_at(edge));
-    if fit.rms_residual_m > o.max_rms_residual_m {
+    // a may not exceed the fluorescent edge; a fit that ends on that bound says nothing about
+    // the gap there (it would read 0 nm by construction).
+    if fit.contact_radius_m >= edge * (1.0 - 1e-3) {
+        result.skipped = Some(format!(
+            "the fitted contact radius {:.3} µm runs into the fluorescent edge {:.3} µm: the rings do not fix the gap at the edge",
+            fit.contact_radius_m * 1e6,
+            edge * 1e6
+        ));
+    } else if fit.rms_residual_m > o.max_rms_residual_m {
         result.skipped = Some(format!(
             "rms gap residual {:.1} nm exceeds {:.1} nm",
             fit.rms_residual_m * 1e9,
