@@ -398,3 +398,66 @@ fn no_profile_error(reflection: &Image, profiles: &[ProfileResult]) -> Error {
     };
     Error::bad_input(Location::file(&reflection.path), reason)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rings where the Hertz gap of a = 12 µm, R = 290 µm reaches the Eq. 1 gaps, both sides.
+    fn profile(edge_m: f64) -> ProfileResult {
+        let o = NewtonOptions::default();
+        let (a, big_r) = (12e-6, 290e-6);
+        let rings = (0..4u32)
+            .flat_map(|m| {
+                let d = ring_gap(m, o.wavelength_m, o.medium_index, o.phase);
+                let (mut lo, mut hi) = (a, 5.0 * a);
+                for _ in 0..200 {
+                    let mid = 0.5 * (lo + hi);
+                    if hertz_gap(mid, a, big_r) < d {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                [1i8, -1].map(|side| Ring {
+                    side,
+                    order: m,
+                    radius_m: lo,
+                    gap_m: d,
+                })
+            })
+            .collect();
+        ProfileResult {
+            index: 0,
+            angle_deg: 0.0,
+            edge_radius_sides_m: [Some(edge_m); 2],
+            rings,
+            fit: None,
+            shifted_fit: None,
+            detection_gap_m: None,
+            skipped: None,
+        }
+    }
+
+    #[test]
+    fn fit_recovers_the_gap_and_refuses_a_contact_radius_at_the_edge() {
+        let o = NewtonOptions::default();
+        let mut good = profile(12.7e-6);
+        fit_profile(&mut good, &o);
+        assert_eq!(good.skipped, None);
+        let expected = hertz_gap(12.7e-6, 12e-6, 290e-6);
+        let got = good.detection_gap_m.unwrap();
+        assert!((got - expected).abs() < 0.05e-9, "{got} vs {expected}");
+        assert!(good.shifted_residual_ratio().unwrap() > 5.0);
+
+        // An edge inside the true contact: a is bounded by the edge and the gap there is 0 by
+        // construction, so the profile must not be used.
+        let mut bounded = profile(10e-6);
+        fit_profile(&mut bounded, &o);
+        let reason = bounded.skipped.expect("skipped");
+        assert!(
+            reason.contains("runs into the fluorescent edge"),
+            "{reason}"
+        );
+    }
+}
