@@ -11,7 +11,7 @@ use rand_distr::{Distribution, Poisson};
 use serde_json::Value;
 
 use contactscope::optics::psf::{
-    fit_spot, measure_psf, synth_beads, BeadKind, BeadParams, Grid, PsfOptions, PsfReport,
+    fit_spot, measure_psf, synth_beads, BeadKind, BeadParams, PlaneView, PsfOptions, PsfReport,
     Sampling, SkipReason, SpotOptions, SyntheticBeads, FWHM_PER_SIGMA,
 };
 use contactscope::stack::image::Image;
@@ -31,7 +31,7 @@ fn b15_spot() -> Vec<f64> {
 }
 
 fn fit_b15(values: &[f64]) -> contactscope::optics::psf::SpotFit {
-    let grid = Grid {
+    let grid = PlaneView {
         values,
         width: SIZE,
         height: SIZE,

@@ -8,7 +8,7 @@ use super::lm::{self, LmOutcome, Problem};
 
 /// A plane as a borrowed row-major grid.
 #[derive(Debug, Clone, Copy)]
-pub struct Grid<'a> {
+pub struct PlaneView<'a> {
     /// Values, `height` rows of `width`.
     pub values: &'a [f64],
     /// Columns.
@@ -107,7 +107,7 @@ pub enum SpotFailure {
 
 /// Measure the spot near pixel (x, y) of `grid`.
 pub fn fit_spot(
-    grid: Grid,
+    grid: PlaneView,
     x: usize,
     y: usize,
     opts: &SpotOptions,
@@ -153,7 +153,7 @@ struct Window {
 }
 
 impl Window {
-    fn crop(grid: Grid, x: usize, y: usize, half: usize) -> Option<Window> {
+    fn crop(grid: PlaneView, x: usize, y: usize, half: usize) -> Option<Window> {
         if x < half || y < half || x + half >= grid.width || y + half >= grid.height {
             return None;
         }
@@ -427,7 +427,7 @@ mod tests {
     #[test]
     fn elliptical_spot_gives_both_sigmas() {
         let values = spot(41, (20.3, 19.6), (2.0, 3.0));
-        let grid = Grid {
+        let grid = PlaneView {
             values: &values,
             width: 41,
             height: 41,
@@ -455,7 +455,7 @@ mod tests {
     #[test]
     fn window_off_the_plane_is_at_edge() {
         let values = spot(21, (3.0, 10.0), (2.0, 2.0));
-        let grid = Grid {
+        let grid = PlaneView {
             values: &values,
             width: 21,
             height: 21,
@@ -469,7 +469,7 @@ mod tests {
     #[test]
     fn flat_window_has_no_signal() {
         let values = vec![5.0; 21 * 21];
-        let grid = Grid {
+        let grid = PlaneView {
             values: &values,
             width: 21,
             height: 21,

@@ -28,7 +28,7 @@ mod skip;
 mod synth;
 
 pub use detect::{detect, Candidate, DetectOptions, Detection};
-pub use fit::{fit_spot, Gauss2dFit, Grid, RadialFit, SpotFailure, SpotFit, SpotOptions};
+pub use fit::{fit_spot, Gauss2dFit, PlaneView, RadialFit, SpotFailure, SpotFit, SpotOptions};
 pub use report::{run_psf, PsfOutcome, PsfRequest};
 pub use skip::SkipReason;
 
@@ -290,7 +290,7 @@ fn measure_bead(
     opts: &PsfOptions,
 ) -> BeadMeasurement {
     let image = &images[c.plane];
-    let grid = Grid {
+    let grid = PlaneView {
         values: &image.values,
         width: image.width,
         height: image.height,
@@ -338,7 +338,7 @@ fn measure_bead(
     bead
 }
 
-fn raw_peak(grid: Grid, x: usize, y: usize) -> f64 {
+fn raw_peak(grid: PlaneView, x: usize, y: usize) -> f64 {
     let mut best = f64::NEG_INFINITY;
     for yy in y.saturating_sub(1)..=(y + 1).min(grid.height - 1) {
         for xx in x.saturating_sub(1)..=(x + 1).min(grid.width - 1) {

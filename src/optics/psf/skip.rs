@@ -1,6 +1,6 @@
 //! Why a bead candidate is not used (methods.md §7.3: isolated, unsaturated, in-focus beads only).
 
-use super::{Candidate, Grid, PsfOptions, SpotFit};
+use super::{Candidate, PlaneView, PsfOptions, SpotFit};
 
 /// Why a candidate does not enter the summary.
 #[derive(Debug, Clone, PartialEq)]
@@ -79,7 +79,7 @@ impl SkipReason {
 
 /// Skips that need no fit: edge, crowding, saturation, focus outside the stack.
 pub(super) fn pre_fit_skip(
-    grid: Grid,
+    grid: PlaneView,
     c: &Candidate,
     all: &[Candidate],
     half: usize,
@@ -112,7 +112,11 @@ pub(super) fn pre_fit_skip(
     None
 }
 
-fn window_pixels<'a>(grid: Grid<'a>, c: &Candidate, half: usize) -> impl Iterator<Item = f64> + 'a {
+fn window_pixels<'a>(
+    grid: PlaneView<'a>,
+    c: &Candidate,
+    half: usize,
+) -> impl Iterator<Item = f64> + 'a {
     let (x0, y0, side) = (c.x - half, c.y - half, 2 * half + 1);
     (y0..y0 + side).flat_map(move |y| {
         grid.values[y * grid.width + x0..y * grid.width + x0 + side]
