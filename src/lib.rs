@@ -70,6 +70,7 @@ pub mod report;
 pub mod solver;
 pub mod spectral;
 pub mod stack;
+pub mod stats;
 pub mod surface;
 pub mod synth;
 pub mod threshold;

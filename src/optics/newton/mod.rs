@@ -16,6 +16,7 @@ pub mod profile;
 mod report;
 pub mod synth;
 
+pub use crate::stats::MeanSd;
 pub use gap::{fit_hertz_gap, hertz_gap, ring_gap, GapFit, Phase};
 pub use report::{run_newton, NewtonOutcome, NewtonRequest};
 pub use synth::{synth_newton, NewtonSynth, NewtonSynthParams, NewtonTruth};
@@ -122,29 +123,6 @@ impl ProfileResult {
     }
 }
 
-/// Mean and sample standard deviation (`None` for fewer than two values).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Spread {
-    /// Mean.
-    pub mean: f64,
-    /// Sample standard deviation (n − 1).
-    pub sd: Option<f64>,
-}
-
-impl Spread {
-    /// Over `values`; `None` when empty.
-    pub fn of(values: &[f64]) -> Option<Spread> {
-        if values.is_empty() {
-            return None;
-        }
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let sd = (values.len() > 1)
-            .then(|| (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt());
-        Some(Spread { mean, sd })
-    }
-}
-
 /// Everything measured by [`analyse`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct NewtonAnalysis {
@@ -155,13 +133,13 @@ pub struct NewtonAnalysis {
     /// All profiles, used and skipped.
     pub profiles: Vec<ProfileResult>,
     /// Detection gap over the profiles used, m.
-    pub detection_gap_m: Spread,
+    pub detection_gap_m: MeanSd,
     /// Edge radius over the profiles used, m.
-    pub edge_radius_m: Spread,
+    pub edge_radius_m: MeanSd,
     /// Fitted contact radius a over the profiles used, m.
-    pub contact_radius_m: Spread,
+    pub contact_radius_m: MeanSd,
     /// Fitted sphere radius R over the profiles used, m.
-    pub sphere_radius_m: Spread,
+    pub sphere_radius_m: MeanSd,
 }
 
 impl NewtonAnalysis {
@@ -362,7 +340,7 @@ fn summarise(
 ) -> Result<NewtonAnalysis> {
     let used: Vec<&ProfileResult> = profiles.iter().filter(|p| p.skipped.is_none()).collect();
     let spread = |f: &dyn Fn(&ProfileResult) -> Option<f64>| {
-        Spread::of(&used.iter().filter_map(|p| f(p)).collect::<Vec<_>>())
+        MeanSd::of(&used.iter().filter_map(|p| f(p)).collect::<Vec<_>>())
     };
     let (Some(gap), Some(edge), Some(a), Some(r)) = (
         spread(&|p| p.detection_gap_m),

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use serde_json::{json, Value};
 
-use super::{analyse, hertz_gap, ring_gap, NewtonAnalysis, NewtonOptions, Spread};
+use super::{analyse, hertz_gap, ring_gap, MeanSd, NewtonAnalysis, NewtonOptions};
 use crate::error::{Error, Result};
 use crate::output::Staging;
 use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
@@ -62,7 +62,7 @@ fn um(v: Option<f64>) -> Option<f64> {
     v.map(|x| x * 1e6)
 }
 
-fn spread_json(s: &Spread, scale: f64) -> (f64, Option<f64>) {
+fn spread_json(s: &MeanSd, scale: f64) -> (f64, Option<f64>) {
     (s.mean * scale, s.sd.map(|sd| sd * scale))
 }
 

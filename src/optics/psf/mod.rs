@@ -32,6 +32,7 @@ pub use fit::{fit_spot, Gauss2dFit, PlaneView, RadialFit, SpotFailure, SpotFit, 
 pub use report::{run_psf, PsfOutcome, PsfRequest};
 pub use skip::SkipReason;
 
+pub use crate::stats::MeanSd;
 use skip::{implausible, pre_fit_skip};
 pub use synth::{synth_beads, BeadKind, BeadParams, BeadTruth, Sampling, SyntheticBeads};
 
@@ -95,34 +96,6 @@ pub struct BeadMeasurement {
     pub sigma_m: Option<f64>,
     /// Why it is not used; `None` for used beads.
     pub skip: Option<SkipReason>,
-}
-
-/// Mean and sample standard deviation (`None` for fewer than two values).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MeanSd {
-    /// Mean.
-    pub mean: f64,
-    /// Sample standard deviation (n − 1).
-    pub sd: Option<f64>,
-}
-
-impl MeanSd {
-    /// Of a non-empty list.
-    pub fn of(values: &[f64]) -> MeanSd {
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let sd = (values.len() >= 2)
-            .then(|| (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt());
-        MeanSd { mean, sd }
-    }
-
-    /// Both scaled (unit conversion).
-    pub fn scaled(self, k: f64) -> MeanSd {
-        MeanSd {
-            mean: self.mean * k,
-            sd: self.sd.map(|s| s * k),
-        }
-    }
 }
 
 /// Over the used beads, metres.
@@ -366,6 +339,7 @@ fn summarise(beads: &[BeadMeasurement], pixel_m: f64) -> Option<PsfSummary> {
     }
     let stats = |f: &dyn Fn(&BeadMeasurement) -> Option<f64>| {
         MeanSd::of(&used.iter().filter_map(|b| f(b)).collect::<Vec<_>>())
+            .unwrap_or(MeanSd::UNDEFINED)
     };
     Some(PsfSummary {
         beads_used: used.len(),
@@ -420,8 +394,5 @@ mod tests {
         assert!((s * s - (191e-9f64.powi(2) - 500e-18)).abs() < 1e-24);
         assert_eq!(corrected_sigma(10e-9, Some(100e-9)), None);
         assert_eq!(corrected_sigma(5.0, None), Some(5.0));
-        let m = MeanSd::of(&[1.0, 2.0, 3.0]);
-        assert_eq!((m.mean, m.sd), (2.0, Some(1.0)));
-        assert_eq!(MeanSd::of(&[4.0]).sd, None);
     }
 }
