@@ -880,6 +880,10 @@ fn optional_pixel_size(text: &Option<String>, flag: &str) -> Result<Option<(f64,
         .with_context(|| flag.to_string())
 }
 
+fn print_written(files: usize, out: &Path) {
+    println!("wrote {files} files to {}", out.display());
+}
+
 fn print_warnings(warnings: &[String]) {
     for w in warnings {
         eprintln!("contactscope: warning: {w}");
@@ -989,11 +993,7 @@ fn simulate(args: SimulateArgs) -> Result<()> {
             l.iterations
         );
     }
-    println!(
-        "wrote {} files to {}",
-        outcome.written.len(),
-        args.out.display()
-    );
+    print_written(outcome.written.len(), &args.out);
     Ok(())
 }
 
@@ -1113,11 +1113,7 @@ fn autocorr(args: AutocorrArgs) -> Result<()> {
             c.label
         );
     }
-    println!(
-        "wrote {} files to {}",
-        outcome.written.len(),
-        args.out.display()
-    );
+    print_written(outcome.written.len(), &args.out);
     Ok(())
 }
 
@@ -1195,11 +1191,7 @@ fn compare(args: CompareArgs) -> Result<()> {
             l.correlation_peak
         );
     }
-    println!(
-        "wrote {} files to {}",
-        outcome.written.len(),
-        args.out.display()
-    );
+    print_written(outcome.written.len(), &args.out);
     Ok(())
 }
 
@@ -1428,11 +1420,7 @@ fn fit_hardening(args: FitArgs) -> Result<()> {
     if let Some(best) = outcome.best() {
         println!("best model: {}", best.family.name());
     }
-    println!(
-        "wrote {} files to {}",
-        outcome.written.len(),
-        args.out.display()
-    );
+    print_written(outcome.written.len(), &args.out);
     Ok(())
 }
 
@@ -1499,11 +1487,7 @@ fn friction_cmd(args: FrictionArgs) -> Result<()> {
             m.relative_spread * 100.0
         );
     }
-    println!(
-        "wrote {} files to {}",
-        outcome.written.len(),
-        args.out.display()
-    );
+    print_written(outcome.written.len(), &args.out);
     Ok(())
 }
 
@@ -1541,10 +1525,6 @@ fn hertz_cmd(args: HertzArgs) -> Result<()> {
     for (p, a) in &outcome.predicted {
         println!("{:>10.3} {:>12.4}", p * 1e3, a * 1e6);
     }
-    println!(
-        "wrote {} files to {}",
-        outcome.written.len(),
-        args.out.display()
-    );
+    print_written(outcome.written.len(), &args.out);
     Ok(())
 }
