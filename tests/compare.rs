@@ -6,7 +6,7 @@ mod common;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use common::{column, read_csv, run, stderr};
+use common::{column, read_csv, rough_surface, run, stderr};
 use contactscope::optics::blur::Grid;
 use contactscope::spectral::register::Dihedral;
 use contactscope::stack::image::read_image;
@@ -23,26 +23,13 @@ const IMAGE_PX: usize = 96;
 /// A 256² rough sphere at 50 nm (12.8 µm) simulated elastically at three loads.
 fn simulation(dir: &Path) -> PathBuf {
     let topo = dir.join("rough.npy");
-    let o = run(&[
-        "surface",
-        "--size",
-        "256",
-        "--pixel-size",
+    rough_surface(
+        &topo,
+        256,
         "50nm",
-        "--hurst",
-        "0.8",
-        "--rms-slope",
-        "0.1",
-        "--rolloff",
-        "2um",
-        "--cutoff",
-        "200nm",
-        "--seed",
-        "4",
-        "--out",
-        s(&topo),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        4,
+        &["--rolloff", "2um", "--cutoff", "200nm"],
+    );
     let sim = dir.join("sim");
     let o = run(&[
         "simulate",

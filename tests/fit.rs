@@ -6,7 +6,7 @@ mod common;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use common::{column, read_csv, run, stderr};
+use common::{column, read_csv, rough_surface, run, stderr};
 use contactscope::optics::blur::Grid;
 use contactscope::stack::image::read_image;
 use contactscope::stack::write::encode_u16_stack;
@@ -23,26 +23,13 @@ const LOADS: &str = "0.05mN..0.4mN:4";
 /// "experiment": a hardening simulation at k = 4 MPa/nm.
 fn truth(dir: &Path) -> (PathBuf, PathBuf) {
     let topo = dir.join("rough.npy");
-    let o = run(&[
-        "surface",
-        "--size",
-        "80",
-        "--pixel-size",
+    rough_surface(
+        &topo,
+        80,
         "100nm",
-        "--hurst",
-        "0.8",
-        "--rms-slope",
-        "0.1",
-        "--rolloff",
-        "2um",
-        "--cutoff",
-        "300nm",
-        "--seed",
-        "5",
-        "--out",
-        s(&topo),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        5,
+        &["--rolloff", "2um", "--cutoff", "300nm"],
+    );
     let sim = dir.join("truth");
     let o = run(&[
         "simulate",
@@ -223,22 +210,7 @@ fn sweep_scores_dice_against_micrographs() {
 fn bad_inputs_fail_cleanly() {
     let dir = tempfile::tempdir().unwrap();
     let topo = dir.path().join("rough.npy");
-    let o = run(&[
-        "surface",
-        "--size",
-        "32",
-        "--pixel-size",
-        "100nm",
-        "--hurst",
-        "0.8",
-        "--rms-slope",
-        "0.1",
-        "--seed",
-        "1",
-        "--out",
-        s(&topo),
-    ]);
-    assert!(o.status.success());
+    rough_surface(&topo, 32, "100nm", 1, &[]);
     let out = dir.path().join("fit");
     let bad = dir.path().join("bad.csv");
     fs::write(&bad, "force_mN,area\n1,2\n2,3\n").unwrap();

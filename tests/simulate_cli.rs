@@ -5,7 +5,7 @@ mod common;
 use std::fs;
 use std::path::Path;
 
-use common::{column, read_csv, run, stderr, stdout};
+use common::{column, read_csv, rough_surface, run, stderr, stdout};
 use contactscope::stack::tiff::TiffReader;
 
 fn s(p: &Path) -> &str {
@@ -14,26 +14,13 @@ fn s(p: &Path) -> &str {
 
 fn make_surface(dir: &Path) -> std::path::PathBuf {
     let path = dir.join("rough.npy");
-    let o = run(&[
-        "surface",
-        "--size",
-        "128",
-        "--pixel-size",
+    rough_surface(
+        &path,
+        128,
         "32nm",
-        "--hurst",
-        "0.8",
-        "--rms-slope",
-        "0.1",
-        "--rolloff",
-        "1um",
-        "--cutoff",
-        "128nm",
-        "--seed",
-        "3",
-        "--out",
-        s(&path),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+        3,
+        &["--rolloff", "1um", "--cutoff", "128nm"],
+    );
     path
 }
 

@@ -36,6 +36,36 @@ pub fn run(args: &[&str]) -> Output {
         .expect("binary runs")
 }
 
+/// Run the binary and insist on success (stderr in the failure message).
+pub fn run_ok(args: &[&str]) -> Output {
+    let out = run(args);
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    out
+}
+
+/// `contactscope surface`: a self-affine map (H = 0.8, h'_rms = 0.1) of `size`² pixels of `pixel`
+/// written to `path`, with further options in `extra` (roll-off, cutoff).
+pub fn rough_surface(path: &Path, size: usize, pixel: &str, seed: u64, extra: &[&str]) {
+    let (size, seed) = (size.to_string(), seed.to_string());
+    let mut args = vec![
+        "surface",
+        "--size",
+        &size,
+        "--pixel-size",
+        pixel,
+        "--hurst",
+        "0.8",
+        "--rms-slope",
+        "0.1",
+        "--seed",
+        &seed,
+        "--out",
+        path.to_str().expect("UTF-8 path"),
+    ];
+    args.extend_from_slice(extra);
+    run_ok(&args);
+}
+
 /// Run in a directory.
 pub fn run_in(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_contactscope"))
