@@ -1,6 +1,8 @@
 //! Turning an [`Analysis`] into the table, the summary and the plot. No computation beyond unit
 //! conversion and the area–load fits lives here.
 
+use std::path::Path;
+
 use serde::Serialize;
 use serde_json::{json, Value};
 
@@ -8,6 +10,7 @@ use crate::analysis::{Analysis, HertzParams};
 use crate::error::{Error, Result};
 use crate::fit::{fit_power_law, fit_proportional, PowerLawFit};
 use crate::hertz;
+use crate::mechanics::table::Table;
 use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::stack::series::Series;
 
@@ -369,4 +372,29 @@ pub fn threshold_json(analysis: &Analysis, integer: bool) -> Value {
             format!("{} equal bins over the series' finite min..max; threshold = upper edge of the highest background bin", crate::threshold::FLOAT_BINS)
         },
     })
+}
+
+/// (force N, area m²) rows of an `analyze` areas.csv (columns `force_mN`, `area_um2`); a table
+/// in pixels is refused with a hint, as is one without rows.
+pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
+    let table = Table::read(path)?;
+    for column in ["force_mN", "area_um2"] {
+        if !table.header().iter().any(|h| h == column) {
+            let hint = if column == "area_um2" && table.header().iter().any(|h| h == "area_px") {
+                " (areas are in pixels: run analyze with --pixel-size)"
+            } else {
+                ""
+            };
+            return Err(Error::bad_input(
+                table.location(),
+                format!("no {column} column{hint}; columns found: {}", table.found()),
+            ));
+        }
+    }
+    let forces = table.numbers("force_mN", 1e-3)?;
+    let areas = table.numbers("area_um2", 1e-12)?;
+    if forces.is_empty() {
+        return Err(Error::bad_input(table.location(), "no rows"));
+    }
+    Ok(forces.into_iter().zip(areas).collect())
 }

@@ -13,6 +13,7 @@ use crate::error::{Error, Location, Result};
 use crate::optics::blur::Grid;
 use crate::output::Staging;
 use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::report::read_areas_csv;
 use crate::solver::cg::SolverOptions;
 use crate::surface::io::TopographySource;
 use crate::surface::stats::SurfaceStats;
@@ -211,45 +212,8 @@ pub fn run_fit(request: &FitRequest) -> Result<FitOutcome> {
 
 /// `force_mN` and `area_um2` of an `analyze` table (or any CSV with those columns).
 pub fn read_measured(path: &Path) -> Result<Measured> {
-    let at = Location::file(path);
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    let headers = reader
-        .headers()
-        .map_err(|e| Error::bad_input(at.clone(), format!("bad CSV header: {e}")))?
-        .clone();
-    let col = |name: &str| {
-        headers.iter().position(|h| h == name).ok_or_else(|| {
-            Error::bad_input(
-                at.clone(),
-                format!(
-                    "no {name} column (found: {}); expected the areas.csv of `contactscope analyze`",
-                    headers.iter().collect::<Vec<_>>().join(", ")
-                ),
-            )
-        })
-    };
-    let (f_col, a_col) = (col("force_mN")?, col("area_um2")?);
-    let mut points = Vec::new();
-    for (i, record) in reader.records().enumerate() {
-        let record =
-            record.map_err(|e| Error::bad_input(at.clone(), format!("row {}: {e}", i + 1)))?;
-        let number = |c: usize, name: &str| -> Result<f64> {
-            record
-                .get(c)
-                .and_then(|v| v.parse::<f64>().ok())
-                .ok_or_else(|| {
-                    Error::bad_input(at.clone(), format!("row {}: {name} is not a number", i + 1))
-                })
-        };
-        points.push((
-            number(f_col, "force_mN")? * 1e-3,
-            number(a_col, "area_um2")? * 1e-12,
-        ));
-    }
-    Measured::new(points).map_err(|e| Error::bad_input(at, e.to_string()))
+    Measured::new(read_areas_csv(path)?)
+        .map_err(|e| Error::bad_input(Location::file(path), e.to_string()))
 }
 
 fn model_body(request: &FitRequest) -> Result<ModelBody> {

@@ -45,6 +45,7 @@ use crate::error::{Error, Location, Result};
 use crate::fit::fit_power_law;
 use crate::output::Staging;
 use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::report::read_areas_csv;
 
 use super::table::Table;
 
@@ -829,7 +830,7 @@ pub fn run_friction(request: &FrictionRequest) -> Result<FrictionOutcome> {
         .map(|path| analyse_trace(path, request, &mut warnings))
         .collect::<Result<Vec<_>>>()?;
     if let Some(path) = &request.areas {
-        let areas = read_areas(path)?;
+        let areas = read_areas_csv(path)?;
         match_areas(&mut traces, &areas, request.force_tolerance, path)?;
     }
     let fit = |f: fn(&TraceResult) -> f64| {
@@ -914,30 +915,6 @@ fn analyse_trace(
         slip,
         area_m2: None,
     })
-}
-
-/// (force N, area m²) rows of an `analyze` areas.csv.
-fn read_areas(path: &Path) -> Result<Vec<(f64, f64)>> {
-    let table = Table::read(path)?;
-    for column in ["force_mN", "area_um2"] {
-        if !table.header().iter().any(|h| h == column) {
-            let hint = if column == "area_um2" && table.header().iter().any(|h| h == "area_px") {
-                " (areas are in pixels: run analyze with --pixel-size)"
-            } else {
-                ""
-            };
-            return Err(Error::bad_input(
-                table.location(),
-                format!("no {column} column{hint}; columns found: {}", table.found()),
-            ));
-        }
-    }
-    let forces = table.numbers("force_mN", 1e-3)?;
-    let areas = table.numbers("area_um2", 1e-12)?;
-    if forces.is_empty() {
-        return Err(Error::bad_input(table.location(), "no rows"));
-    }
-    Ok(forces.into_iter().zip(areas).collect())
 }
 
 /// Give each trace the area of the row with the nearest force, within `tolerance` (relative).

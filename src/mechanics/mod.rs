@@ -6,4 +6,4 @@
 pub mod friction;
 pub mod squeeze;
 
-mod table;
+pub(crate) mod table;
