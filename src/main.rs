@@ -137,13 +137,7 @@ struct FitArgs {
     #[arg(long)]
     experiment: PathBuf,
     #[command(flatten)]
-    input: TopographyInput,
-    /// Sphere radius added to a flattened map (and the GT sphere), e.g. 290um.
-    #[arg(long)]
-    radius: Option<String>,
-    /// Contact modulus E*, e.g. 3.7GPa.
-    #[arg(long)]
-    modulus: String,
+    body: BodyArgs,
     /// Models to fit or score, comma-separated.
     #[arg(long, default_value = "gt,elastic,hardness,hardening")]
     models: String,
@@ -318,8 +312,9 @@ struct TopographyInput {
     detrend: DetrendArg,
 }
 
+/// The rough sphere and its material, as `simulate` and `fit-hardening` take them.
 #[derive(clap::Args)]
-struct SimulateArgs {
+struct BodyArgs {
     #[command(flatten)]
     input: TopographyInput,
     /// Sphere radius added to a flattened map (and the GT sphere), e.g. 290um.
@@ -328,6 +323,12 @@ struct SimulateArgs {
     /// Contact modulus E*, e.g. 3.7GPa.
     #[arg(long)]
     modulus: String,
+}
+
+#[derive(clap::Args)]
+struct SimulateArgs {
+    #[command(flatten)]
+    body: BodyArgs,
     /// Contact model.
     #[arg(long, value_enum)]
     model: ModelArg,
@@ -940,9 +941,9 @@ fn simulate(args: SimulateArgs) -> Result<()> {
         bail!("--hardening applies to --model hardening only");
     }
     let request = SimulateRequest {
-        topography: topography_source(&args.input)?,
-        radius_m: optional_length(&args.radius, "--radius")?,
-        e_star_pa: units::parse_positive(&args.modulus, Dimension::Pressure)
+        topography: topography_source(&args.body.input)?,
+        radius_m: optional_length(&args.body.radius, "--radius")?,
+        e_star_pa: units::parse_positive(&args.body.modulus, Dimension::Pressure)
             .context("--modulus")?,
         model: model_of(&args)?,
         periodic: args.periodic,
@@ -1373,9 +1374,9 @@ fn fit_hardening(args: FitArgs) -> Result<()> {
     }
     let request = FitRequest {
         experiment: args.experiment.clone(),
-        topography: topography_source(&args.input)?,
-        radius_m: optional_length(&args.radius, "--radius")?,
-        e_star_pa: units::parse_positive(&args.modulus, Dimension::Pressure)
+        topography: topography_source(&args.body.input)?,
+        radius_m: optional_length(&args.body.radius, "--radius")?,
+        e_star_pa: units::parse_positive(&args.body.modulus, Dimension::Pressure)
             .context("--modulus")?,
         periodic: args.periodic,
         families,
