@@ -952,6 +952,7 @@ fn simulate(args: SimulateArgs) -> Result<()> {
             max_iterations: args.max_iterations,
             tolerance: args.tolerance,
             monitor: None,
+            ..SolverOptions::default()
         },
         out_dir: args.out.clone(),
         command_line: std::env::args().collect(),
@@ -1388,6 +1389,7 @@ fn fit_hardening(args: FitArgs) -> Result<()> {
             max_iterations: args.max_iterations,
             tolerance: args.tolerance,
             monitor: None,
+            ..SolverOptions::default()
         },
         out_dir: args.out.clone(),
         command_line: std::env::args().collect(),

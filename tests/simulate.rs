@@ -32,6 +32,7 @@ fn run(topo: &Topography, model: Model, loads: &[f64]) -> Vec<LoadStep> {
             max_iterations: 3000,
             tolerance: 1e-9,
             monitor: None,
+            ..SolverOptions::default()
         },
     };
     sweep(&setup, loads, &|_, _| {}).unwrap()

@@ -327,6 +327,7 @@ fn iteration_limit_is_a_typed_error() {
         max_iterations: 3,
         tolerance: 1e-12,
         monitor: None,
+        ..SolverOptions::default()
     };
     match solve_load(&problem, 15.0, &options) {
         Err(contactscope::Error::NotConverged {
@@ -391,6 +392,7 @@ fn persson_slope_kappa_for_a_periodic_self_affine_surface() {
             max_iterations: 5000,
             tolerance: 1e-8,
             monitor: None,
+            ..SolverOptions::default()
         };
         let sol = solve_load(&problem, mean * 1.0, &options).unwrap();
         let fraction = sol.contact_pixels() as f64 / (n * n) as f64;

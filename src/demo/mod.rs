@@ -294,6 +294,7 @@ fn solver_options() -> SolverOptions<'static> {
         max_iterations: 5000,
         tolerance: 1e-8,
         monitor: None,
+        ..SolverOptions::default()
     }
 }
 
@@ -308,7 +309,10 @@ fn truth_ramp(p: &DemoParams, roughness: &Topography) -> Result<Truth> {
             modulus_pa_per_m: p.k_pa_per_m,
             initial_pa: 0.0,
         },
-        options: solver_options(),
+        options: SolverOptions {
+            gap_scale_m: Some(roughness.rms_height()),
+            ..solver_options()
+        },
     };
     let steps = sweep(&setup, &p.loads_n, &|_, _| {})?;
     if steps.iter().any(|s| s.edge_contact) {

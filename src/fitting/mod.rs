@@ -228,6 +228,11 @@ impl ModelBody {
         if let Some(r) = radius_m {
             body.add_sphere(r)?;
         }
+        // Gap residuals relative to the roughness (SolverOptions::gap_scale_m).
+        let options = SolverOptions {
+            gap_scale_m: options.gap_scale_m.or(Some(stats.h_rms_m)),
+            ..options
+        };
         Ok(ModelBody {
             roughness,
             body,

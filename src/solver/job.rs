@@ -125,8 +125,10 @@ pub fn run_simulate(
             if let Some(r) = request.radius_m {
                 body.add_sphere(r)?;
             }
+            // Gap residuals relative to the roughness (SolverOptions::gap_scale_m).
             let options = SolverOptions {
                 monitor,
+                gap_scale_m: request.options.gap_scale_m.or(Some(stats.h_rms_m)),
                 ..request.options
             };
             run_halfspace(request, model, &body, options, &staging, progress)?

@@ -21,7 +21,7 @@ use crate::error::{Error, Result};
 use crate::measure::patches::count_patches;
 use crate::surface::Topography;
 
-use super::cg::{solve_load, solve_load_bounded, Plasticity, Problem, Solution, SolverOptions};
+use super::cg::{solve_load_with, Plasticity, Problem, Solution, SolverOptions};
 use super::halfspace::{Boundary, ElasticOperator};
 
 /// The contact model.
@@ -189,13 +189,17 @@ fn solve_step(
         pixel_area,
     };
     match setup.model {
-        Model::Elastic => Ok((solve_load(&problem, force, &setup.options)?, 1)),
+        Model::Elastic => Ok((
+            solve_load_with(&problem, force, Plasticity::Elastic, None, &setup.options)?,
+            1,
+        )),
         Model::Hardness {
             hardness_pa,
             volume_conserving: None,
         } => {
             let cap = vec![hardness_pa; geometry.len()];
-            let sol = solve_load_bounded(&problem, force, Plasticity::Cap(&cap), &setup.options)?;
+            let sol =
+                solve_load_with(&problem, force, Plasticity::Cap(&cap), None, &setup.options)?;
             for (h, o) in plastic.iter_mut().zip(capped_overlap(&sol, hardness_pa)) {
                 *h += o;
             }
@@ -217,7 +221,7 @@ fn solve_step(
                 yield_pressure: &yield_pressure,
                 compliance: 1.0 / modulus_pa_per_m,
             };
-            let sol = solve_load_bounded(&problem, force, plasticity, &setup.options)?;
+            let sol = solve_load_with(&problem, force, plasticity, None, &setup.options)?;
             for ((h, p), y) in plastic.iter_mut().zip(&sol.pressure).zip(&yield_pressure) {
                 *h += (p - y).max(0.0) / modulus_pa_per_m;
             }
@@ -280,7 +284,7 @@ fn conserving_step(
             separation: &geometry,
             pixel_area,
         };
-        let sol = solve_load_bounded(&problem, force, Plasticity::Cap(&cap), &setup.options)?;
+        let sol = solve_load_with(&problem, force, Plasticity::Cap(&cap), None, &setup.options)?;
         let overlap = capped_overlap(&sol, hardness);
         worst = overlap.iter().copied().fold(0.0, f64::max);
         let reference = *first_overlap.get_or_insert(worst);
