@@ -265,3 +265,51 @@ fn bad_parameters_are_errors() {
     .is_err());
     assert!(sweep(&setup(Model::Elastic), &[-1.0], &|_, _| {}).is_err());
 }
+
+#[test]
+fn the_gap_is_after_the_plastic_update_for_every_model() {
+    // Issue 11 item 6: one meaning of the gap map, g = s + h_pl − δ + u after the load's plastic
+    // update: never negative beyond the solver's tolerance, 0 on the contact, for every model.
+    let topo = rough_sphere(96, 5.0, 0.004);
+    let range = {
+        let h = &topo.heights;
+        h.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            - h.iter().copied().fold(f64::INFINITY, f64::min)
+    };
+    let models = [
+        ("elastic", Model::Elastic),
+        (
+            "hardness",
+            Model::Hardness {
+                hardness_pa: 4.0,
+                volume_conserving: None,
+            },
+        ),
+        (
+            "hardening",
+            Model::Hardening {
+                modulus_pa_per_m: 200.0,
+                initial_pa: 0.0,
+            },
+        ),
+    ];
+    for (name, model) in models {
+        for step in run(&topo, model, &[3.0, 6.0]) {
+            let gap = &step.solution.gap;
+            let pressure = &step.solution.pressure;
+            let lowest = gap.iter().copied().fold(f64::INFINITY, f64::min);
+            assert!(lowest > -1e-7 * range, "{name}: gap {lowest} below 0");
+            let on_contact = (0..gap.len())
+                .filter(|&i| pressure[i] > 0.0)
+                .map(|i| gap[i].abs())
+                .fold(0.0, f64::max);
+            assert!(
+                on_contact < 1e-7 * range,
+                "{name}: gap {on_contact} on the contact"
+            );
+            if name != "elastic" {
+                assert!(step.plastic_m.iter().any(|h| *h > 0.0), "{name}: it yields");
+            }
+        }
+    }
+}

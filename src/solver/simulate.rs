@@ -16,6 +16,11 @@
 //! * The plastic state h_pl carries from each load to the next, like the experiment's ramp.
 //! * Contact = pixels with p > 0. Contact on the border of a free-boundary map means the map is
 //!   too small: it is reported per load (`edge_contact`), not ignored.
+//! * **The gap** of a [`LoadStep`] is the gap between the deformed surfaces after the load's
+//!   plastic update, g = s + h_pl − δ + u, for every model: ≥ 0, and 0 on the contact to the
+//!   solver's tolerance (Eq. 5: to its overlap tolerance). The overlap that flowed is in
+//!   `plastic_m`. (The hardness model used to report the gap before the update, negative on
+//!   yielding pixels, and hardening the gap after it.)
 
 use crate::error::{Error, Result};
 use crate::measure::patches::count_patches;
@@ -76,7 +81,8 @@ pub struct Setup<'a> {
 pub struct LoadStep {
     /// Imposed normal force, N.
     pub force_n: f64,
-    /// The contact solution (pressure Pa, gap m, approach m).
+    /// The contact solution (pressure Pa, approach m, and the gap in m after this load's plastic
+    /// update: see the module docs).
     pub solution: Solution,
     /// Plastic displacement after this load, m (material removed, ≥ 0 where it flowed).
     pub plastic_m: Vec<f64>,
@@ -198,10 +204,13 @@ fn solve_step(
             volume_conserving: None,
         } => {
             let cap = vec![hardness_pa; geometry.len()];
-            let sol =
+            let mut sol =
                 solve_load_with(&problem, force, Plasticity::Cap(&cap), None, &setup.options)?;
-            for (h, o) in plastic.iter_mut().zip(capped_overlap(&sol, hardness_pa)) {
+            let overlap = capped_overlap(&sol, hardness_pa);
+            for ((h, g), o) in plastic.iter_mut().zip(&mut sol.gap).zip(overlap) {
+                // The overlap flows: the gap after the update is 0 where it was negative.
                 *h += o;
+                *g += o;
             }
             Ok((sol, 1))
         }
