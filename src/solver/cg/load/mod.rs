@@ -32,7 +32,7 @@
 //! pixel joined in the last step. The force balance ΔA·Σp = W holds to round-off after every step.
 //!
 //! Restarts ([`Restart::Adaptive`], the default): the conjugate direction is kept unless more
-//! than a fraction of the free pixels joined (or switched between elastic and plastic) in the
+//! than a tenth of the free pixels joined (or switched between elastic and plastic) in the
 //! last step, the energy E(p) rose (the step stopped reducing the error), or t is not a descent
 //! direction. [`Restart::EveryChange`] restarts whenever any pixel joins, as PK.
 //!

@@ -79,6 +79,9 @@ pub(super) struct Step {
     pub capped: usize,
     pub min_inside: f64,
     pub headroom: f64,
+    /// Σp over the inside and over the capped pixels.
+    pub inside_total: f64,
+    pub capped_total: f64,
     /// Pixels that joined from p = 0, left the cap, were pushed onto the cap, or whose hardening
     /// spring switched on or off.
     pub engaged: usize,
@@ -98,6 +101,8 @@ impl Default for Step {
             capped: 0,
             min_inside: f64::INFINITY,
             headroom: f64::INFINITY,
+            inside_total: 0.0,
+            capped_total: 0.0,
             engaged: 0,
             released: 0,
             clamped: 0,
@@ -116,6 +121,8 @@ impl Step {
             capped: self.capped + o.capped,
             min_inside: self.min_inside.min(o.min_inside),
             headroom: self.headroom.min(o.headroom),
+            inside_total: self.inside_total + o.inside_total,
+            capped_total: self.capped_total + o.capped_total,
             engaged: self.engaged + o.engaged,
             released: self.released + o.released,
             clamped: self.clamped + o.clamped,
@@ -131,12 +138,13 @@ impl Step {
     }
 }
 
-/// Shifts that restore the load ([`Solver::load_shift`]): of the pixels strictly inside their
-/// bounds, and of the pixels at the cap.
+/// How the load is restored after a step ([`Solver::load_shift`]): the pixels strictly inside
+/// their bounds move to clip(λ·p + μ, 0, cap), the capped ones to λ_c·p.
 #[derive(Clone, Copy)]
 pub(super) struct Shift {
-    pub inside: f64,
-    pub capped: f64,
+    pub inside_scale: f64,
+    pub inside_add: f64,
+    pub capped_scale: f64,
 }
 
 impl Solver<'_> {
@@ -226,12 +234,13 @@ impl Solver<'_> {
         )
     }
 
-    /// Σg² over F. From the shifted sums when δ moved little (no cancellation), else by a second,
-    /// exact pass with the new δ.
+    /// Σg² over F. From the shifted sums Σg'² − n·m² when n·m² ≤ ½Σg'² (then the subtraction
+    /// loses at most a bit or two; δ moved by less than the residual), else by a second, exact pass
+    /// with the new δ.
     pub(super) fn residual_norm(&self, gaps: &Gaps, m: f64, delta: f64) -> f64 {
         let count = gaps.count as f64;
         let shifted = gaps.sum_sq - count * m * m;
-        if count * m * m <= 1e-6 * gaps.sum_sq && shifted >= 0.0 {
+        if count * m * m <= 0.5 * gaps.sum_sq {
             return shifted;
         }
         reduce(
@@ -346,10 +355,12 @@ impl Solver<'_> {
                     }
                     if new > 0.0 && new < cap {
                         acc.inside += 1;
+                        acc.inside_total += new;
                         acc.min_inside = acc.min_inside.min(new);
                         acc.headroom = acc.headroom.min(cap - new);
                     } else if new > 0.0 {
                         acc.capped += 1;
+                        acc.capped_total += new;
                     }
                     p[k] = new;
                     acc.total += new;
@@ -363,53 +374,58 @@ impl Solver<'_> {
         step
     }
 
-    /// How the load is restored after a step: the pixels strictly inside their bounds move by a
-    /// common shift μ, p ← clip(p + μ, 0, cap), and only when they cannot absorb an excess (all
-    /// at 0) do the capped pixels come down by a second common shift. This is the Euclidean
-    /// projection onto the load restricted first to the inside pixels, then to the capped ones:
-    /// it leaves the bounds alone whenever it can, so the active set, once found, stays found
-    /// (projecting onto every loaded pixel at once takes a sliver off each capped pixel and
-    /// cycles). Pixels at p = 0 never move. `None` when no pixel is loaded.
+    /// How the load is restored after a step. A deficit (clamps at the cap took load off) is
+    /// spread over the pixels strictly inside their bounds by a common shift μ,
+    /// p ← clip(p + μ, 0, cap): the Euclidean projection onto the load restricted to them, which
+    /// leaves the bounds alone whenever it can, so an active set, once found, stays found. If
+    /// even their caps cannot carry it they are filled to the cap, and the next iteration's
+    /// approach engages more pixels. An excess (clipping at 0 and joining pixels added load) is
+    /// taken off the inside pixels in proportion, p ← λp with λ < 1 (exact in one pass, nothing
+    /// crosses 0; an additive shift would push the pixels that just joined below 0 and need a
+    /// search on most iterations), and off the capped ones only when the inside ones cannot
+    /// absorb it (projecting onto every loaded pixel at once takes a sliver off each capped pixel
+    /// and cycles). Pixels at p = 0 never move. `None` when no pixel is loaded.
     pub(super) fn load_shift(&self, step: &Step) -> Option<Shift> {
         if step.inside + step.capped == 0 {
             return None;
         }
         let miss = self.target - step.total;
-        if step.inside > 0 {
-            // The usual case: μ = miss/|inside| crosses no bound and is exact without a pass.
-            let mu = miss / step.inside as f64;
-            if mu < step.headroom && -mu < step.min_inside {
-                return Some(Shift {
-                    inside: mu,
-                    capped: 0.0,
-                });
-            }
-            let (mu, carried) = self.solve_shift(miss / step.inside as f64, |v, cap| {
-                (v > 0.0 && v < cap).then_some(cap)
+        let keep = Shift {
+            inside_scale: 1.0,
+            inside_add: 0.0,
+            capped_scale: 1.0,
+        };
+        if miss < 0.0 {
+            let excess = -miss;
+            return Some(if excess <= step.inside_total {
+                Shift {
+                    inside_scale: 1.0 - excess / step.inside_total,
+                    ..keep
+                }
+            } else {
+                Shift {
+                    inside_scale: 0.0,
+                    capped_scale: 1.0 - (excess - step.inside_total) / step.capped_total,
+                    ..keep
+                }
             });
-            if carried {
-                return Some(Shift {
-                    inside: mu,
-                    capped: 0.0,
-                });
-            }
         }
-        if miss > 0.0 {
-            // The loaded pixels cannot carry the load even at their caps: fill them up; the next
-            // iteration's approach engages more pixels.
+        if step.inside == 0 {
+            return Some(keep);
+        }
+        // The usual case: μ = miss/|inside| reaches no cap and is exact without a pass.
+        let mu = miss / step.inside as f64;
+        if mu < step.headroom {
             return Some(Shift {
-                inside: f64::INFINITY,
-                capped: 0.0,
+                inside_add: mu,
+                ..keep
             });
         }
-        // The inside pixels cannot take the excess off (all would reach 0): they go to 0 and
-        // the capped ones come down.
-        let (mu, _) = self.solve_shift(miss / step.capped.max(1) as f64, |v, cap| {
-            (v >= cap).then_some(cap)
-        });
+        let (mu, carried) = self.solve_shift(mu, |v, cap| (v > 0.0 && v < cap).then_some(cap));
         Some(Shift {
-            inside: f64::NEG_INFINITY,
-            capped: mu,
+            // If the caps cannot carry it: fill them up.
+            inside_add: if carried { mu } else { f64::INFINITY },
+            ..keep
         })
     }
 
@@ -535,9 +551,9 @@ impl Solver<'_> {
                 for (k, i) in range.enumerate() {
                     let (v, cap) = (p[k], bounds.cap(i));
                     if v > 0.0 && v < cap {
-                        p[k] = (v + shift.inside).clamp(0.0, cap);
-                    } else if v > 0.0 && shift.capped != 0.0 {
-                        p[k] = (v + shift.capped).clamp(0.0, cap);
+                        p[k] = (v * shift.inside_scale + shift.inside_add).clamp(0.0, cap);
+                    } else if v > 0.0 {
+                        p[k] = v * shift.capped_scale;
                     }
                     acc = (acc.0 + (p[k] - previous[k]).abs(), acc.1 + p[k]);
                 }
