@@ -30,7 +30,7 @@ pub use displacement::solve_displacement;
 pub use load::{solve_load, solve_load_with};
 pub use reference::solve_load_bounded;
 
-use super::halfspace::ElasticOperator;
+use super::halfspace::{ElasticOperator, Workspace};
 
 /// Called after every CG iteration with (iteration, relative residual), e.g. for a progress bar.
 pub type Monitor<'a> = &'a (dyn Fn(usize, f64) + Sync);
@@ -293,14 +293,27 @@ fn finish(
     approach: f64,
     plasticity: Plasticity,
     iterations: usize,
+    residuals: (f64, f64),
+) -> Solution {
+    let mut work = problem.operator.workspace();
+    finish_with(
+        problem, pressure, approach, plasticity, iterations, residuals, &mut work,
+    )
+}
+
+/// [`finish`] with the caller's workspace of the whole operator.
+fn finish_with(
+    problem: &Problem,
+    pressure: Vec<f64>,
+    approach: f64,
+    plasticity: Plasticity,
+    iterations: usize,
     (gap_residual, pressure_change): (f64, f64),
+    work: &mut Workspace,
 ) -> Solution {
     let n = problem.len();
     let mut displacement = vec![0.0; n];
-    let mut work = problem.operator.workspace();
-    problem
-        .operator
-        .apply(&pressure, &mut displacement, &mut work);
+    problem.operator.apply(&pressure, &mut displacement, work);
     let gap = (0..n)
         .map(|i| {
             problem.separation[i] - approach + displacement[i] + plasticity.spring(i, pressure[i])
