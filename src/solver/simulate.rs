@@ -12,7 +12,9 @@
 //! * **Hardening** uses the implicit "series compliance" step (§3.4): consistent to round-off,
 //!   needs no seed when p_Y0 = 0, and path independent for monotone loading. Negative h_pl cannot
 //!   arise (Eq. 5 is not offered with hardening), so p_Y = p_Y0 + k·h_pl needs no clamp.
-//! * **Load control with a cap** is an outer root-find on the approach (§2.3(a)).
+//! * **Load control with a cap** is one constrained-CG run with the approach as the load's
+//!   Lagrange multiplier ([`super::cg::load`]); the root-find on the approach of §2.3(a) is kept as
+//!   the reference ([`super::cg::Method::Reference`]).
 //! * The plastic state h_pl carries from each load to the next, like the experiment's ramp.
 //! * Contact = pixels with p > 0. Contact on the border of a free-boundary map means the map is
 //!   too small: it is reported per load (`edge_contact`), not ignored.
