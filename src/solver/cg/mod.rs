@@ -12,7 +12,7 @@
 //!   is projected onto the bounds and rescaled to the load each iteration, and the conjugate
 //!   direction survives small changes of the active set ([`Restart::Adaptive`]).
 //! * [`displacement`] — imposed approach δ, with any bound ([`solve_displacement`]).
-//! * [`reference`] — the previous algorithms, kept to check the fast ones: PK with a restart
+//! * [`reference`](mod@reference) — the previous algorithms, kept to check the fast ones: PK with a restart
 //!   whenever any pixel engages, and, for bounded models, a root-find on δ over
 //!   displacement-controlled solves ([`Method::Reference`]).
 //!

@@ -46,7 +46,7 @@
 //! transform is 16 times smaller than the whole padded grid. Periodic maps use the whole grid.
 //!
 //! Cost per iteration: two operator applications and five fused, parallel passes over the
-//! window's fields with deterministic sums ([`super::sums`]); nothing is allocated inside the
+//! window's fields with deterministic sums (`cg::sums`); nothing is allocated inside the
 //! loop except when the window changes.
 //!
 //! [`ElasticOperator::window`]: crate::solver::halfspace::ElasticOperator::window
