@@ -26,14 +26,14 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
 
 use contactscope::analysis::{self, AnalysisOptions, DEFAULT_MEMORY_BUDGET};
+use contactscope::io::series::{self, Series};
+use contactscope::io::tiff::write::{encode_u16_stack_compressed, Compression};
+use contactscope::io::tiff::TiffReader;
+use contactscope::io::units::{self, Dimension};
 use contactscope::measure::{measure, patch_stats};
 use contactscope::report::Report;
-use contactscope::stack::series::{self, Series};
-use contactscope::stack::tiff::TiffReader;
-use contactscope::stack::write::{encode_u16_stack_compressed, Compression};
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::{Binning, Histogram, Threshold};
-use contactscope::units::{self, Dimension};
 
 const SIZE: usize = 1024;
 const IMAGES: usize = 40;
@@ -220,7 +220,7 @@ fn series_benches(c: &mut Criterion) {
     let plane = TiffReader::open(&raw).unwrap().read_page(0, 0).unwrap();
     assert_eq!(
         plane.samples,
-        contactscope::stack::Samples::Int {
+        contactscope::image::Samples::Int {
             codes: data.codes[last].clone(),
             offset: 0
         },

@@ -16,10 +16,10 @@ use std::sync::{Arc, Mutex};
 use rayon::prelude::*;
 
 use crate::error::{Error, Location, Result};
+use crate::image::{PixelSize, PixelSizeSource, Plane, Samples};
+use crate::io::series::{ImageRef, Series};
+use crate::io::tiff::TiffReader;
 use crate::measure::{measure, Mask, Measurement};
-use crate::stack::series::{ImageRef, Series};
-use crate::stack::tiff::TiffReader;
-use crate::stack::{PixelSize, PixelSizeSource, Plane, Samples};
 use crate::threshold::{
     histogram, Binning, FloatBinning, Histogram, Method, Threshold, FLOAT_BINS,
 };
@@ -294,7 +294,7 @@ fn empty_samples(series: &Series) -> Samples {
 
 fn integer_offset(series: &Series) -> i32 {
     match series.files[0].sample_type {
-        crate::stack::SampleType::I16 => -32768,
+        crate::image::SampleType::I16 => -32768,
         _ => 0,
     }
 }

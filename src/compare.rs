@@ -18,15 +18,16 @@ use serde_json::{json, Value};
 
 use crate::analysis::global_threshold;
 use crate::error::{Error, Location, Result};
+use crate::image::pixel_size_or;
+use crate::io::plot::edge_panels_png;
+use crate::io::series::{self, Series};
+use crate::io::staging::Staging;
+use crate::io::tiff::read_image;
+use crate::io::tiff::TiffReader;
 use crate::measure::distance::squared_distance;
 use crate::optics::blur::{microscope_image, Grid, IntensityScale};
-use crate::output::Staging;
-use crate::plot::edge_panels_png;
 use crate::spectral::job::AcfCurve;
 use crate::spectral::register::{register, translate, Dihedral, Shift};
-use crate::stack::image::{pixel_size_or, read_image};
-use crate::stack::series::{self, Series};
-use crate::stack::tiff::TiffReader;
 use crate::threshold::otsu_of_values;
 
 /// Where the micrographs come from.

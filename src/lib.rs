@@ -20,7 +20,7 @@
 //!
 //! ```
 //! use contactscope::measure::measure;
-//! use contactscope::stack::Plane;
+//! use contactscope::image::Plane;
 //! use contactscope::synth::{generate, SynthParams};
 //! use contactscope::threshold::{Binning, Histogram, Threshold};
 //!
@@ -60,20 +60,18 @@ pub mod error;
 pub mod fit;
 pub mod fitting;
 pub mod hertz;
+pub mod image;
+pub mod io;
 pub mod measure;
 pub mod mechanics;
 pub mod optics;
-pub mod output;
 pub mod pipeline;
-pub mod plot;
 pub mod report;
 pub mod solver;
 pub mod spectral;
-pub mod stack;
 pub mod stats;
 pub mod surface;
 pub mod synth;
 pub mod threshold;
-pub mod units;
 
 pub use error::{Error, Result};

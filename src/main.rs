@@ -13,6 +13,11 @@ use contactscope::compare::{self as comparison, CompareRequest, CompareSettings,
 use contactscope::demo::DemoParams;
 use contactscope::fitting::job::{self as fit_job, FitRequest, Sweep, SweepMicrographs};
 use contactscope::fitting::{Family, Imaging, Search};
+use contactscope::io::series::{self, Series};
+use contactscope::io::tiff::write::Compression;
+use contactscope::io::tiff::TiffReader;
+use contactscope::io::topography::{read_topography, write_gsf, write_npy, TopographySource};
+use contactscope::io::units::{self, Dimension};
 use contactscope::mechanics::friction::{self, FrictionRequest, SlipOptions};
 use contactscope::mechanics::squeeze::{self, HertzRequest};
 use contactscope::optics::newton::{self as newton_rings, NewtonOptions, NewtonRequest, Phase};
@@ -22,16 +27,11 @@ use contactscope::solver::cg::SolverOptions;
 use contactscope::solver::job::{self, ModelChoice, SimulateRequest};
 use contactscope::solver::simulate::Model;
 use contactscope::spectral::job::{run_autocorr, AutocorrRequest};
-use contactscope::stack::series::{self, Series};
-use contactscope::stack::tiff::TiffReader;
-use contactscope::stack::write::Compression;
 use contactscope::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
-use contactscope::surface::io::{read_topography, write_gsf, write_npy, TopographySource};
 use contactscope::surface::stats::SurfaceStats;
 use contactscope::surface::Detrend;
 use contactscope::synth::{self, Layout, SynthParams};
 use contactscope::threshold::Method;
-use contactscope::units::{self, Dimension};
 
 #[derive(Parser)]
 #[command(

@@ -7,13 +7,13 @@ use serde_json::json;
 
 use crate::analysis::{self, Analysis, AnalysisOptions, ImageSink, Progress};
 use crate::error::Result;
+use crate::image::Plane;
+use crate::io::plot::overlay_png;
+use crate::io::series::{ImageRef, Series};
+use crate::io::staging::Staging;
+use crate::io::tiff::write::encode_u8_stack;
 use crate::measure::Mask;
-use crate::output::Staging;
-use crate::plot::overlay_png;
 use crate::report::{inputs_json, threshold_json, Report};
-use crate::stack::series::{ImageRef, Series};
-use crate::stack::write::encode_u8_stack;
-use crate::stack::Plane;
 
 /// Everything `analyze` needs, already validated.
 #[derive(Debug, Clone)]

@@ -10,9 +10,9 @@ use crate::analysis::{Analysis, HertzParams};
 use crate::error::{Error, Result};
 use crate::fit::{fit_power_law, fit_proportional, PowerLawFit};
 use crate::hertz;
-use crate::mechanics::table::Table;
-use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
-use crate::stack::series::Series;
+use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::series::Series;
+use crate::io::table::Table;
 
 /// One row of `areas.csv`, in physical units where a pixel size is known.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -19,9 +19,9 @@ use rand_distr::{Distribution, Poisson, StandardNormal};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
+use crate::io::staging::write_atomic;
+use crate::io::tiff::write::{encode_u16_stack_compressed, Compression};
 use crate::optics::blur::{self, Edges};
-use crate::output::write_atomic;
-use crate::stack::write::{encode_u16_stack_compressed, Compression};
 
 /// Parameters of a synthetic series. SI units.
 #[derive(Debug, Clone, Serialize)]

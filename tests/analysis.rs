@@ -7,8 +7,8 @@ use std::io::Cursor;
 use std::path::Path;
 
 use contactscope::analysis::{analyze, Analysis, AnalysisOptions};
-use contactscope::stack::series;
-use contactscope::stack::write::{encode_u16_stack_compressed, Compression};
+use contactscope::io::series;
+use contactscope::io::tiff::write::{encode_u16_stack_compressed, Compression};
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::Method;
 use tiff::encoder::{colortype, TiffEncoder};

@@ -40,9 +40,14 @@ fn write_u16(
     pixel_m: Option<f64>,
 ) -> PathBuf {
     let path = dir.join(name);
-    let bytes =
-        contactscope::stack::write::encode_u16_stack(&[codes], w, h, pixel_m.map(|p| (p, p)), "")
-            .unwrap();
+    let bytes = contactscope::io::tiff::write::encode_u16_stack(
+        &[codes],
+        w,
+        h,
+        pixel_m.map(|p| (p, p)),
+        "",
+    )
+    .unwrap();
     fs::write(&path, bytes).unwrap();
     path
 }

@@ -7,8 +7,8 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use common::{column, read_csv, run, stderr, stdout};
-use contactscope::stack::tiff::TiffReader;
-use contactscope::stack::write::encode_u16_stack;
+use contactscope::io::tiff::write::encode_u16_stack;
+use contactscope::io::tiff::TiffReader;
 use contactscope::synth::{self, Layout, SynthParams};
 
 fn small_series(dir: &Path, layout: Layout) -> Vec<PathBuf> {

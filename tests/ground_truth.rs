@@ -3,10 +3,10 @@
 mod common;
 
 use contactscope::analysis::{analyze, AnalysisOptions};
+use contactscope::image::Plane;
+use contactscope::io::series;
 use contactscope::measure::measure;
 use contactscope::report::Report;
-use contactscope::stack::series;
-use contactscope::stack::Plane;
 use contactscope::synth::{self, Layout, SynthParams};
 use contactscope::threshold::{Binning, Histogram, Threshold};
 

@@ -10,12 +10,12 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Poisson};
 use serde_json::Value;
 
+use contactscope::image::Image;
+use contactscope::image::{PixelSize, PixelSizeSource};
 use contactscope::optics::psf::{
     fit_spot, measure_psf, synth_beads, BeadKind, BeadParams, PlaneView, PsfOptions, PsfReport,
     Sampling, SkipReason, SpotOptions, SyntheticBeads, FWHM_PER_SIGMA,
 };
-use contactscope::stack::image::Image;
-use contactscope::stack::{PixelSize, PixelSizeSource};
 
 const SIZE: usize = 41;
 const CENTRE: (f64, f64) = (20.37, 19.81);

@@ -14,8 +14,8 @@ mod common;
 use std::path::PathBuf;
 
 use contactscope::analysis::global_threshold;
-use contactscope::stack::series;
-use contactscope::stack::tiff::TiffReader;
+use contactscope::io::series;
+use contactscope::io::tiff::TiffReader;
 use contactscope::Error;
 
 /// (path under real-tiff, channel, skimage threshold, exact threshold when skimage differs)

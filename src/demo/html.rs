@@ -11,8 +11,8 @@ use super::{DemoParams, Recovered};
 use crate::compare::Comparison;
 use crate::error::{Error, Result};
 use crate::fitting::{Family, ModelFit};
-use crate::output::write_atomic;
-use crate::plot::edge_panels_png;
+use crate::io::plot::edge_panels_png;
+use crate::io::staging::write_atomic;
 use crate::spectral::job::{acf_chart, AcfCurve};
 
 /// Everything the report shows.

@@ -27,6 +27,10 @@ use crate::compare::{
 use crate::error::{Error, Result};
 use crate::fitting::job::{run_fit, FitRequest};
 use crate::fitting::{Family, Imaging, ModelBody, Search};
+use crate::io::series;
+use crate::io::staging::write_atomic;
+use crate::io::tiff::write::encode_u16_stack;
+use crate::io::topography::{write_npy, TopographySource};
 use crate::mechanics::friction::{
     self, CsvLayout, FrictionRequest, SlipOptions, TraceParams, XAxis,
 };
@@ -36,15 +40,11 @@ use crate::optics::newton::{
     run_newton, synth_newton, NewtonOptions, NewtonRequest, NewtonSynthParams,
 };
 use crate::optics::psf::{run_psf, synth_beads, BeadParams, PsfRequest};
-use crate::output::write_atomic;
 use crate::pipeline::{run_analyze, AnalyzeRequest};
 use crate::solver::cg::SolverOptions;
 use crate::solver::halfspace::Boundary;
 use crate::solver::simulate::{sweep, Model, Setup};
-use crate::stack::series;
-use crate::stack::write::encode_u16_stack;
 use crate::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
-use crate::surface::io::{write_npy, TopographySource};
 use crate::surface::Topography;
 use crate::synth::{render_micrograph, MicrographParams};
 use crate::threshold::Method;

@@ -10,14 +10,14 @@ use serde_json::{json, Value};
 use super::{fit_parameter, Evaluation, Family, Imaging, Measured, ModelBody, ModelFit, Search};
 use crate::compare::{compare_maps, CompareSettings, ExperimentInput, Micrographs, SimulatedMap};
 use crate::error::{Error, Location, Result};
+use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::staging::Staging;
+use crate::io::topography::TopographySource;
+use crate::io::units::{self, Dimension};
 use crate::optics::blur::Grid;
-use crate::output::Staging;
-use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::report::read_areas_csv;
 use crate::solver::cg::SolverOptions;
-use crate::surface::io::TopographySource;
 use crate::surface::stats::SurfaceStats;
-use crate::units::{self, Dimension};
 
 /// A parameter sweep: one family, explicit values (Pa or Pa/m).
 #[derive(Debug, Clone, PartialEq)]

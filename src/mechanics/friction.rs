@@ -43,11 +43,11 @@ use serde_json::{json, Value};
 
 use crate::error::{Error, Location, Result};
 use crate::fit::fit_power_law;
-use crate::output::Staging;
-use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::staging::Staging;
 use crate::report::read_areas_csv;
 
-use super::table::Table;
+use crate::io::table::Table;
 
 /// The quantity on a trace's x axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -5,5 +5,3 @@
 
 pub mod friction;
 pub mod squeeze;
-
-pub(crate) mod table;

@@ -25,10 +25,10 @@ use serde_json::{json, Value};
 
 use crate::error::{Error, Location, Result};
 use crate::hertz;
-use crate::output::Staging;
-use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::staging::Staging;
 
-use super::table::Table;
+use crate::io::table::Table;
 
 /// Fewest loaded points (P > 0) a fit needs.
 pub const MIN_POINTS: usize = 3;

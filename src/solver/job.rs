@@ -8,11 +8,11 @@ use serde_json::{json, Value};
 
 use crate::error::{Error, Result};
 use crate::fit::fit_power_law;
+use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::staging::Staging;
+use crate::io::tiff::write::encode_f32_stack;
+use crate::io::topography::TopographySource;
 use crate::measure::patches::count_patches;
-use crate::output::Staging;
-use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
-use crate::stack::write::encode_f32_stack;
-use crate::surface::io::TopographySource;
 use crate::surface::stats::SurfaceStats;
 use crate::surface::Topography;
 

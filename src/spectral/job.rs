@@ -8,9 +8,10 @@ use std::path::{Path, PathBuf};
 use serde_json::{json, Value};
 
 use crate::error::{Error, Location, Result};
-use crate::output::Staging;
-use crate::plot::{Axes, Chart, Curve, Legend};
-use crate::stack::image::{read_pages, Image};
+use crate::image::Image;
+use crate::io::plot::{Axes, Chart, Curve, Legend};
+use crate::io::staging::Staging;
+use crate::io::tiff::read_pages;
 
 use super::autocorrelation::{autocorrelation, first_crossing, radial_average};
 

@@ -13,7 +13,6 @@
 //!   and Bruker/Nanoscope files.
 
 pub mod generate;
-pub mod io;
 pub mod stats;
 
 use ndarray::Array2;

@@ -16,7 +16,7 @@ pub use histogram::{Binning, FloatBinning, Histogram};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::stack::Samples;
+use crate::image::Samples;
 
 /// Number of equal bins for float data over the series' finite min..max.
 pub const FLOAT_BINS: usize = 4096;
@@ -200,7 +200,7 @@ mod tests {
         assert!((101.0..900.0).contains(&t) && t.fract() == 0.0, "{t}");
     }
     use super::*;
-    use crate::stack::Plane;
+    use crate::image::Plane;
 
     #[test]
     fn per_image_histograms_merge_to_the_series_histogram() {

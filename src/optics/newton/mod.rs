@@ -22,7 +22,7 @@ pub use report::{run_newton, NewtonOutcome, NewtonRequest};
 pub use synth::{synth_newton, NewtonSynth, NewtonSynthParams, NewtonTruth};
 
 use crate::error::{Error, Location, Result};
-use crate::stack::image::Image;
+use crate::image::Image;
 use profile::{edge_crossing, find_contact, noise_sd, peaks, smooth, Contact, HalfLine};
 
 /// Choices of the analysis. SI units.

@@ -7,9 +7,9 @@ use serde_json::{json, Value};
 
 use super::{analyse, hertz_gap, ring_gap, MeanSd, NewtonAnalysis, NewtonOptions};
 use crate::error::{Error, Result};
-use crate::output::Staging;
-use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
-use crate::stack::image::read_image;
+use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::staging::Staging;
+use crate::io::tiff::read_image;
 
 /// What `contactscope newton` asks for.
 #[derive(Debug, Clone)]

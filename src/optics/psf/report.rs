@@ -6,11 +6,12 @@ use std::path::{Path, PathBuf};
 use serde_json::{json, Value};
 
 use crate::error::{Error, Result};
-use crate::output::Staging;
-use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
-use crate::stack::image::{read_pages, Image};
-use crate::stack::tiff::TiffReader;
-use crate::stack::SampleType;
+use crate::image::Image;
+use crate::image::SampleType;
+use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::staging::Staging;
+use crate::io::tiff::read_pages;
+use crate::io::tiff::TiffReader;
 
 use super::{measure_psf, BeadMeasurement, MeanSd, PsfOptions, PsfReport, FWHM_PER_SIGMA};
 

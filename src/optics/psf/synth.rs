@@ -16,7 +16,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Poisson};
 
 use crate::error::{Error, Result};
-use crate::stack::write::encode_u16_stack;
+use crate::io::tiff::write::encode_u16_stack;
 
 /// How a spot is turned into pixel values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -136,7 +136,7 @@ pub fn write_gsf(path: &Path, topography: &Topography) -> Result<()> {
     for h in topography.heights.iter() {
         out.extend_from_slice(&(*h as f32).to_le_bytes());
     }
-    crate::output::write_atomic(path, &out)
+    crate::io::staging::write_atomic(path, &out)
 }
 
 #[cfg(test)]

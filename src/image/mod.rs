@@ -1,17 +1,16 @@
-//! Images and their calibration: one decoded page (a [`Plane`]), its sample type, and the pixel
-//! size with the metadata it came from.
+//! Images in memory and their calibration: one decoded page (a [`Plane`]) with its sample type,
+//! the pixel size with the metadata it came from, and plain `f64` images ([`Image`]) for the
+//! optics commands. No file access here: readers live in [`crate::io::tiff`].
 //!
 //! Integer data of every width is held as `u16` codes plus an offset (`value = code + offset`),
 //! so that one 65 536-bin histogram indexes any 8-bit, 16-bit or signed 16-bit image directly and
 //! exactly. Float data is held as `f32`.
 
-pub mod image;
-pub mod metadata;
-pub mod series;
-pub mod tiff;
-pub mod write;
+use std::path::PathBuf;
 
 use serde::Serialize;
+
+use crate::error::{Error, Location, Result};
 
 /// Sample type of the data as stored in the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -165,5 +164,54 @@ impl PixelSize {
     pub fn same_size(&self, other: &PixelSize) -> bool {
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.abs().max(b.abs());
         close(self.x_m, other.x_m) && close(self.y_m, other.y_m)
+    }
+}
+
+/// One decoded 2-D image as plain `f64`s, row-major (`values[y * width + x]`), in the file's
+/// intensity units, with the pixel size and the page it came from: the input of the optics
+/// commands (`psf`, `autocorr`, `newton`, `compare`), which look at one image or one stack at a
+/// time rather than at a load series. A z stack is a `Vec<Image>` in page order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// Pixel values, `height` rows of `width`.
+    pub values: Vec<f64>,
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// Pixel size from `--pixel-size` or the file's metadata, if known.
+    pub pixel_size: Option<PixelSize>,
+    /// The file it came from (a label for messages; nothing here opens it).
+    pub path: PathBuf,
+    /// Zero-based TIFF page (IFD index) it came from.
+    pub page: usize,
+}
+
+impl Image {
+    /// Value at column `x`, row `y`.
+    pub fn at(&self, x: usize, y: usize) -> f64 {
+        self.values[y * self.width + x]
+    }
+
+    /// Pixel size, or an error naming the file and asking for `--pixel-size`.
+    pub fn require_pixel_size(&self) -> Result<PixelSize> {
+        self.pixel_size.ok_or_else(|| {
+            Error::bad_input(
+                Location::file(&self.path),
+                "no pixel size in the file's metadata; give one with --pixel-size (e.g. 200nm)",
+            )
+        })
+    }
+}
+
+/// The override as a [`PixelSize`], else the file's own.
+pub fn pixel_size_or(file: Option<PixelSize>, override_m: Option<(f64, f64)>) -> Option<PixelSize> {
+    match override_m {
+        Some((x_m, y_m)) => Some(PixelSize {
+            x_m,
+            y_m,
+            source: PixelSizeSource::CommandLine,
+        }),
+        None => file,
     }
 }

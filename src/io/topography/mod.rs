@@ -5,7 +5,7 @@
 //! | extension | format | pixel size | height unit |
 //! |---|---|---|---|
 //! | `.npy` | NumPy array, float32/float64, 2-D, C or Fortran order, either byte order | argument (required) | argument (default m) |
-//! | `.tif`, `.tiff` | float32/float64 TIFF, first page ([`crate::stack::tiff`]) | metadata, or the argument | argument (default m) |
+//! | `.tif`, `.tiff` | float32/float64 TIFF, first page ([`crate::io::tiff`]) | metadata, or the argument | argument (default m) |
 //! | `.gsf` | Gwyddion Simple Field | `XReal`/`YReal`, or the argument | `ZUnits` (default m) |
 //! | `.txt`, `.csv`, `.dat` | text matrix, one row per line, `#` comments | argument (required) | argument (default m) |
 //! | `.top` | WSxM (Nanotec) image | header | header |
@@ -28,11 +28,11 @@ use std::path::{Path, PathBuf};
 use ndarray::Array2;
 
 use crate::error::{Error, Location, Result};
-use crate::stack::metadata::length_unit_factor;
-use crate::stack::tiff::TiffReader;
-use crate::stack::{SampleType, Samples};
+use crate::image::{SampleType, Samples};
+use crate::io::tiff::metadata::length_unit_factor;
+use crate::io::tiff::TiffReader;
 
-use super::{Detrend, Topography};
+use crate::surface::{Detrend, Topography};
 
 pub use gsf::{read_gsf, write_gsf};
 pub use nanoscope::read_nanoscope;
@@ -167,7 +167,7 @@ pub(crate) fn unitless_scale(height_unit_m: Option<f64>) -> Result<f64> {
 
 /// Conversion of stored heights to metres. For sub-metre units that are an exact power of ten
 /// (nm, µm) it divides by the integer `1/unit`, so that `6` nm gives exactly the literal `6e-9`
-/// (multiplying by the inexact `1e-9` would not; as in [`crate::units`]).
+/// (multiplying by the inexact `1e-9` would not; as in [`crate::io::units`]).
 pub(crate) fn to_metres(unit_m: f64) -> impl Fn(f64) -> f64 {
     let inverse = (1.0 / unit_m).round();
     let divide = unit_m < 1.0 && inverse * unit_m == 1.0;

@@ -16,8 +16,8 @@ use tiff::tags::Tag;
 use tiff::{ColorType, TiffError};
 
 use super::metadata::{self, ImageJDescription};
-use super::{PixelSize, PixelSizeSource, Plane, SampleType, Samples};
 use crate::error::{Error, Location, Result};
+use crate::image::{PixelSize, PixelSizeSource, Plane, SampleType, Samples};
 
 /// Largest decoded page we accept (bytes); guards allocations against absurd header dimensions.
 pub const MAX_PAGE_BYTES: usize = 1 << 30;

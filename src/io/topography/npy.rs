@@ -82,7 +82,7 @@ pub fn write_npy(path: &Path, topography: &Topography) -> Result<()> {
     for h in topography.heights.iter() {
         out.extend_from_slice(&h.to_le_bytes());
     }
-    crate::output::write_atomic(path, &out)
+    crate::io::staging::write_atomic(path, &out)
 }
 
 fn decode(data: &[u8], dtype: Dtype) -> Vec<f64> {

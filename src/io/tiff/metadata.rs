@@ -5,7 +5,7 @@
 //! resolution tags, so the XML wins; ImageJ writes XResolution as pixels per `unit=` with
 //! ResolutionUnit = NONE, so the unit must come from the description.
 
-use crate::units::Dimension;
+use crate::io::units::Dimension;
 
 /// What an ImageJ ImageDescription (`ImageJ=1.x\nimages=…\nunit=…`) says.
 #[derive(Debug, Clone, Default, PartialEq)]

@@ -1,6 +1,6 @@
 //! Writing TIFF stacks with ImageJ calibration (for generated series and saved masks).
 //!
-//! The ImageJ convention (read back by [`super::tiff`]): ImageDescription on the first page
+//! The ImageJ convention (read back by [`super::read`]): ImageDescription on the first page
 //! with `ImageJ=`, `images=`, `slices=` and `unit=micron`, and X/YResolution as pixels per
 //! micron with ResolutionUnit = NONE.
 

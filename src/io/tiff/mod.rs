@@ -1,58 +1,20 @@
-//! Single images and z stacks as plain `f64` grids with their origin and pixel size: the input
-//! of the optics commands (`psf`, `autocorr`, `newton`, `compare`), which look at one image or
-//! one stack at a time rather than at a load series.
+//! TIFF files: the reader ([`read`]: header facts, pages, channels, pixel-size metadata), the
+//! ImageJ/OME metadata parsers ([`metadata`]) and the writer ([`write`]); plus the single images
+//! and z stacks of the optics commands as [`Image`]s ([`read_pages`], [`read_image`]).
 
-use std::path::{Path, PathBuf};
+pub mod metadata;
+pub mod read;
+pub mod write;
+
+use std::path::Path;
+
+pub use read::{ChannelLayout, TiffInfo, TiffReader};
+pub use write::{
+    encode_f32_stack, encode_u16_stack, encode_u16_stack_compressed, encode_u8_stack, Compression,
+};
 
 use crate::error::{Error, Location, Result};
-use crate::stack::tiff::TiffReader;
-use crate::stack::{PixelSize, PixelSizeSource};
-
-/// One decoded 2-D image, row-major (`values[y * width + x]`), in the file's intensity units.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Image {
-    /// Pixel values, `height` rows of `width`.
-    pub values: Vec<f64>,
-    /// Columns.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-    /// Pixel size from `--pixel-size` or the file's metadata, if known.
-    pub pixel_size: Option<PixelSize>,
-    /// The file it came from.
-    pub path: PathBuf,
-    /// Zero-based TIFF page (IFD index) it came from.
-    pub page: usize,
-}
-
-impl Image {
-    /// Value at column `x`, row `y`.
-    pub fn at(&self, x: usize, y: usize) -> f64 {
-        self.values[y * self.width + x]
-    }
-
-    /// Pixel size, or an error naming the file and asking for `--pixel-size`.
-    pub fn require_pixel_size(&self) -> Result<PixelSize> {
-        self.pixel_size.ok_or_else(|| {
-            Error::bad_input(
-                Location::file(&self.path),
-                "no pixel size in the file's metadata; give one with --pixel-size (e.g. 200nm)",
-            )
-        })
-    }
-}
-
-/// The override as a [`PixelSize`], else the file's own.
-pub fn pixel_size_or(file: Option<PixelSize>, override_m: Option<(f64, f64)>) -> Option<PixelSize> {
-    match override_m {
-        Some((x_m, y_m)) => Some(PixelSize {
-            x_m,
-            y_m,
-            source: PixelSizeSource::CommandLine,
-        }),
-        None => file,
-    }
-}
+use crate::image::{pixel_size_or, Image};
 
 /// Every page of one channel of a TIFF file (a z stack, a time series or a single image), in
 /// page order. `channel` may be `None` for single-channel files only.
@@ -127,7 +89,7 @@ pub fn read_image(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stack::write::encode_u16_stack;
+    use crate::image::PixelSizeSource;
 
     #[test]
     fn pages_and_single_image() {
