@@ -25,13 +25,14 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
 
-use contactscope::analysis::{self, AnalysisOptions, DEFAULT_MEMORY_BUDGET};
+use contactscope::io::series::DEFAULT_MEMORY_BUDGET;
 use contactscope::io::series::{self, Series};
 use contactscope::io::tiff::write::{encode_u16_stack_compressed, Compression};
 use contactscope::io::tiff::TiffReader;
 use contactscope::io::units::{self, Dimension};
+use contactscope::jobs::analyze::report::Report;
+use contactscope::jobs::analyze::{analyze_series, AnalyzeOptions};
 use contactscope::measure::{measure, patch_stats};
-use contactscope::report::Report;
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::{Binning, Histogram, Threshold};
 
@@ -152,13 +153,13 @@ fn generate() -> Data {
 fn whole_job(dir: &Path, forces_n: &[f64], memory_budget: usize) -> (Series, Vec<u8>, f64, u64) {
     let mut series = series::from_files(&[dir.to_path_buf()], None).expect("series");
     series::assign_forces(&mut series, forces_n).expect("forces");
-    let options = AnalysisOptions {
+    let options = AnalyzeOptions {
         memory_budget,
-        ..AnalysisOptions::default()
+        ..AnalyzeOptions::default()
     };
-    let analysis = analysis::analyze(&series, &options, &|_, _, _| {}, &|_, _, _, _| Ok(()))
-        .expect("analysis");
-    let report = Report::new(&analysis, None);
+    let analysis =
+        analyze_series(&series, &options, &|_, _, _| {}, &|_, _, _| Ok(())).expect("analysis");
+    let report = Report::new(&series, &analysis, None);
     let csv = report.areas_csv().expect("csv");
     let threshold = analysis.series_threshold.expect("global").value;
     let contact = analysis

@@ -53,25 +53,27 @@
 
 #![warn(missing_docs)]
 
+pub mod error;
+
+// (a) algorithms on in-memory data
 pub mod analysis;
 pub mod compare;
-pub mod demo;
-pub mod error;
-pub mod fit;
-pub mod fitting;
-pub mod hertz;
 pub mod image;
-pub mod io;
 pub mod measure;
 pub mod mechanics;
+pub mod model_fit;
+pub mod numerics;
 pub mod optics;
-pub mod pipeline;
-pub mod report;
 pub mod solver;
 pub mod spectral;
-pub mod stats;
 pub mod surface;
 pub mod synth;
 pub mod threshold;
+
+// (b) input and output
+pub mod io;
+
+// (c) jobs: one command's whole run, files to files
+pub mod jobs;
 
 pub use error::{Error, Result};

@@ -8,29 +8,37 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use contactscope::analysis::{self, AnalysisOptions, HertzParams, Pass};
-use contactscope::compare::{self as comparison, CompareRequest, CompareSettings, ExperimentInput};
-use contactscope::demo::DemoParams;
-use contactscope::fitting::job::{self as fit_job, FitRequest, Sweep, SweepMicrographs};
-use contactscope::fitting::{Family, Imaging, Search};
+use contactscope::analysis::Pass;
+use contactscope::compare::CompareSettings;
+use contactscope::io::results::fwhm_from_psf_json;
+use contactscope::io::series::DEFAULT_MEMORY_BUDGET;
 use contactscope::io::series::{self, Series};
 use contactscope::io::tiff::write::Compression;
 use contactscope::io::tiff::TiffReader;
 use contactscope::io::topography::{read_topography, write_gsf, write_npy, TopographySource};
 use contactscope::io::units::{self, Dimension};
-use contactscope::mechanics::friction::{self, FrictionRequest, SlipOptions};
-use contactscope::mechanics::squeeze::{self, HertzRequest};
-use contactscope::optics::newton::{self as newton_rings, NewtonOptions, NewtonRequest, Phase};
-use contactscope::optics::psf::{self, PsfRequest};
-use contactscope::pipeline::{self, AnalyzeRequest};
+use contactscope::jobs::analyze::{self as pipeline, AnalyzeRequest};
+use contactscope::jobs::analyze::{AnalyzeOptions, HertzParams};
+use contactscope::jobs::autocorr::{run_autocorr, AutocorrRequest};
+use contactscope::jobs::compare::{self as comparison, CompareRequest, ExperimentInput};
+use contactscope::jobs::demo::DemoParams;
+use contactscope::jobs::fit_hardening::{self as fit_job, FitRequest, Sweep, SweepMicrographs};
+use contactscope::jobs::friction::{self, FrictionRequest};
+use contactscope::jobs::hertz::{self as squeeze, HertzRequest};
+use contactscope::jobs::newton::{self as newton_rings, NewtonRequest};
+use contactscope::jobs::psf::{self as psf_job, PsfRequest};
+use contactscope::jobs::simulate::{self as job, ModelChoice, SimulateRequest};
+use contactscope::jobs::synth_series::{self as synth, Layout};
+use contactscope::mechanics::friction::SlipOptions;
+use contactscope::model_fit::{Family, Imaging, Search};
+use contactscope::optics::newton::{NewtonOptions, Phase};
+use contactscope::optics::psf;
 use contactscope::solver::cg::SolverOptions;
-use contactscope::solver::job::{self, ModelChoice, SimulateRequest};
 use contactscope::solver::simulate::Model;
-use contactscope::spectral::job::{run_autocorr, AutocorrRequest};
 use contactscope::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
 use contactscope::surface::stats::SurfaceStats;
 use contactscope::surface::Detrend;
-use contactscope::synth::{self, Layout, SynthParams};
+use contactscope::synth::SynthParams;
 use contactscope::threshold::Method;
 
 #[derive(Parser)]
@@ -448,7 +456,7 @@ struct AnalyzeArgs {
     #[arg(long)]
     save_masks: bool,
     /// Decoded images of compressed files kept in memory between the two passes, in MiB.
-    #[arg(long, default_value_t = analysis::DEFAULT_MEMORY_BUDGET >> 20)]
+    #[arg(long, default_value_t = DEFAULT_MEMORY_BUDGET >> 20)]
     memory_mib: usize,
     /// No progress bar.
     #[arg(long, short)]
@@ -608,7 +616,7 @@ fn analyze(args: AnalyzeArgs) -> Result<()> {
         }),
         _ => None,
     };
-    let options = AnalysisOptions {
+    let options = AnalyzeOptions {
         method: Method::parse(&args.threshold)?,
         pixel_size_override: optional_pixel_size(&args.pixel_size, "--pixel-size")?,
         hertz,
@@ -666,8 +674,8 @@ fn print_outcome(outcome: &pipeline::AnalyzeOutcome, out: &Path) {
         None => println!("pixel size: unknown, areas in pixels"),
     }
     let unit = match r.unit {
-        contactscope::report::AreaUnit::SquareMicrometre => "µm²",
-        contactscope::report::AreaUnit::Pixel => "px",
+        contactscope::jobs::analyze::AreaUnit::SquareMicrometre => "µm²",
+        contactscope::jobs::analyze::AreaUnit::Pixel => "px",
     };
     println!(
         "{:>10} {:>12} {:>8} {:>10}",
@@ -717,7 +725,8 @@ fn is_per_image(path: &Path) -> bool {
 
 fn threshold(args: ThresholdArgs) -> Result<()> {
     let series = series::from_files(&args.inputs, args.channel)?;
-    let (t, pixels, warnings) = analysis::global_threshold(&series, &|_, _, _| {})?;
+    let (t, pixels, warnings) =
+        contactscope::analysis::global_threshold(&series.planes(0), &|_, _, _| {})?;
     for w in &warnings {
         eprintln!("contactscope: warning: {w}");
     }
@@ -828,7 +837,7 @@ fn demo(args: DemoArgs) -> Result<()> {
             eprintln!("[{:>5.1} s] {stage}", start.elapsed().as_secs_f64());
         }
     };
-    let outcome = contactscope::demo::run_demo(&args.out, &params, &progress)?;
+    let outcome = contactscope::jobs::demo::run_demo(&args.out, &params, &progress)?;
     println!(
         "{:<32} {:>12} {:>22} {:>8}  by",
         "quantity", "truth", "recovered", "error"
@@ -1147,7 +1156,7 @@ fn compare(args: CompareArgs) -> Result<()> {
         }
     };
     let psf_fwhm_m = match (&args.psf, &args.psf_fwhm) {
-        (Some(path), _) => comparison::fwhm_from_psf_json(path)?,
+        (Some(path), _) => fwhm_from_psf_json(path)?,
         (None, Some(text)) => {
             units::parse_positive(text, Dimension::Length).context("--psf-fwhm")?
         }
@@ -1254,7 +1263,7 @@ fn psf(args: PsfArgs) -> Result<()> {
         out_dir: args.out.clone(),
         command_line: std::env::args().collect(),
     };
-    let outcome = psf::run_psf(&request)?;
+    let outcome = psf_job::run_psf(&request)?;
     let r = &outcome.report;
     let s = &r.summary;
     println!(

@@ -13,9 +13,10 @@ use serde_json::Value;
 use contactscope::image::Image;
 use contactscope::image::{PixelSize, PixelSizeSource};
 use contactscope::optics::psf::{
-    fit_spot, measure_psf, synth_beads, BeadKind, BeadParams, PlaneView, PsfOptions, PsfReport,
-    Sampling, SkipReason, SpotOptions, SyntheticBeads, FWHM_PER_SIGMA,
+    fit_spot, measure_psf, PlaneView, PsfOptions, PsfReport, SkipReason, SpotOptions,
+    FWHM_PER_SIGMA,
 };
+use contactscope::synth::beads::{synth_beads, BeadKind, BeadParams, Sampling, SyntheticBeads};
 
 const SIZE: usize = 41;
 const CENTRE: (f64, f64) = (20.37, 19.81);

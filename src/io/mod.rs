@@ -13,8 +13,12 @@
 //! | [`series`] | files, folders and manifests → which page is which load; the file-backed plane source of the series analysis |
 //! | [`topography`] | height maps: `.npy`, float TIFF, `.gsf`, text, WSxM, Nanoscope |
 //! | [`plot`] | charts (PNG/SVG) and micrograph panels (PNG) |
+//! | [`mechanics`] | the mechanics CSVs: friction traces, squeeze tests |
+//! | [`results`] | one command's outputs read by another: `areas.csv`, a `simulate` folder, `psf.json` |
 
+pub mod mechanics;
 pub mod plot;
+pub mod results;
 pub mod series;
 pub mod staging;
 pub mod table;

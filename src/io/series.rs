@@ -4,15 +4,23 @@
 //! `img2` comes before `img10`) or a manifest CSV with columns `file`, optional `page`,
 //! `force_mN` and optional `friction_mN`, paths relative to the manifest's folder.
 //! Pages are zero-based TIFF page (IFD) indices, as tifffile numbers them.
+//!
+//! [`SeriesPlanes`] is the file-backed plane source the series analysis
+//! ([`crate::analysis::analyze`]) reads through, and [`pixel_size`] the series' pixel size from
+//! the files' metadata or an override.
 
 use std::cmp::Ordering;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use super::tiff::{TiffInfo, TiffReader};
+use crate::analysis::PlaneSource;
 use crate::error::{Error, Location, Result};
+use crate::image::{PixelSize, PixelSizeSource, Plane, SampleType};
 
 /// One image of a series.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -377,6 +385,200 @@ fn page_list(pages: &[usize]) -> String {
             .collect::<Vec<_>>()
             .join(","),
     }
+}
+
+/// Default budget for decoded planes of compressed files kept between the two passes of the
+/// analysis.
+pub const DEFAULT_MEMORY_BUDGET: usize = 128 << 20;
+
+impl Series {
+    /// The file-backed plane source of the series for [`crate::analysis`] (see
+    /// [`SeriesPlanes`]).
+    pub fn planes(&self, memory_budget: usize) -> SeriesPlanes<'_> {
+        SeriesPlanes::new(self, memory_budget)
+    }
+}
+
+/// The pixel size for the whole series: the override, or the files' metadata if they agree.
+///
+/// Notes from the files' metadata, and the lack of any pixel size, are added to `warnings`.
+pub fn pixel_size(
+    series: &Series,
+    override_m: Option<(f64, f64)>,
+    warnings: &mut Vec<String>,
+) -> Result<Option<PixelSize>> {
+    if let Some((x_m, y_m)) = override_m {
+        return Ok(Some(PixelSize {
+            x_m,
+            y_m,
+            source: PixelSizeSource::CommandLine,
+        }));
+    }
+    let first = &series.files[0];
+    for other in &series.files[1..] {
+        let agree = match (&first.pixel_size, &other.pixel_size) {
+            (Some(a), Some(b)) => a.same_size(b),
+            (None, None) => true,
+            _ => false,
+        };
+        if !agree {
+            let show = |p: &Option<PixelSize>| {
+                p.map_or("no pixel size".to_string(), |p| {
+                    format!("{:.6}×{:.6} µm", p.x_m * 1e6, p.y_m * 1e6)
+                })
+            };
+            return Err(Error::SeriesMismatch {
+                at: Location::file(&other.path),
+                reason: format!("pixel size is {}", show(&other.pixel_size)),
+                expected: format!("{}; give --pixel-size to override", show(&first.pixel_size)),
+            });
+        }
+    }
+    for f in &series.files {
+        warnings.extend(f.notes.iter().map(|n| format!("{}: {n}", f.path.display())));
+    }
+    if first.pixel_size.is_none() {
+        warnings.push(
+            "no pixel size in the files' metadata and no --pixel-size: areas are in pixels".into(),
+        );
+    }
+    Ok(first.pixel_size)
+}
+
+/// The file-backed [`PlaneSource`] of a series: pages decoded on demand, each run of images of one
+/// file with its own decoder, decoded planes of compressed files kept between the analysis'
+/// passes up to a memory budget (re-reading an uncompressed page costs less than keeping it).
+pub struct SeriesPlanes<'a> {
+    series: &'a Series,
+    cache: Mutex<Vec<Option<Arc<Plane>>>>,
+    cacheable: Vec<bool>,
+    budget_left: Mutex<usize>,
+}
+
+impl<'a> SeriesPlanes<'a> {
+    /// The planes of `series`, keeping up to `budget` bytes of decoded compressed planes.
+    pub fn new(series: &'a Series, budget: usize) -> Self {
+        let compressed = |path: &Path| {
+            series
+                .info_of(path)
+                .is_some_and(|info| info.compression != "none")
+        };
+        SeriesPlanes {
+            series,
+            cache: Mutex::new(vec![None; series.images.len()]),
+            cacheable: series.images.iter().map(|i| compressed(&i.path)).collect(),
+            budget_left: Mutex::new(budget),
+        }
+    }
+
+    fn plane(&self, reader: &mut Option<TiffReader>, i: usize) -> Result<Arc<Plane>> {
+        if let Some(p) = self.cache.lock().expect("lock")[i].clone() {
+            return Ok(p);
+        }
+        let plane = Arc::new(self.read(reader, &self.series.images[i])?);
+        let mut left = self.budget_left.lock().expect("lock");
+        if self.cacheable[i] && plane.heap_bytes() <= *left {
+            *left -= plane.heap_bytes();
+            self.cache.lock().expect("lock")[i] = Some(plane.clone());
+        }
+        Ok(plane)
+    }
+
+    fn read(&self, reader: &mut Option<TiffReader>, image: &ImageRef) -> Result<Plane> {
+        if reader.as_ref().is_none_or(|r| r.info().path != image.path) {
+            *reader = Some(TiffReader::open(&image.path)?);
+        }
+        let reader = reader.as_mut().expect("just opened");
+        let plane = reader.read_page(image.page, self.series.channel)?;
+        check_plane(&plane, self.series, &image.path, image.page)?;
+        Ok(plane)
+    }
+}
+
+impl PlaneSource for SeriesPlanes<'_> {
+    fn len(&self) -> usize {
+        self.series.images.len()
+    }
+
+    fn sample_type(&self) -> SampleType {
+        self.series.files[0].sample_type
+    }
+
+    fn label(&self, index: usize) -> String {
+        let image = &self.series.images[index];
+        Location::page(&image.path, image.page).to_string()
+    }
+
+    /// In parallel over runs of images of one file.
+    fn scan<T: Send, F: Fn(usize, &Plane) -> Result<T> + Sync>(&self, f: F) -> Result<Vec<T>> {
+        let groups = work_units(&self.series.images, rayon::current_num_threads());
+        let results: Vec<Vec<(usize, Result<T>)>> = groups
+            .par_iter()
+            .map(|indices| {
+                let mut reader = None;
+                let mut out = Vec::with_capacity(indices.len());
+                for &i in indices {
+                    let r = self.plane(&mut reader, i).and_then(|p| f(i, &p));
+                    let failed = r.is_err();
+                    out.push((i, r));
+                    if failed {
+                        break;
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut flat: Vec<(usize, Result<T>)> = results.into_iter().flatten().collect();
+        flat.sort_by_key(|(i, _)| *i);
+        if let Some(pos) = flat.iter().position(|(_, r)| r.is_err()) {
+            return Err(flat.swap_remove(pos).1.err().expect("is an error"));
+        }
+        Ok(flat.into_iter().map(|(_, r)| r.expect("checked")).collect())
+    }
+}
+
+fn check_plane(plane: &Plane, series: &Series, path: &Path, page: usize) -> Result<()> {
+    let first = &series.files[0];
+    if (plane.width, plane.height, plane.sample_type)
+        != (first.width, first.height, first.sample_type)
+    {
+        return Err(Error::SeriesMismatch {
+            at: Location::page(path, page),
+            reason: format!(
+                "page is {}×{} {}",
+                plane.width,
+                plane.height,
+                plane.sample_type.name()
+            ),
+            expected: format!(
+                "{}×{} {}",
+                first.width,
+                first.height,
+                first.sample_type.name()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Units of parallel work: the image indices of each file (files in first-use order), split into
+/// runs short enough that a single multi-page file keeps every thread busy. Each unit opens its
+/// own decoder.
+fn work_units(images: &[ImageRef], threads: usize) -> Vec<Vec<usize>> {
+    let mut by_file: HashMap<&Path, usize> = HashMap::new();
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (i, image) in images.iter().enumerate() {
+        let g = *by_file.entry(&image.path).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(i);
+    }
+    let run = images.len().div_ceil(4 * threads.max(1)).max(1);
+    groups
+        .iter()
+        .flat_map(|g| g.chunks(run).map(<[usize]>::to_vec))
+        .collect()
 }
 
 #[cfg(test)]

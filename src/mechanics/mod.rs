@@ -4,4 +4,5 @@
 //! ("Mechanical testing") and Fig. 3b. Conventions: `docs/mechanics.md`.
 
 pub mod friction;
+pub mod hertz;
 pub mod squeeze;

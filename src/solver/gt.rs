@@ -1555,7 +1555,7 @@ mod tests {
     fn hertz_limit() {
         // σ = 1e-4·δ_Hertz: the asperity layer is a stiff penalty, GT must give Hertz.
         let (force, radius, e_star) = (0.01, 290e-6, 3.7e9);
-        let a = crate::hertz::contact_radius(force, radius, e_star);
+        let a = crate::mechanics::hertz::contact_radius(force, radius, e_star);
         let delta = a * a / radius;
         let params = ps_sphere(1e-4 * delta);
         let profile = gt_profile(&params, force).unwrap();
@@ -1608,7 +1608,7 @@ mod tests {
                     let u = &profile.separation_m;
                     assert!(u.windows(2).all(|w| w[1] > w[0]), "{what}");
                     // Roughness spreads the load: the centre never exceeds Hertz's p₀.
-                    let a = crate::hertz::contact_radius(force, 290e-6, 3.7e9);
+                    let a = crate::mechanics::hertz::contact_radius(force, 290e-6, 3.7e9);
                     assert!(p[0] < 1.001 * 2.0 * 3.7e9 * a / (PI * 290e-6), "{what}");
                     assert!(profile.gt_area_m2 > 0.0 && profile.gt_area_m2.is_finite());
                 }

@@ -22,9 +22,10 @@ use crate::image::Samples;
 pub const FLOAT_BINS: usize = 4096;
 
 /// How the threshold is chosen.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Method {
     /// One exact Otsu threshold over the pooled histogram of all images (the paper's rule).
+    #[default]
     GlobalOtsu,
     /// Each image its own Otsu threshold (for comparison).
     PerImageOtsu,

@@ -13,13 +13,9 @@
 
 pub mod gap;
 pub mod profile;
-mod report;
-pub mod synth;
 
-pub use crate::stats::MeanSd;
+pub use crate::numerics::stats::MeanSd;
 pub use gap::{fit_hertz_gap, hertz_gap, ring_gap, GapFit, Phase};
-pub use report::{run_newton, NewtonOutcome, NewtonRequest};
-pub use synth::{synth_newton, NewtonSynth, NewtonSynthParams, NewtonTruth};
 
 use crate::error::{Error, Location, Result};
 use crate::image::Image;

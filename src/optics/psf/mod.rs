@@ -23,18 +23,14 @@
 mod detect;
 mod fit;
 mod lm;
-mod report;
 mod skip;
-mod synth;
 
 pub use detect::{detect, Candidate, DetectOptions, Detection};
 pub use fit::{fit_spot, Gauss2dFit, PlaneView, RadialFit, SpotFailure, SpotFit, SpotOptions};
-pub use report::{run_psf, PsfOutcome, PsfRequest};
 pub use skip::SkipReason;
 
-pub use crate::stats::MeanSd;
+pub use crate::numerics::stats::MeanSd;
 use skip::{implausible, pre_fit_skip};
-pub use synth::{synth_beads, BeadKind, BeadParams, BeadTruth, Sampling, SyntheticBeads};
 
 use crate::error::{Error, Location, Result};
 use crate::image::Image;

@@ -11,8 +11,6 @@
 //! once. Hardening and hardness runs load in increasing force order, carrying the plastic
 //! deformation from load to load, as an experiment's load ramp does.
 
-pub mod job;
-
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use serde_json::{json, Value};
 
+use crate::analysis::fit::fit_power_law;
 use crate::error::{Error, Result};
-use crate::fit::fit_power_law;
 use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::io::staging::Staging;
 use crate::io::tiff::write::encode_f32_stack;
@@ -16,10 +16,10 @@ use crate::measure::patches::count_patches;
 use crate::surface::stats::SurfaceStats;
 use crate::surface::Topography;
 
-use super::cg::{Monitor, SolverOptions};
-use super::gt::{gt_bearing_area, gt_profile, GtParams};
-use super::halfspace::Boundary;
-use super::simulate::{separation, sweep, LoadStep, Model, Setup};
+use crate::solver::cg::{Monitor, SolverOptions};
+use crate::solver::gt::{gt_bearing_area, gt_profile, GtParams};
+use crate::solver::halfspace::Boundary;
+use crate::solver::simulate::{separation, sweep, LoadStep, Model, Setup};
 
 /// Which model to run.
 #[derive(Debug, Clone, Copy, PartialEq)]

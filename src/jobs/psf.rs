@@ -13,7 +13,8 @@ use crate::io::staging::Staging;
 use crate::io::tiff::read_pages;
 use crate::io::tiff::TiffReader;
 
-use super::{measure_psf, BeadMeasurement, MeanSd, PsfOptions, PsfReport, FWHM_PER_SIGMA};
+use crate::numerics::stats::MeanSd;
+use crate::optics::psf::{measure_psf, BeadMeasurement, PsfOptions, PsfReport, FWHM_PER_SIGMA};
 
 /// Beads drawn in `psf_profiles.png` at most (the legend stays readable).
 const MAX_PLOTTED_BEADS: usize = 8;

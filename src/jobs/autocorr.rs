@@ -1,7 +1,7 @@
 //! The `autocorr` job: radially averaged intensity autocorrelations of several images (an
 //! experiment and a simulation, say) as one CSV, one JSON of correlation lengths and one linear
 //! plot with a curve per image, so they can be compared as in Weber et al. 2018 (patch scale
-//! ≈ 5 µm). The estimator and its choices are in [`super::autocorrelation`].
+//! ≈ 5 µm). The estimator and its choices are in [`crate::spectral::autocorrelation`].
 
 use std::path::{Path, PathBuf};
 
@@ -13,68 +13,7 @@ use crate::io::plot::{Axes, Chart, Curve, Legend};
 use crate::io::staging::Staging;
 use crate::io::tiff::read_pages;
 
-use super::autocorrelation::{autocorrelation, first_crossing, radial_average};
-
-/// Radially averaged autocorrelation of one image with its correlation lengths.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AcfCurve {
-    /// Name in tables and legends: the file name, with `:page N` for multi-page files.
-    pub label: String,
-    /// `(lag in m, C)`, C(0) = 1.
-    pub profile: Vec<(f64, f64)>,
-    /// First lag where C ≤ 1/e, m.
-    pub xi_1e_m: Option<f64>,
-    /// First lag where C ≤ 0, m.
-    pub first_zero_m: Option<f64>,
-}
-
-impl AcfCurve {
-    /// The autocorrelation of `values` (`height` rows of `width`, pixel `dx_m × dy_m`) up to
-    /// `max_lag_m`.
-    pub fn of_grid(
-        label: &str,
-        values: &[f64],
-        (width, height): (usize, usize),
-        (dx_m, dy_m): (f64, f64),
-        max_lag_m: f64,
-    ) -> Result<Self> {
-        if !(max_lag_m.is_finite() && max_lag_m > 0.0) {
-            return Err(Error::InvalidArgument(format!(
-                "largest lag {max_lag_m:e} m is not a positive length"
-            )));
-        }
-        let acf = autocorrelation(values, width, height)?;
-        let profile = radial_average(&acf, dx_m, dy_m, max_lag_m);
-        Ok(AcfCurve {
-            label: label.to_string(),
-            xi_1e_m: first_crossing(&profile, (-1.0f64).exp()),
-            first_zero_m: first_crossing(&profile, 0.0),
-            profile,
-        })
-    }
-
-    /// C interpolated linearly at `lag_m`, `None` outside the profile.
-    pub fn at(&self, lag_m: f64) -> Option<f64> {
-        self.profile.windows(2).find_map(|w| {
-            let ((r0, c0), (r1, c1)) = (w[0], w[1]);
-            (r0..=r1)
-                .contains(&lag_m)
-                .then(|| c0 + (c1 - c0) * (lag_m - r0) / (r1 - r0))
-        })
-    }
-
-    /// Root-mean-square difference between two curves over their common lags (sampled at this
-    /// curve's lags), or `None` if they share no lag.
-    pub fn rms_distance(&self, other: &AcfCurve) -> Option<f64> {
-        let diffs: Vec<f64> = self
-            .profile
-            .iter()
-            .filter_map(|&(r, c)| other.at(r).map(|o| c - o))
-            .collect();
-        (!diffs.is_empty())
-            .then(|| (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt())
-    }
-}
+use crate::spectral::autocorrelation::AcfCurve;
 
 /// Everything `autocorr` needs, already parsed.
 #[derive(Debug, Clone)]

@@ -17,9 +17,9 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Poisson};
 use serde::Serialize;
 
-use super::gap::{hertz_gap, Phase};
 use crate::error::{Error, Result};
-use crate::synth::gaussian_blur;
+use crate::optics::blur::isotropic_blur;
+use crate::optics::newton::gap::{hertz_gap, Phase};
 
 /// Parameters of [`synth_newton`]. SI units.
 #[derive(Debug, Clone, Serialize)]
@@ -143,7 +143,7 @@ pub fn synth_newton(p: &NewtonSynthParams) -> Result<NewtonSynth> {
         .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
     let sigma_px = p.psf_fwhm_m / (8.0 * 2f64.ln()).sqrt() / p.pixel_size_m;
-    let blur = |v: &[f64]| gaussian_blur(v, p.width, p.height, sigma_px);
+    let blur = |v: &[f64]| isotropic_blur(v, p.width, p.height, sigma_px);
     let fluorescence: Vec<f64> = blur(&fluorescence)
         .iter()
         .map(|v| v + p.fluorescence_background)

@@ -10,10 +10,11 @@ use serde_json::json;
 use super::{DemoParams, Recovered};
 use crate::compare::Comparison;
 use crate::error::{Error, Result};
-use crate::fitting::{Family, ModelFit};
 use crate::io::plot::edge_panels_png;
 use crate::io::staging::write_atomic;
-use crate::spectral::job::{acf_chart, AcfCurve};
+use crate::jobs::autocorr::acf_chart;
+use crate::model_fit::{Family, ModelFit};
+use crate::spectral::autocorrelation::AcfCurve;
 
 /// Everything the report shows.
 pub(super) struct Facts<'a> {

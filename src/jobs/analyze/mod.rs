@@ -1,19 +1,80 @@
 //! The `analyze` job end to end: a validated request in, staged outputs committed, a summary
 //! out. The command line only builds an [`AnalyzeRequest`] and prints the [`AnalyzeOutcome`].
+//! [`analyze_series`] is the analysis of a series of files without the outputs.
+
+pub mod report;
 
 use std::path::{Path, PathBuf};
 
 use serde_json::json;
 
+pub use report::{AreaUnit, HertzParams, Report, Row};
+
 use crate::analysis::{self, Analysis, AnalysisOptions, ImageSink, Progress};
 use crate::error::Result;
 use crate::image::Plane;
 use crate::io::plot::overlay_png;
-use crate::io::series::{ImageRef, Series};
+use crate::io::series::{self, ImageRef, Series, DEFAULT_MEMORY_BUDGET};
 use crate::io::staging::Staging;
 use crate::io::tiff::write::encode_u8_stack;
 use crate::measure::Mask;
-use crate::report::{inputs_json, threshold_json, Report};
+use crate::threshold::Method;
+use report::{inputs_json, threshold_json};
+
+/// What to do with a series of files, beyond the series itself.
+#[derive(Debug, Clone)]
+pub struct AnalyzeOptions {
+    /// Threshold method.
+    pub method: Method,
+    /// Pixel size (x, y) in metres that overrides the files' metadata.
+    pub pixel_size_override: Option<(f64, f64)>,
+    /// Hertz reference parameters.
+    pub hertz: Option<HertzParams>,
+    /// Bytes of decoded planes of compressed files to keep between passes.
+    pub memory_budget: usize,
+}
+
+impl Default for AnalyzeOptions {
+    fn default() -> Self {
+        AnalyzeOptions {
+            method: Method::GlobalOtsu,
+            pixel_size_override: None,
+            hertz: None,
+            memory_budget: DEFAULT_MEMORY_BUDGET,
+        }
+    }
+}
+
+/// Analyse a series of files: the pixel size from the override or the files' metadata (they
+/// must agree), then [`analysis::analyze`] over the files' planes. Warnings about the pixel size
+/// come first in the result's warnings.
+pub fn analyze_series(
+    series: &Series,
+    options: &AnalyzeOptions,
+    progress: Progress,
+    sink: ImageSink,
+) -> Result<Analysis> {
+    if series.images.is_empty() {
+        return Err(crate::error::Error::InvalidArgument(
+            "the series has no images".into(),
+        ));
+    }
+    let mut warnings = Vec::new();
+    let pixel_size = series::pixel_size(series, options.pixel_size_override, &mut warnings)?;
+    let analysis_options = AnalysisOptions {
+        method: options.method,
+        pixel_size,
+    };
+    let mut analysis = analysis::analyze(
+        &series.planes(options.memory_budget),
+        &analysis_options,
+        progress,
+        sink,
+    )?;
+    warnings.append(&mut analysis.warnings);
+    analysis.warnings = warnings;
+    Ok(analysis)
+}
 
 /// Everything `analyze` needs, already validated.
 #[derive(Debug, Clone)]
@@ -21,7 +82,7 @@ pub struct AnalyzeRequest {
     /// The series with forces.
     pub series: Series,
     /// Analysis options.
-    pub options: AnalysisOptions,
+    pub options: AnalyzeOptions,
     /// Output folder.
     pub out_dir: PathBuf,
     /// Write one overlay PNG per image.
@@ -78,12 +139,12 @@ pub fn run_analyze(request: &AnalyzeRequest, progress: Progress) -> Result<Analy
         .chain(request.series.manifest.clone())
         .collect();
     let staging = Staging::new(&request.out_dir, &inputs)?;
-    let sink = |i: usize, image: &ImageRef, plane: &Plane, mask: &Mask| -> Result<()> {
-        write_image_outputs(&staging, request, i, image, plane, mask)
+    let sink = |i: usize, plane: &Plane, mask: &Mask| -> Result<()> {
+        write_image_outputs(&staging, request, i, plane, mask)
     };
     let sink: ImageSink = &sink;
-    let analysis = analysis::analyze(&request.series, &request.options, progress, sink)?;
-    let report = Report::new(&analysis, request.options.hertz);
+    let analysis = analyze_series(&request.series, &request.options, progress, sink)?;
+    let report = Report::new(&request.series, &analysis, request.options.hertz);
     staging.write("areas.csv", &report.areas_csv()?)?;
     let plot = report.area_plot("Contact area versus normal force");
     staging.write("area_vs_load.png", &plot.to_png()?)?;
@@ -95,8 +156,8 @@ pub fn run_analyze(request: &AnalyzeRequest, progress: Progress) -> Result<Analy
         "inputs": inputs_json(&request.series, &analysis),
         "threshold": threshold_json(&analysis, integer),
         "area_unit": match report.unit {
-            crate::report::AreaUnit::SquareMicrometre => "um2",
-            crate::report::AreaUnit::Pixel => "px",
+            AreaUnit::SquareMicrometre => "um2",
+            AreaUnit::Pixel => "px",
         },
         "fits": report.fits_json(),
         "hertz": request.options.hertz.map(|h| json!({
@@ -119,10 +180,10 @@ fn write_image_outputs(
     staging: &Staging,
     request: &AnalyzeRequest,
     index: usize,
-    image: &ImageRef,
     plane: &Plane,
     mask: &Mask,
 ) -> Result<()> {
+    let image = &request.series.images[index];
     let stem = image_stem(index, image);
     if request.overlays {
         let png = overlay_png(

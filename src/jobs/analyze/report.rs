@@ -1,18 +1,25 @@
-//! Turning an [`Analysis`] into the table, the summary and the plot. No computation beyond unit
-//! conversion and the area–load fits lives here.
-
-use std::path::Path;
+//! Turning an [`Analysis`] of a series into the table, the summary and the plot. No computation
+//! beyond unit conversion, the area–load fits ([`crate::analysis::fit`]) and the Hertz reference
+//! ([`crate::mechanics::hertz`]) lives here.
 
 use serde::Serialize;
 use serde_json::{json, Value};
 
-use crate::analysis::{Analysis, HertzParams};
+use crate::analysis::fit::{fit_power_law, fit_proportional, PowerLawFit};
+use crate::analysis::Analysis;
 use crate::error::{Error, Result};
-use crate::fit::{fit_power_law, fit_proportional, PowerLawFit};
-use crate::hertz;
 use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::io::series::Series;
-use crate::io::table::Table;
+use crate::mechanics::hertz;
+
+/// Sphere radius and contact modulus for the Hertz reference columns.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct HertzParams {
+    /// Sphere radius, metres.
+    pub radius_m: f64,
+    /// Contact modulus E*, pascals.
+    pub modulus_pa: f64,
+}
 
 /// One row of `areas.csv`, in physical units where a pixel size is known.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -101,27 +108,28 @@ pub struct Report {
 }
 
 impl Report {
-    /// Derive rows and fits.
-    pub fn new(analysis: &Analysis, hertz: Option<HertzParams>) -> Self {
+    /// Derive rows and fits; `analysis` is the analysis of `series`, image by image.
+    pub fn new(series: &Series, analysis: &Analysis, hertz: Option<HertzParams>) -> Self {
         let unit = match analysis.pixel_size {
             Some(_) => AreaUnit::SquareMicrometre,
             None => AreaUnit::Pixel,
         };
         let pixel_area = analysis.pixel_size.map_or(1.0, |p| p.area_um2());
-        let rows: Vec<Row> = analysis
+        let rows: Vec<Row> = series
             .images
             .iter()
-            .map(|r| {
+            .zip(&analysis.images)
+            .map(|(image, r)| {
                 let m = &r.measurement;
                 let area = m.contact_pixels as f64 * pixel_area;
-                let force_mn = r.image.force_n.map(|f| f * 1e3);
-                let hertz_radius = match (hertz, r.image.force_n) {
+                let force_mn = image.force_n.map(|f| f * 1e3);
+                let hertz_radius = match (hertz, image.force_n) {
                     (Some(h), Some(f)) => Some(hertz::contact_radius(f, h.radius_m, h.modulus_pa)),
                     _ => None,
                 };
                 Row {
-                    image: r.image.path.display().to_string(),
-                    page: r.image.page,
+                    image: image.path.display().to_string(),
+                    page: image.page,
                     force_mn,
                     threshold: r.threshold.value,
                     contact_pixels: m.contact_pixels,
@@ -136,7 +144,7 @@ impl Report {
                         _ => None,
                     },
                     equivalent_radius: (area / std::f64::consts::PI).sqrt(),
-                    friction_mn: r.image.friction_n.map(|f| f * 1e3),
+                    friction_mn: image.friction_n.map(|f| f * 1e3),
                     hertz_radius_um: hertz_radius.map(|a| a * 1e6),
                     hertz_area_um2: hertz_radius.map(|a| std::f64::consts::PI * a * a * 1e12),
                 }
@@ -372,29 +380,4 @@ pub fn threshold_json(analysis: &Analysis, integer: bool) -> Value {
             format!("{} equal bins over the series' finite min..max; threshold = upper edge of the highest background bin", crate::threshold::FLOAT_BINS)
         },
     })
-}
-
-/// (force N, area m²) rows of an `analyze` areas.csv (columns `force_mN`, `area_um2`); a table
-/// in pixels is refused with a hint, as is one without rows.
-pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
-    let table = Table::read(path)?;
-    for column in ["force_mN", "area_um2"] {
-        if !table.header().iter().any(|h| h == column) {
-            let hint = if column == "area_um2" && table.header().iter().any(|h| h == "area_px") {
-                " (areas are in pixels: run analyze with --pixel-size)"
-            } else {
-                ""
-            };
-            return Err(Error::bad_input(
-                table.location(),
-                format!("no {column} column{hint}; columns found: {}", table.found()),
-            ));
-        }
-    }
-    let forces = table.numbers("force_mN", 1e-3)?;
-    let areas = table.numbers("area_um2", 1e-12)?;
-    if forces.is_empty() {
-        return Err(Error::bad_input(table.location(), "no rows"));
-    }
-    Ok(forces.into_iter().zip(areas).collect())
 }

@@ -1,4 +1,6 @@
-//! Summary statistics shared by the commands.
+//! Summary statistics shared by the commands: mean ± sample sd and the median. Kept here rather
+//! than taken from a crate: each is a few lines, exact, and needs no conversion of our slices
+//! (`statrs`' `Data` would copy every slice into its own container first).
 
 /// Mean and sample standard deviation (n − 1; `None` for a single value).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,6 +39,25 @@ impl MeanSd {
     }
 }
 
+/// Median (mean of the middle two for an even count); NaN for an empty slice. Sorts `values`.
+pub fn median_in_place(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+/// [`median_in_place`] of a copy.
+pub fn median(values: &[f64]) -> f64 {
+    median_in_place(&mut values.to_vec())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -48,5 +69,15 @@ mod tests {
         assert_eq!(MeanSd::of(&[4.0]).unwrap().sd, None);
         assert_eq!(MeanSd::of(&[]), None);
         assert_eq!(m.scaled(2.0).sd, Some(2.0));
+    }
+
+    #[test]
+    fn median_of_even_and_odd() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(median(&[]).is_nan());
+        let mut v = [3.0, 1.0, 2.0];
+        assert_eq!(median_in_place(&mut v), 2.0);
+        assert_eq!(v, [1.0, 2.0, 3.0], "sorted in place");
     }
 }

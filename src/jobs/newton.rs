@@ -5,11 +5,12 @@ use std::path::PathBuf;
 
 use serde_json::{json, Value};
 
-use super::{analyse, hertz_gap, ring_gap, MeanSd, NewtonAnalysis, NewtonOptions};
 use crate::error::{Error, Result};
 use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::io::staging::Staging;
 use crate::io::tiff::read_image;
+use crate::numerics::stats::MeanSd;
+use crate::optics::newton::{analyse, hertz_gap, ring_gap, NewtonAnalysis, NewtonOptions};
 
 /// What `contactscope newton` asks for.
 #[derive(Debug, Clone)]

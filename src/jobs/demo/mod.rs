@@ -20,32 +20,32 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::AnalysisOptions;
-use crate::compare::{
-    compare_maps, CompareSettings, Comparison, ExperimentInput, Micrographs, SimulatedMap,
-};
+use crate::compare::{compare_maps, CompareSettings, Comparison, SimulatedMap};
 use crate::error::{Error, Result};
-use crate::fitting::job::{run_fit, FitRequest};
-use crate::fitting::{Family, Imaging, ModelBody, Search};
 use crate::io::series;
 use crate::io::staging::write_atomic;
 use crate::io::tiff::write::encode_u16_stack;
 use crate::io::topography::{write_npy, TopographySource};
-use crate::mechanics::friction::{
-    self, CsvLayout, FrictionRequest, SlipOptions, TraceParams, XAxis,
-};
-use crate::mechanics::squeeze::{run_hertz, HertzRequest};
+use crate::jobs::analyze::AnalyzeOptions;
+use crate::jobs::analyze::{run_analyze, AnalyzeRequest};
+use crate::jobs::compare::{load_micrographs, ExperimentInput};
+use crate::jobs::fit_hardening::{run_fit, FitRequest};
+use crate::jobs::friction::{run_friction, FrictionRequest};
+use crate::jobs::hertz::{run_hertz, HertzRequest};
+use crate::jobs::newton::{run_newton, NewtonRequest};
+use crate::jobs::psf::{run_psf, PsfRequest};
+use crate::mechanics::friction::{SlipOptions, XAxis};
+use crate::model_fit::{Family, Imaging, ModelBody, Search};
 use crate::optics::blur::Grid;
-use crate::optics::newton::{
-    run_newton, synth_newton, NewtonOptions, NewtonRequest, NewtonSynthParams,
-};
-use crate::optics::psf::{run_psf, synth_beads, BeadParams, PsfRequest};
-use crate::pipeline::{run_analyze, AnalyzeRequest};
+use crate::optics::newton::NewtonOptions;
 use crate::solver::cg::SolverOptions;
 use crate::solver::halfspace::Boundary;
 use crate::solver::simulate::{sweep, Model, Setup};
 use crate::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
 use crate::surface::Topography;
+use crate::synth::beads::{synth_beads, BeadParams};
+use crate::synth::rings::{synth_newton, NewtonSynthParams};
+use crate::synth::traces::{synthetic_trace, trace_csv, CsvLayout, TraceParams};
 use crate::synth::{render_micrograph, MicrographParams};
 use crate::threshold::Method;
 
@@ -382,7 +382,7 @@ fn write_micrographs(p: &DemoParams, maps: &[Grid], data: &Path) -> Result<PathB
 fn analyze(work: &Path, manifest: &Path) -> Result<Vec<(f64, f64)>> {
     let request = AnalyzeRequest {
         series: series::from_manifest(manifest, None)?,
-        options: AnalysisOptions {
+        options: AnalyzeOptions {
             method: Method::GlobalOtsu,
             pixel_size_override: None,
             hertz: None,
@@ -481,7 +481,7 @@ fn hertz(work: &Path, data: &Path, p: &DemoParams) -> Result<Recovered> {
     let mut text = String::from("force_mN,displacement_um\n");
     for i in 0..25 {
         let force = 2e-3 + 48e-3 * f64::from(i) / 24.0;
-        let delta = crate::hertz::approach(force, radius, p.e_star_pa);
+        let delta = crate::mechanics::hertz::approach(force, radius, p.e_star_pa);
         let noise: f64 = rand_distr::Distribution::sample(&rand_distr::StandardNormal, &mut rng);
         text.push_str(&format!(
             "{},{}\n",
@@ -521,7 +521,7 @@ fn friction(
     let mut traces = Vec::new();
     for (i, &(force, area)) in measured.iter().enumerate() {
         let f_s = p.tau_pa * area;
-        let trace = friction::synthetic_trace(&TraceParams {
+        let trace = synthetic_trace(&TraceParams {
             static_friction_n: f_s,
             kinetic_friction_n: 0.8 * f_s,
             // Loading over 20 µm of drive, as the generator's default trace.
@@ -531,7 +531,7 @@ fn friction(
             seed: p.seed + i as u64,
             ..TraceParams::default()
         });
-        let text = friction::trace_csv(
+        let text = trace_csv(
             &trace,
             &CsvLayout {
                 x_axis: XAxis::Displacement,
@@ -544,7 +544,7 @@ fn friction(
         write_atomic(&path, text.as_bytes())?;
         traces.push(path);
     }
-    let outcome = friction::run_friction(&FrictionRequest {
+    let outcome = run_friction(&FrictionRequest {
         traces,
         normal_force_n: None,
         rotation_radius_m: None,
@@ -570,7 +570,7 @@ fn friction(
 /// The fitted parameters of the demo's model fit.
 struct FitResult {
     k: Recovered,
-    fits: Vec<crate::fitting::ModelFit>,
+    fits: Vec<crate::model_fit::ModelFit>,
     k_pa_per_m: f64,
     hardness_pa: f64,
 }
@@ -639,7 +639,7 @@ fn compare_models(
     manifest: &Path,
     fit: &FitResult,
 ) -> Result<Vec<(String, Comparison)>> {
-    let micrographs = Micrographs::load(
+    let (_, micrographs) = load_micrographs(
         &ExperimentInput::Manifest(manifest.to_path_buf()),
         None,
         None,

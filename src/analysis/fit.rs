@@ -80,7 +80,7 @@ pub fn fit_proportional(x: &[f64], y: &[f64]) -> Option<(f64, usize)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hertz::contact_radius;
+    use crate::mechanics::hertz::contact_radius;
 
     #[test]
     fn hertz_areas_give_two_thirds() {

@@ -7,15 +7,18 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
-use super::{fit_parameter, Evaluation, Family, Imaging, Measured, ModelBody, ModelFit, Search};
-use crate::compare::{compare_maps, CompareSettings, ExperimentInput, Micrographs, SimulatedMap};
+use crate::compare::{compare_maps, CompareSettings, Micrographs, SimulatedMap};
 use crate::error::{Error, Location, Result};
 use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
+use crate::io::results::read_areas_csv;
 use crate::io::staging::Staging;
 use crate::io::topography::TopographySource;
 use crate::io::units::{self, Dimension};
+use crate::jobs::compare::{load_micrographs, ExperimentInput};
+use crate::model_fit::{
+    fit_parameter, Evaluation, Family, Imaging, Measured, ModelBody, ModelFit, Search,
+};
 use crate::optics::blur::Grid;
-use crate::report::read_areas_csv;
 use crate::solver::cg::SolverOptions;
 use crate::surface::stats::SurfaceStats;
 
@@ -156,7 +159,10 @@ pub fn run_fit(request: &FitRequest) -> Result<FitOutcome> {
     let micrographs = request
         .micrographs
         .as_ref()
-        .map(|m| Micrographs::load(&m.experiment, m.channel, m.pixel_size_m))
+        .map(|m| {
+            load_micrographs(&m.experiment, m.channel, m.pixel_size_m)
+                .map(|(_, micrographs)| micrographs)
+        })
         .transpose()?;
     let mut warnings = Vec::new();
     let mut fits = Vec::new();

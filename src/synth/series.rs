@@ -11,17 +11,14 @@
 //!
 //! The ground truth per image is the number of true contact pixels and its area.
 
-use std::path::{Path, PathBuf};
-
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Poisson, StandardNormal};
+use rand_distr::StandardNormal;
 use serde::Serialize;
 
+use super::micrograph::shot_noise_12bit;
 use crate::error::{Error, Result};
-use crate::io::staging::write_atomic;
-use crate::io::tiff::write::{encode_u16_stack_compressed, Compression};
-use crate::optics::blur::{self, Edges};
+use crate::optics::blur::isotropic_blur;
 
 /// Parameters of a synthetic series. SI units.
 #[derive(Debug, Clone, Serialize)]
@@ -149,7 +146,7 @@ pub fn generate(p: &SynthParams) -> Result<Vec<SynthImage>> {
             .iter()
             .map(|&t| if t { signal } else { 0.0 })
             .collect();
-        let blurred = gaussian_blur(&ideal, p.width, p.height, psf_sigma_px);
+        let blurred = isotropic_blur(&ideal, p.width, p.height, psf_sigma_px);
         let codes = render(p, &blurred, &mut rng)?;
         images.push(SynthImage {
             force_n: force,
@@ -186,7 +183,7 @@ fn normalised_noise(p: &SynthParams, correlation_m: f64, rng: &mut ChaCha8Rng) -
     let white: Vec<f64> = (0..p.width * p.height)
         .map(|_| rng.sample(StandardNormal))
         .collect();
-    let mut field = gaussian_blur(&white, p.width, p.height, correlation_m / p.pixel_size_m);
+    let mut field = isotropic_blur(&white, p.width, p.height, correlation_m / p.pixel_size_m);
     let n = field.len() as f64;
     let mean = field.iter().sum::<f64>() / n;
     let sd = (field.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
@@ -207,199 +204,9 @@ fn render(p: &SynthParams, signal: &[f64], rng: &mut ChaCha8Rng) -> Result<Vec<u
     shot_noise_12bit(&expected, p.counts_per_photon, rng)
 }
 
-/// Photon shot noise on expected grey levels (Poisson in photons of `counts_per_photon` grey
-/// levels each), rounded and clipped to 12 bits.
-fn shot_noise_12bit(
-    expected: &[f64],
-    counts_per_photon: f64,
-    rng: &mut ChaCha8Rng,
-) -> Result<Vec<u16>> {
-    expected
-        .iter()
-        .map(|&e| {
-            let photons = Poisson::new(e.max(1e-9) / counts_per_photon)
-                .map_err(|e| Error::InvalidArgument(format!("shot noise: {e}")))?
-                .sample(rng);
-            Ok((photons * counts_per_photon).round().clamp(0.0, 4095.0) as u16)
-        })
-        .collect()
-}
-
-/// How [`render_micrograph`] turns a simulated contact map into a 12-bit confocal image.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MicrographParams {
-    /// PSF full width at half maximum, m.
-    pub fwhm_m: f64,
-    /// Image pixel size, m (square pixels).
-    pub pixel_m: f64,
-    /// Image width, pixels.
-    pub width: usize,
-    /// Image height, pixels.
-    pub height: usize,
-    /// Image pixel (x, y) where the map's first pixel corner lands.
-    pub corner_px: (usize, usize),
-    /// Background grey level.
-    pub background: f64,
-    /// Grey level added by a fully covered contact pixel.
-    pub contact_level: f64,
-    /// Grey levels per detected photon (shot noise); 0 for none.
-    pub counts_per_photon: f64,
-    /// Noise seed.
-    pub seed: u64,
-}
-
-/// A simulated contact map (1 = contact) as the microscope would record it: blurred by the PSF and
-/// integrated onto image pixels ([`crate::optics::blur::microscope_image`]), placed on a
-/// background, with shot noise, 12 bits. Errors if the map does not fit the image.
-pub fn render_micrograph(map: &blur::Grid, p: &MicrographParams) -> Result<Vec<u16>> {
-    let image = blur::microscope_image(map, p.fwhm_m, (p.pixel_m, p.pixel_m))?;
-    let (x0, y0) = p.corner_px;
-    if x0 + image.width > p.width || y0 + image.height > p.height {
-        return Err(Error::InvalidArgument(format!(
-            "the rendered map ({}×{} px) at ({x0}, {y0}) does not fit a {}×{} image",
-            image.width, image.height, p.width, p.height
-        )));
-    }
-    let mut expected = vec![p.background; p.width * p.height];
-    for y in 0..image.height {
-        for x in 0..image.width {
-            expected[(y + y0) * p.width + x + x0] +=
-                p.contact_level * image.values[y * image.width + x];
-        }
-    }
-    if p.counts_per_photon <= 0.0 {
-        return Ok(expected
-            .iter()
-            .map(|v| v.round().clamp(0.0, 4095.0) as u16)
-            .collect());
-    }
-    shot_noise_12bit(
-        &expected,
-        p.counts_per_photon,
-        &mut ChaCha8Rng::seed_from_u64(p.seed),
-    )
-}
-
-/// Separable Gaussian blur with mirrored edges; `sigma_px` in pixels (see
-/// [`crate::optics::blur::gaussian_blur`]).
-pub fn gaussian_blur(data: &[f64], width: usize, height: usize, sigma_px: f64) -> Vec<f64> {
-    blur::gaussian_blur(data, width, height, (sigma_px, sigma_px), Edges::Mirror)
-}
-
-/// How a generated series is laid out on disk.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Layout {
-    /// One multi-page TIFF `series.tif`.
-    MultiPage,
-    /// One file per load, `load_01.tif`, `load_02.tif`, …
-    Files,
-}
-
-/// Write a generated series into `dir`: the TIFF(s), `manifest.csv` (file, page, force_mN) and
-/// `truth.csv` (true contact pixels and area per image). Returns the files written.
-pub fn write_series(p: &SynthParams, dir: &Path, layout: Layout) -> Result<Vec<PathBuf>> {
-    write_series_compressed(p, dir, layout, Compression::None)
-}
-
-/// [`write_series`] with a choice of TIFF compression.
-pub fn write_series_compressed(
-    p: &SynthParams,
-    dir: &Path,
-    layout: Layout,
-    compression: Compression,
-) -> Result<Vec<PathBuf>> {
-    let images = generate(p)?;
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let size = Some((p.pixel_size_m, p.pixel_size_m));
-    let description = format!(
-        "contactscope synth-series seed={} fwhm_nm={:.0}\n",
-        p.seed,
-        p.psf_fwhm_m * 1e9
-    );
-    let encode = |pages: &[&[u16]]| {
-        encode_u16_stack_compressed(pages, p.width, p.height, size, &description, compression)
-    };
-    let mut written = Vec::new();
-    let mut locations = Vec::new();
-    match layout {
-        Layout::MultiPage => {
-            let pages: Vec<&[u16]> = images.iter().map(|im| im.codes.as_slice()).collect();
-            let bytes = encode(&pages)?;
-            written.push(write_file(dir, "series.tif", &bytes)?);
-            locations.extend((0..images.len()).map(|i| ("series.tif".to_string(), i)));
-        }
-        Layout::Files => {
-            let digits = images.len().to_string().len().max(2);
-            for (i, im) in images.iter().enumerate() {
-                let name = format!("load_{:0digits$}.tif", i + 1);
-                let bytes = encode(&[&im.codes])?;
-                written.push(write_file(dir, &name, &bytes)?);
-                locations.push((name, 0));
-            }
-        }
-    }
-    let mut manifest = String::from("file,page,force_mN\n");
-    let mut truth = String::from("file,page,force_mN,true_contact_pixels,true_area_um2\n");
-    for ((file, page), im) in locations.iter().zip(&images) {
-        let force_mn = im.force_n * 1e3;
-        manifest.push_str(&format!("{file},{page},{force_mn}\n"));
-        truth.push_str(&format!(
-            "{file},{page},{force_mn},{},{:.6}\n",
-            im.true_contact_pixels, im.true_area_um2
-        ));
-    }
-    written.push(write_file(dir, "manifest.csv", manifest.as_bytes())?);
-    written.push(write_file(dir, "truth.csv", truth.as_bytes())?);
-    Ok(written)
-}
-
-fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
-    let path = dir.join(name);
-    write_atomic(&path, bytes)?;
-    Ok(path)
-}
-
-/// True areas (µm²) from a `truth.csv` written by [`write_series`], in row order.
-pub fn read_truth(path: &Path) -> Result<Vec<f64>> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let mut reader = csv::Reader::from_reader(text.as_bytes());
-    let bad = |reason: String| Error::bad_input(crate::error::Location::file(path), reason);
-    let column = reader
-        .headers()
-        .map_err(|e| bad(e.to_string()))?
-        .iter()
-        .position(|h| h == "true_area_um2")
-        .ok_or_else(|| bad("no column true_area_um2".into()))?;
-    reader
-        .records()
-        .map(|r| {
-            let r = r.map_err(|e| bad(e.to_string()))?;
-            r.get(column)
-                .and_then(|v| v.parse().ok())
-                .ok_or_else(|| bad("true_area_um2 is not a number".into()))
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn blur_preserves_mass_and_matches_gaussian_width() {
-        let (w, h) = (41, 41);
-        let mut delta = vec![0.0; w * h];
-        delta[20 * w + 20] = 1.0;
-        let out = gaussian_blur(&delta, w, h, 2.0);
-        assert!((out.iter().sum::<f64>() - 1.0).abs() < 1e-12);
-        let var: f64 = out
-            .iter()
-            .enumerate()
-            .map(|(i, v)| v * ((i % w) as f64 - 20.0).powi(2))
-            .sum();
-        // The kernel is cut at 4σ, which lowers the variance by about 0.03 %.
-        assert!((var - 4.0).abs() < 2e-3, "variance {var}");
-    }
 
     #[test]
     fn generation_is_deterministic_and_truth_follows_the_area_law() {
