@@ -20,6 +20,7 @@
 //! P = (4/3)E*√R (δ − δ₀)^(3/2), minimises the same residual over δ₀ and is reported separately.
 
 use crate::error::{Error, Result};
+use crate::numerics::golden::golden_section;
 
 /// Fewest loaded points (P > 0) a fit needs.
 pub const MIN_POINTS: usize = 3;
@@ -199,25 +200,23 @@ fn ss_res(points: &[SqueezePoint], fit: &HertzFit) -> f64 {
     fit.residuals(points).iter().map(|r| r * r).sum()
 }
 
-/// Minimum of `f` on [lo, hi]: the best of 200 grid points, then golden section in its bracket.
+/// Minimum of `f` on [lo, hi]: the best of 200 grid points, then golden section in its bracket
+/// down to 1e-12 of the range (below the rounding of δ for any loaded squeeze curve).
 fn minimise(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
     const GRID: usize = 200;
     let at = |i: usize| lo + (hi - lo) * i as f64 / GRID as f64;
     let best = (0..=GRID)
         .min_by(|&a, &b| f(at(a)).total_cmp(&f(at(b))))
         .unwrap_or(0);
-    let (mut a, mut b) = (at(best.saturating_sub(1)), at((best + 1).min(GRID)));
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    for _ in 0..100 {
-        let c = b - g * (b - a);
-        let d = a + g * (b - a);
-        if f(c) < f(d) {
-            b = d;
-        } else {
-            a = c;
-        }
+    let (a, b) = (at(best.saturating_sub(1)), at((best + 1).min(GRID)));
+    let width = 1e-12 * (hi - lo);
+    let found = golden_section(a, b, width, &mut |x| {
+        Ok::<f64, std::convert::Infallible>(f(x))
+    });
+    match found {
+        Ok(m) => m.x,
+        Err(never) => match never {},
     }
-    0.5 * (a + b)
 }
 
 #[cfg(test)]

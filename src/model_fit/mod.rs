@@ -14,6 +14,7 @@
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::numerics::golden::golden_section;
 use crate::optics::blur::{microscope_image, Grid};
 use crate::solver::cg::SolverOptions;
 use crate::solver::gt::{gt_bearing_area, gt_profile, GtParams};
@@ -409,17 +410,18 @@ pub fn fit_parameter(
         .min_by(|&i, &j| values[i].total_cmp(&values[j]))
         .expect("grid is not empty");
     let at_range_edge = best == 0 || best == values.len() - 1;
-    let (mut x0, mut x1) = (
+    let (x0, x1) = (
         grid[best.saturating_sub(1)],
         grid[(best + 1).min(grid.len() - 1)],
     );
-    let ln_best = golden_section(&mut x0, &mut x1, search.ln_tolerance, &mut |x| {
+    let ln_best = golden_section(x0, x1, search.ln_tolerance, &mut |x| {
         let m = misfit_at(x).unwrap_or(f64::INFINITY);
         if m.is_finite() {
             trace.push((x.exp(), m));
         }
-        Ok(m)
-    })?;
+        Ok::<f64, Error>(m)
+    })?
+    .x;
     let best_eval = body.score(family, Some(ln_best.exp()), measured, false)?;
     let parameter_se = standard_error(body, family, measured, ln_best, &best_eval)?;
     Ok(ModelFit {
@@ -429,37 +431,6 @@ pub fn fit_parameter(
         trace,
         at_range_edge,
     })
-}
-
-/// Minimum of a unimodal function on [x0, x1] by golden-section search to width `tolerance`.
-fn golden_section(
-    x0: &mut f64,
-    x1: &mut f64,
-    tolerance: f64,
-    f: &mut dyn FnMut(f64) -> Result<f64>,
-) -> Result<f64> {
-    let ratio = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = (*x0, *x1);
-    let mut c = b - ratio * (b - a);
-    let mut d = a + ratio * (b - a);
-    let (mut fc, mut fd) = (f(c)?, f(d)?);
-    while b - a > tolerance {
-        if fc <= fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - ratio * (b - a);
-            fc = f(c)?;
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + ratio * (b - a);
-            fd = f(d)?;
-        }
-    }
-    (*x0, *x1) = (a, b);
-    Ok(if fc <= fd { c } else { d })
 }
 
 /// Gauss–Newton standard error of the parameter at `ln_best` (see the module docs); `None` with a
@@ -501,19 +472,6 @@ fn standard_error(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn golden_section_finds_a_parabola_minimum() {
-        let (mut a, mut b) = (-3.0, 5.0);
-        let mut calls = 0;
-        let x = golden_section(&mut a, &mut b, 1e-6, &mut |x| {
-            calls += 1;
-            Ok((x - 1.234).powi(2))
-        })
-        .unwrap();
-        assert!((x - 1.234).abs() < 1e-6, "{x}");
-        assert!(calls < 40, "{calls} evaluations");
-    }
 
     #[test]
     fn misfit_is_rms_log_ratio() {
