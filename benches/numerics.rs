@@ -14,12 +14,11 @@
 //! Run with `cargo bench --bench numerics`; see `docs/performance.md`.
 
 use std::hint::black_box;
-use std::path::PathBuf;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 
-use contactscope::image::{Image, PixelSize, PixelSizeSource};
+use contactscope::io::tiff::{encode_u16_stack, read_pages};
 use contactscope::io::topography::{read_npy, write_npy};
 use contactscope::mechanics::hertz;
 use contactscope::mechanics::squeeze::{fit_hertz_with_offset, SqueezePoint};
@@ -67,24 +66,19 @@ fn psf(c: &mut Criterion) {
         ..BeadParams::default()
     })
     .expect("beads");
-    let pixel = PixelSize {
-        x_m: 100e-9,
-        y_m: 100e-9,
-        source: PixelSizeSource::CommandLine,
-    };
-    let images: Vec<Image> = beads
-        .planes
-        .iter()
-        .enumerate()
-        .map(|(page, codes)| Image {
-            values: codes.iter().map(|&c| f64::from(c)).collect(),
-            width: beads.width,
-            height: beads.height,
-            pixel_size: Some(pixel),
-            path: PathBuf::from("beads.tif"),
-            page,
-        })
-        .collect();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("beads.tif");
+    let pages: Vec<&[u16]> = beads.planes.iter().map(Vec::as_slice).collect();
+    let tiff = encode_u16_stack(
+        &pages,
+        beads.width,
+        beads.height,
+        Some((100e-9, 100e-9)),
+        "",
+    )
+    .expect("tiff");
+    std::fs::write(&path, tiff).expect("write");
+    let images = read_pages(&path, None, None).expect("read");
     let mut g = c.benchmark_group("psf");
     g.sample_size(10).measurement_time(Duration::from_secs(3));
     g.bench_function("measure", |b| {

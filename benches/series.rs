@@ -14,7 +14,7 @@
 //! (decode, histogram, classify + measure, patch labelling) to show where the time goes.
 //!
 //! The data are generated once per run (fixed seed, the CLI's default 2018) into a temporary
-//! folder with the same parameters as `bench/run_comparison.sh` uses through
+//! folder with the same parameters as `benches/python/run_comparison.sh` uses through
 //! `contactscope synth-series --size 1024 --loads <40 forces>`; set `CONTACTSCOPE_BENCH_DIR` to
 //! keep them in a folder of your choice instead. Run with `cargo bench --bench series`; see
 //! `docs/performance.md`.
@@ -42,7 +42,7 @@ const PIXEL_SIZE_M: f64 = 200e-9;
 const SEED: u64 = 2018;
 
 /// The 40 forces as the CLI receives them: log-spaced 4…400 mN, three decimals.
-/// `bench/run_comparison.sh` builds the same string.
+/// `benches/python/run_comparison.sh` builds the same string.
 fn forces_text() -> String {
     let items: Vec<String> = (0..IMAGES)
         .map(|i| format!("{:.3}", 4.0 * 100f64.powf(i as f64 / (IMAGES - 1) as f64)))

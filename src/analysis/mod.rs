@@ -324,3 +324,61 @@ fn integer_offset(sample_type: SampleType) -> i32 {
         _ => 0,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plane(width: usize, codes: Vec<u16>) -> Plane {
+        let height = codes.len() / width;
+        Plane::from_u16(width, height, codes)
+    }
+
+    #[test]
+    fn in_memory_planes_give_the_histogram_threshold() {
+        // Two 4×2 planes, background 10 and contact 50; one pixel of contact in the first,
+        // three in the second.
+        let planes = [
+            plane(4, vec![10, 10, 10, 50, 10, 10, 10, 10]),
+            plane(4, vec![50, 50, 10, 50, 10, 10, 10, 10]),
+        ];
+        let seen = AtomicUsize::new(0);
+        let sink = |_: usize, _: &Plane, _: &Mask| {
+            seen.fetch_add(1, Ordering::Relaxed);
+            Ok(())
+        };
+        let a = analyze(
+            &planes[..],
+            &AnalysisOptions::default(),
+            &|_, _, _| {},
+            &sink,
+        )
+        .unwrap();
+        let t = a.series_threshold.unwrap().value;
+        assert!((10.0..50.0).contains(&t), "{t}");
+        let counts: Vec<u64> = a
+            .images
+            .iter()
+            .map(|r| r.measurement.contact_pixels)
+            .collect();
+        assert_eq!(counts, vec![1, 3]);
+        assert_eq!((a.histogram_pixels, seen.into_inner()), (16, 2));
+    }
+
+    #[test]
+    fn in_memory_planes_must_agree_and_exist() {
+        let planes = [plane(4, vec![1; 8]), plane(2, vec![2; 8])];
+        let err = global_threshold(&planes[..], &|_, _, _| {})
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("image 1 is 2×4"), "{err}");
+        let none: [Plane; 0] = [];
+        assert!(analyze(
+            &none[..],
+            &AnalysisOptions::default(),
+            &|_, _, _| {},
+            &|_, _, _| Ok(())
+        )
+        .is_err());
+    }
+}

@@ -10,6 +10,7 @@ use clap::ValueEnum;
 
 use contactscope::io::topography::TopographySource;
 use contactscope::io::units::{self, Dimension};
+use contactscope::solver::cg::SolverOptions;
 use contactscope::surface::Detrend;
 
 /// `--pixel-size`: overrides the files' calibration.
@@ -54,6 +55,28 @@ macro_rules! default_out {
     };
 }
 pub(crate) use default_out;
+
+/// The contact solver's stopping rule (`simulate`, `fit-hardening`).
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct SolverArgs {
+    /// Relative CG tolerance.
+    #[arg(long, default_value_t = 1e-8)]
+    pub tolerance: f64,
+    /// Most CG iterations per load.
+    #[arg(long, default_value_t = 5000)]
+    pub max_iterations: usize,
+}
+
+impl SolverArgs {
+    /// The solver options (no progress monitor).
+    pub fn options(&self) -> SolverOptions<'static> {
+        SolverOptions {
+            max_iterations: self.max_iterations,
+            tolerance: self.tolerance,
+            monitor: None,
+        }
+    }
+}
 
 /// `--quiet`, `-q`.
 #[derive(clap::Args, Clone, Copy, Debug)]

@@ -9,9 +9,8 @@ use contactscope::io::units::{self, Dimension};
 use contactscope::jobs::compare::ExperimentInput;
 use contactscope::jobs::fit_hardening::{run_fit, FitRequest, Sweep, SweepMicrographs};
 use contactscope::model_fit::{Family, Imaging, Search};
-use contactscope::solver::cg::SolverOptions;
 
-use super::args::{default_out, optional_pixel_size, BodyArgs, OutputFolder};
+use super::args::{default_out, optional_pixel_size, BodyArgs, OutputFolder, SolverArgs};
 use super::{command_line, print_warnings, print_written};
 
 default_out!(Out, "contactscope-out/fit");
@@ -52,12 +51,8 @@ pub struct Args {
     /// Periodic boundaries (nominally flat periodic maps).
     #[arg(long)]
     periodic: bool,
-    /// CG relative tolerance.
-    #[arg(long, default_value_t = 1e-8)]
-    tolerance: f64,
-    /// CG iteration limit per load.
-    #[arg(long, default_value_t = 5000)]
-    max_iterations: usize,
+    #[command(flatten)]
+    solver: SolverArgs,
     #[command(flatten)]
     out: OutputFolder<Out>,
 }
@@ -151,11 +146,7 @@ pub fn run(args: Args) -> Result<()> {
         sweep,
         micrographs: sweep_micrographs(&args)?,
         imaging: imaging(&args)?,
-        options: SolverOptions {
-            max_iterations: args.max_iterations,
-            tolerance: args.tolerance,
-            monitor: None,
-        },
+        options: args.solver.options(),
         out_dir: args.out.out.clone(),
         command_line: command_line(),
     };

@@ -6,10 +6,9 @@ use indicatif::ProgressStyle;
 
 use contactscope::io::units::{self, Dimension};
 use contactscope::jobs::simulate::{run_simulate, ModelChoice, SimulateRequest};
-use contactscope::solver::cg::SolverOptions;
 use contactscope::solver::simulate::Model;
 
-use super::args::{default_out, BodyArgs, OutputFolder, Quiet};
+use super::args::{default_out, BodyArgs, OutputFolder, Quiet, SolverArgs};
 use super::{command_line, print_warnings, print_written, progress_bar};
 
 default_out!(Out, "contactscope-out/simulate");
@@ -51,12 +50,8 @@ pub struct Args {
     /// Loads: 4mN,10mN,40mN or 4mN..400mN:12 (log-spaced).
     #[arg(long)]
     loads: String,
-    /// Relative solver tolerance.
-    #[arg(long, default_value_t = 1e-8)]
-    tolerance: f64,
-    /// Most CG iterations per solve.
-    #[arg(long, default_value_t = 5000)]
-    max_iterations: usize,
+    #[command(flatten)]
+    solver: SolverArgs,
     #[command(flatten)]
     out: OutputFolder<Out>,
     #[command(flatten)]
@@ -114,11 +109,7 @@ pub fn run(args: Args) -> Result<()> {
         model: model_of(&args)?,
         periodic: args.periodic,
         loads_n: units::parse_loads(&args.loads).context("--loads")?,
-        options: SolverOptions {
-            max_iterations: args.max_iterations,
-            tolerance: args.tolerance,
-            monitor: None,
-        },
+        options: args.solver.options(),
         out_dir: args.out.out.clone(),
         command_line: command_line(),
     };

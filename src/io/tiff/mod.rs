@@ -1,5 +1,5 @@
 //! TIFF files: the reader ([`read`]: header facts, pages, channels, pixel-size metadata), the
-//! ImageJ/OME metadata parsers ([`metadata`]) and the writer ([`write`]); plus the single images
+//! ImageJ/OME metadata parsers ([`metadata`]) and the writer ([`mod@write`]); plus the single images
 //! and z stacks of the optics commands as [`Image`]s ([`read_pages`], [`read_image`]).
 
 pub mod metadata;

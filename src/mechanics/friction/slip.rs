@@ -213,7 +213,7 @@ fn first_local_min(smooth: &[f64], from: usize) -> usize {
         .unwrap_or(smooth.len() - 1)
 }
 
-/// Least-squares line through the `samples` points ending at `end`, evaluated at x[end].
+/// Least-squares line through the `samples` points ending at `end`, evaluated at `x[end]`.
 fn line_value_at(x: &[f64], f: &[f64], end: usize, samples: usize) -> f64 {
     let start = end.saturating_sub(samples.max(2) - 1);
     let (xs, fs) = (&x[start..=end], &f[start..=end]);

@@ -8,7 +8,7 @@
 //! fluorescent edge r_f gives the gap at which the molecules light up: the detection gap (the
 //! paper: 9 nm, averaged over 20 profiles).
 //!
-//! [`analyse`] does the measurement on two images in memory; [`run_newton`] reads the files and
+//! [`analyse`] does the measurement on two images in memory; [`crate::jobs::newton::run_newton`] reads the files and
 //! writes `newton.json`, `newton_rings.csv`, `newton_profiles.csv` and `newton_gap.png`.
 
 pub mod gap;

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # contactscope CLI vs tifffile + scikit-image on the same files, plus peak memory.
 #
-#   bench/run_comparison.sh            # from the repository root, after `cargo build --release`
+#   benches/python/run_comparison.sh            # from the repository root, after `cargo build --release`
 #
 # Generates under /tmp/cs-bench (override with CS_BENCH_DIR; nothing is written in the repo):
 #   cmp/files_raw       40 × 1024² uint16 single-page TIFFs (contactscope synth-series --layout files)
@@ -16,10 +16,10 @@
 # hyperfine.
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/.." && pwd)
+REPO=$(cd "$(dirname "$0")/../.." && pwd)
 ROOT=${CS_BENCH_DIR:-/tmp/cs-bench}
 CS=$REPO/target/release/contactscope
-PY=$REPO/bench/python_baseline.py
+PY=$REPO/benches/python/python_baseline.py
 RUNS=${RUNS:-10}
 RES=$ROOT/results
 mkdir -p "$ROOT/cmp" "$ROOT/big" "$RES"
