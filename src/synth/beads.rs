@@ -16,7 +16,6 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Poisson};
 
 use crate::error::{Error, Result};
-use crate::io::tiff::write::encode_u16_stack;
 
 /// How a spot is turned into pixel values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -124,20 +123,6 @@ pub struct SyntheticBeads {
     pub height: usize,
     /// One entry per bead.
     pub truth: Vec<BeadTruth>,
-}
-
-impl SyntheticBeads {
-    /// The planes as an uncompressed 16-bit TIFF with ImageJ calibration (pixel size in m).
-    pub fn to_tiff(&self, pixel_size_m: Option<f64>) -> Result<Vec<u8>> {
-        let pages: Vec<&[u16]> = self.planes.iter().map(|p| p.as_slice()).collect();
-        encode_u16_stack(
-            &pages,
-            self.width,
-            self.height,
-            pixel_size_m.map(|p| (p, p)),
-            "",
-        )
-    }
 }
 
 /// Generate beads as described in the module documentation.

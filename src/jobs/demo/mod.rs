@@ -412,7 +412,9 @@ fn psf(work: &Path, data: &Path, p: &DemoParams) -> Result<Recovered> {
         ..BeadParams::default()
     })?;
     let path = data.join("beads.tif");
-    write_atomic(&path, &beads.to_tiff(Some(pixel))?)?;
+    let pages: Vec<&[u16]> = beads.planes.iter().map(Vec::as_slice).collect();
+    let tiff = encode_u16_stack(&pages, beads.width, beads.height, Some((pixel, pixel)), "")?;
+    write_atomic(&path, &tiff)?;
     let outcome = run_psf(&PsfRequest {
         input: path,
         channel: None,
