@@ -2,10 +2,11 @@
 //! beside it: [`stats`] (mean ± sample sd, the median) and [`golden`] (golden-section search
 //! with an absolute stopping width).
 //!
-//! What was taken from crates instead: erfc (`libm`), the complete elliptic integrals
-//! (`ellip`), the dense LU solve of the Greenwood–Tripp Newton iteration (`nalgebra`) and the
-//! bead fits' Levenberg–Marquardt (`levenberg-marquardt`); `.npy` reading stays ours
-//! ([`crate::io::topography`], reason there).
+//! What was taken from crates instead: erfc (`libm`) and the bead fits' Levenberg–Marquardt
+//! (`levenberg-marquardt`). Kept elsewhere, with the measured reason beside the code: the
+//! complete elliptic integrals and the dense solve of the Greenwood–Tripp model
+//! ([`crate::solver::gt`], speed) and `.npy` reading ([`crate::io::topography`], hostile
+//! input).
 
 pub mod golden;
 pub mod stats;

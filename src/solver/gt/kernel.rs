@@ -389,18 +389,48 @@ pub(super) fn max_abs(a: &[f64]) -> f64 {
     a.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
-/// Solves A·x = b (A row-major n × n) by LU decomposition with partial pivoting (nalgebra);
-/// `None` if A is singular or the solution not finite. Against our former Gaussian elimination
-/// on 256 × 256 systems: the same residual (1e-15) and time (2.6 ms against 2.2 ms, copy into
-/// column-major order included); `docs/performance.md`.
-pub(super) fn solve_dense(a: Vec<f64>, b: Vec<f64>) -> Option<Vec<f64>> {
+/// Solves A·x = b (A row-major n × n) by Gaussian elimination with partial pivoting; `None` if
+/// A is singular or not finite.
+///
+/// Kept rather than `nalgebra`'s LU, for speed (`docs/performance.md`, "Numerics from crates"):
+/// on random 256 × 256 systems both reach the same residual (1e-15) in about the same time
+/// (2.2 against 2.6 ms), but on the Newton systems of [`super::gt_profile`] (Weber et al.'s
+/// sphere at 4 mN) the whole profile took 36.5 ms with this elimination and 53.1 ms with the LU (the same elliptic
+/// integrals in both builds).
+pub(super) fn solve_dense(mut a: Vec<f64>, mut b: Vec<f64>) -> Option<Vec<f64>> {
     let n = b.len();
-    let x = nalgebra::DMatrix::from_row_slice(n, n, &a)
-        .lu()
-        .solve(&nalgebra::DVector::from_vec(b))?;
-    x.iter()
-        .all(|v| v.is_finite())
-        .then(|| x.as_slice().to_vec())
+    for col in 0..n {
+        let pivot =
+            (col..n).max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))?;
+        let pv = a[pivot * n + col];
+        if !(pv.abs() > 0.0 && pv.is_finite()) {
+            return None;
+        }
+        if pivot != col {
+            for k in 0..n {
+                a.swap(pivot * n + k, col * n + k);
+            }
+            b.swap(pivot, col);
+        }
+        let (head, tail) = a.split_at_mut((col + 1) * n);
+        let pivot_row = &head[col * n + col..];
+        let b_col = b[col];
+        for (r, row) in tail.chunks_exact_mut(n).enumerate() {
+            let f = row[col] / pv;
+            if f != 0.0 {
+                for (x, y) in row[col..].iter_mut().zip(pivot_row) {
+                    *x -= f * y;
+                }
+                b[col + 1 + r] -= f * b_col;
+            }
+        }
+    }
+    for col in (0..n).rev() {
+        let row = &a[col * n..(col + 1) * n];
+        let s = dot(&row[col + 1..], &b[col + 1..]);
+        b[col] = (b[col] - s) / row[col];
+    }
+    b.iter().all(|x| x.is_finite()).then_some(b)
 }
 
 /// How [`RadialKernel::solve`] iterates.
