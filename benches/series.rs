@@ -14,7 +14,7 @@
 //! (decode, histogram, classify + measure, patch labelling) to show where the time goes.
 //!
 //! The data are generated once per run (fixed seed, the CLI's default 2018) into a temporary
-//! folder with the same parameters as `bench/run_comparison.sh` uses through
+//! folder with the same parameters as `benches/python/run_comparison.sh` uses through
 //! `contactscope synth-series --size 1024 --loads <40 forces>`; set `CONTACTSCOPE_BENCH_DIR` to
 //! keep them in a folder of your choice instead. Run with `cargo bench --bench series`; see
 //! `docs/performance.md`.
@@ -25,15 +25,16 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
 
-use contactscope::analysis::{self, AnalysisOptions, DEFAULT_MEMORY_BUDGET};
+use contactscope::io::series::DEFAULT_MEMORY_BUDGET;
+use contactscope::io::series::{self, Series};
+use contactscope::io::tiff::write::{encode_u16_stack_compressed, Compression};
+use contactscope::io::tiff::TiffReader;
+use contactscope::io::units::{self, Dimension};
+use contactscope::jobs::analyze::report::Report;
+use contactscope::jobs::analyze::{analyze_series, AnalyzeOptions};
 use contactscope::measure::{measure, patch_stats};
-use contactscope::report::Report;
-use contactscope::stack::series::{self, Series};
-use contactscope::stack::tiff::TiffReader;
-use contactscope::stack::write::{encode_u16_stack_compressed, Compression};
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::{Binning, Histogram, Threshold};
-use contactscope::units::{self, Dimension};
 
 const SIZE: usize = 1024;
 const IMAGES: usize = 40;
@@ -41,7 +42,7 @@ const PIXEL_SIZE_M: f64 = 200e-9;
 const SEED: u64 = 2018;
 
 /// The 40 forces as the CLI receives them: log-spaced 4…400 mN, three decimals.
-/// `bench/run_comparison.sh` builds the same string.
+/// `benches/python/run_comparison.sh` builds the same string.
 fn forces_text() -> String {
     let items: Vec<String> = (0..IMAGES)
         .map(|i| format!("{:.3}", 4.0 * 100f64.powf(i as f64 / (IMAGES - 1) as f64)))
@@ -152,13 +153,13 @@ fn generate() -> Data {
 fn whole_job(dir: &Path, forces_n: &[f64], memory_budget: usize) -> (Series, Vec<u8>, f64, u64) {
     let mut series = series::from_files(&[dir.to_path_buf()], None).expect("series");
     series::assign_forces(&mut series, forces_n).expect("forces");
-    let options = AnalysisOptions {
+    let options = AnalyzeOptions {
         memory_budget,
-        ..AnalysisOptions::default()
+        ..AnalyzeOptions::default()
     };
-    let analysis = analysis::analyze(&series, &options, &|_, _, _| {}, &|_, _, _, _| Ok(()))
-        .expect("analysis");
-    let report = Report::new(&analysis, None);
+    let analysis =
+        analyze_series(&series, &options, &|_, _, _| {}, &|_, _, _| Ok(())).expect("analysis");
+    let report = Report::new(&series, &analysis, None);
     let csv = report.areas_csv().expect("csv");
     let threshold = analysis.series_threshold.expect("global").value;
     let contact = analysis
@@ -220,7 +221,7 @@ fn series_benches(c: &mut Criterion) {
     let plane = TiffReader::open(&raw).unwrap().read_page(0, 0).unwrap();
     assert_eq!(
         plane.samples,
-        contactscope::stack::Samples::Int {
+        contactscope::image::Samples::Int {
             codes: data.codes[last].clone(),
             offset: 0
         },

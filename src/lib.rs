@@ -2,25 +2,33 @@
 //!
 //! Real-contact-area microscopy after Weber et al., Nat. Commun. 9, 888 (2018): confocal images of a
 //! rough sphere pressed on a rigidochromic coverslip, one per normal load, become an
-//! area-versus-load table.
+//! area-versus-load table, checked against contact mechanics.
 //!
-//! The pipeline, one module per stage:
+//! ## Four layers
 //!
-//! 1. [`stack`] — TIFF pages to [`stack::Plane`]s with pixel-size metadata; [`stack::series`]
-//!    turns files, directories and manifests into an ordered load series.
-//! 2. [`threshold`] — a mergeable [`threshold::Histogram`] and an exact Otsu threshold over the
-//!    whole series (Otsu 1979).
-//! 3. [`measure`] — contact pixels, area, intensities and 8-connected patches per image.
-//! 4. [`fit`] — power-law and proportional area–load fits; [`hertz`] reference formulas.
-//! 5. [`analysis`] — runs 1–4 over a series in two streaming passes with bounded memory.
-//! 6. [`report`], [`plot`], [`output`] — CSV, JSON and PNG/SVG outputs, written atomically;
-//!    [`pipeline`] runs the whole `analyze` job.
-//! 7. [`synth`] — a seeded generator of realistic load series with known ground truth.
-//! 8. [`mechanics`] — rheometer friction traces (F = τ·A) and squeeze tests (Hertz E*).
+//! * **(a) Algorithms on in-memory data**, one module per stage, no file access:
+//!   [`image`] (planes and pixel sizes) → [`threshold`] (mergeable histogram, exact Otsu 1979) →
+//!   [`measure`] (contact pixels, intensities, patches) → [`analysis`] (the two-pass series
+//!   analysis over a [`analysis::PlaneSource`]; area–load fits). Beside them: [`optics`] (PSF,
+//!   blur, Newton rings), [`spectral`] (FFTs, autocorrelation, registration), [`surface`]
+//!   (height maps), [`solver`] (half-space contact, plasticity, Greenwood–Tripp), [`mechanics`]
+//!   (friction, squeeze tests, Hertz), [`compare`] (simulated maps against micrographs),
+//!   [`model_fit`] (contact models fitted to an area–load curve), [`synth`] (seeded generators
+//!   with known truth) and [`numerics`].
+//! * **(b) I/O**, [`io`]: every file format, quantities as text, atomic output folders.
+//! * **(c) Jobs**, [`jobs`]: one command's whole run, files to files, a typed request in and an
+//!   outcome out; the command line and (later) Python call them.
+//! * **(d) Front-ends**: the `contactscope` binary (`src/main.rs`, `src/cli/`) parses, calls a
+//!   job and prints.
+//!
+//! `docs/architecture.md` draws the picture and follows `analyze`, `simulate`, `compare` and
+//! `fit-hardening` through it.
+//!
+//! ## The pipeline in memory
 //!
 //! ```
 //! use contactscope::measure::measure;
-//! use contactscope::stack::Plane;
+//! use contactscope::image::Plane;
 //! use contactscope::synth::{generate, SynthParams};
 //! use contactscope::threshold::{Binning, Histogram, Threshold};
 //!
@@ -45,6 +53,11 @@
 //!     let area_um2 = m.contact_pixels as f64 * 0.04;
 //!     assert!((area_um2 / truth.true_area_um2 - 1.0).abs() < 0.15);
 //! }
+//!
+//! // The same two passes as one call: the series analysis over the in-memory planes.
+//! use contactscope::analysis::{analyze, AnalysisOptions};
+//! let analysis = analyze(planes.as_slice(), &AnalysisOptions::default(), &|_, _, _| {}, &|_, _, _| Ok(()))?;
+//! assert_eq!(analysis.series_threshold.map(|s| s.value), Some(t.value));
 //! # Ok::<(), contactscope::Error>(())
 //! ```
 //!
@@ -53,27 +66,27 @@
 
 #![warn(missing_docs)]
 
+pub mod error;
+
+// (a) algorithms on in-memory data
 pub mod analysis;
 pub mod compare;
-pub mod demo;
-pub mod error;
-pub mod fit;
-pub mod fitting;
-pub mod hertz;
+pub mod image;
 pub mod measure;
 pub mod mechanics;
+pub mod model_fit;
+pub mod numerics;
 pub mod optics;
-pub mod output;
-pub mod pipeline;
-pub mod plot;
-pub mod report;
 pub mod solver;
 pub mod spectral;
-pub mod stack;
-pub mod stats;
 pub mod surface;
 pub mod synth;
 pub mod threshold;
-pub mod units;
+
+// (b) input and output
+pub mod io;
+
+// (c) jobs: one command's whole run, files to files
+pub mod jobs;
 
 pub use error::{Error, Result};

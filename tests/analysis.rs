@@ -6,9 +6,10 @@ mod common;
 use std::io::Cursor;
 use std::path::Path;
 
-use contactscope::analysis::{analyze, Analysis, AnalysisOptions};
-use contactscope::stack::series;
-use contactscope::stack::write::{encode_u16_stack_compressed, Compression};
+use contactscope::analysis::Analysis;
+use contactscope::io::series;
+use contactscope::io::tiff::write::{encode_u16_stack_compressed, Compression};
+use contactscope::jobs::analyze::{analyze_series, AnalyzeOptions};
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::Method;
 use tiff::encoder::{colortype, TiffEncoder};
@@ -30,9 +31,9 @@ fn write_deflate(path: &Path, pages: &[Vec<u16>], width: usize, height: usize) {
     std::fs::write(path, bytes).unwrap();
 }
 
-fn run(paths: &[std::path::PathBuf], options: &AnalysisOptions) -> Analysis {
+fn run(paths: &[std::path::PathBuf], options: &AnalyzeOptions) -> Analysis {
     let s = series::from_files(paths, None).unwrap();
-    analyze(&s, options, &|_, _, _| {}, &|_, _, _, _| Ok(())).unwrap()
+    analyze_series(&s, options, &|_, _, _| {}, &|_, _, _| Ok(())).unwrap()
 }
 
 fn pixels(a: &Analysis) -> Vec<(u64, u64, u64)> {
@@ -59,22 +60,22 @@ fn results_do_not_depend_on_cache_or_layout() {
         write_deflate(&path, std::slice::from_ref(page), p.width, p.height);
         singles.push(path);
     }
-    let cached = run(std::slice::from_ref(&stack), &AnalysisOptions::default());
+    let cached = run(std::slice::from_ref(&stack), &AnalyzeOptions::default());
     let uncached = run(
         std::slice::from_ref(&stack),
-        &AnalysisOptions {
+        &AnalyzeOptions {
             memory_budget: 0,
-            ..AnalysisOptions::default()
+            ..AnalyzeOptions::default()
         },
     );
     let tiny_cache = run(
         std::slice::from_ref(&stack),
-        &AnalysisOptions {
+        &AnalyzeOptions {
             memory_budget: 3 * p.width * p.height * 2,
-            ..AnalysisOptions::default()
+            ..AnalyzeOptions::default()
         },
     );
-    let files = run(&singles, &AnalysisOptions::default());
+    let files = run(&singles, &AnalyzeOptions::default());
     assert_eq!(pixels(&cached), pixels(&uncached));
     assert_eq!(pixels(&cached), pixels(&tiny_cache));
     assert_eq!(pixels(&cached), pixels(&files));
@@ -101,7 +102,7 @@ fn float_data_threshold_and_per_image_method() {
         }
     }
     std::fs::write(&path, bytes.into_inner()).unwrap();
-    let float = run(std::slice::from_ref(&path), &AnalysisOptions::default());
+    let float = run(std::slice::from_ref(&path), &AnalyzeOptions::default());
     assert!(
         float.warnings.iter().any(|w| w.contains("NaN")),
         "{:?}",
@@ -116,7 +117,7 @@ fn float_data_threshold_and_per_image_method() {
     let ints: Vec<Vec<u16>> = images.iter().map(|i| i.codes.clone()).collect();
     let int_path = dir.path().join("int.tif");
     write_deflate(&int_path, &ints, p.width, p.height);
-    let int = run(std::slice::from_ref(&int_path), &AnalysisOptions::default());
+    let int = run(std::slice::from_ref(&int_path), &AnalyzeOptions::default());
     for (f, i) in float.images.iter().zip(&int.images) {
         let (a, b) = (
             f.measurement.contact_pixels as f64,
@@ -126,9 +127,9 @@ fn float_data_threshold_and_per_image_method() {
     }
     let per_image = run(
         std::slice::from_ref(&path),
-        &AnalysisOptions {
+        &AnalyzeOptions {
             method: Method::PerImageOtsu,
-            ..AnalysisOptions::default()
+            ..AnalyzeOptions::default()
         },
     );
     assert!(per_image.series_threshold.is_none());

@@ -7,7 +7,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use common::{column, read_csv, run, stderr};
-use contactscope::synth::gaussian_blur;
+use contactscope::optics::blur::isotropic_blur;
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use serde_json::Value;
@@ -22,7 +22,7 @@ fn blurred_noise(dir: &Path, name: &str, n: usize, sigma_px: f64, pixel_m: f64) 
     let noise: Vec<f64> = (0..n * n)
         .map(|_| StandardNormal.sample(&mut rng))
         .collect();
-    let field = gaussian_blur(&noise, n, n, sigma_px);
+    let field = isotropic_blur(&noise, n, n, sigma_px);
     let sd = (field.iter().map(|v| v * v).sum::<f64>() / field.len() as f64).sqrt();
     let codes: Vec<u16> = field
         .iter()
@@ -40,9 +40,14 @@ fn write_u16(
     pixel_m: Option<f64>,
 ) -> PathBuf {
     let path = dir.join(name);
-    let bytes =
-        contactscope::stack::write::encode_u16_stack(&[codes], w, h, pixel_m.map(|p| (p, p)), "")
-            .unwrap();
+    let bytes = contactscope::io::tiff::write::encode_u16_stack(
+        &[codes],
+        w,
+        h,
+        pixel_m.map(|p| (p, p)),
+        "",
+    )
+    .unwrap();
     fs::write(&path, bytes).unwrap();
     path
 }

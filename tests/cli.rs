@@ -7,9 +7,10 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use common::{column, read_csv, run, stderr, stdout};
-use contactscope::stack::tiff::TiffReader;
-use contactscope::stack::write::encode_u16_stack;
-use contactscope::synth::{self, Layout, SynthParams};
+use contactscope::io::tiff::write::encode_u16_stack;
+use contactscope::io::tiff::TiffReader;
+use contactscope::jobs::synth_series::{write_series, Layout};
+use contactscope::synth::{self, SynthParams};
 
 fn small_series(dir: &Path, layout: Layout) -> Vec<PathBuf> {
     let p = SynthParams {
@@ -18,7 +19,7 @@ fn small_series(dir: &Path, layout: Layout) -> Vec<PathBuf> {
         forces_n: vec![4e-3, 8e-3, 16e-3, 32e-3],
         ..SynthParams::default()
     };
-    synth::write_series(&p, dir, layout).unwrap()
+    write_series(&p, dir, layout).unwrap()
 }
 
 fn s(p: &Path) -> &str {

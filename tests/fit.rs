@@ -7,9 +7,9 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use common::{column, read_csv, rough_surface, run, stderr};
+use contactscope::io::tiff::read_image;
+use contactscope::io::tiff::write::encode_u16_stack;
 use contactscope::optics::blur::Grid;
-use contactscope::stack::image::read_image;
-use contactscope::stack::write::encode_u16_stack;
 use contactscope::synth::{render_micrograph, MicrographParams};
 use serde_json::Value;
 

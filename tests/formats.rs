@@ -6,8 +6,8 @@ mod common;
 
 use std::path::Path;
 
-use contactscope::stack::tiff::{ChannelLayout, TiffReader};
-use contactscope::stack::{PixelSizeSource, Plane};
+use contactscope::image::{PixelSizeSource, Plane};
+use contactscope::io::tiff::{ChannelLayout, TiffReader};
 use contactscope::Error;
 
 struct Expected {

@@ -2,18 +2,19 @@
 
 mod common;
 
-use contactscope::analysis::{analyze, AnalysisOptions};
+use contactscope::image::Plane;
+use contactscope::io::series;
+use contactscope::jobs::analyze::report::Report;
+use contactscope::jobs::analyze::{analyze_series, AnalyzeOptions};
+use contactscope::jobs::synth_series::{read_truth, write_series, Layout};
 use contactscope::measure::measure;
-use contactscope::report::Report;
-use contactscope::stack::series;
-use contactscope::stack::Plane;
-use contactscope::synth::{self, Layout, SynthParams};
+use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::{Binning, Histogram, Threshold};
 
 #[test]
 fn bundled_fixture_is_what_the_generator_makes() {
     let dir = tempfile::tempdir().unwrap();
-    synth::write_series(&SynthParams::default(), dir.path(), Layout::MultiPage).unwrap();
+    write_series(&SynthParams::default(), dir.path(), Layout::MultiPage).unwrap();
     for name in ["series.tif", "manifest.csv", "truth.csv"] {
         let bundled = std::fs::read(common::fixture_series().join(name)).unwrap();
         let fresh = std::fs::read(dir.path().join(name)).unwrap();
@@ -28,15 +29,12 @@ fn bundled_fixture_is_what_the_generator_makes() {
 fn bundled_series_areas_match_the_truth() {
     let manifest = common::fixture_series().join("manifest.csv");
     let s = series::from_manifest(&manifest, None).unwrap();
-    let analysis = analyze(
-        &s,
-        &AnalysisOptions::default(),
-        &|_, _, _| {},
-        &|_, _, _, _| Ok(()),
-    )
+    let analysis = analyze_series(&s, &AnalyzeOptions::default(), &|_, _, _| {}, &|_, _, _| {
+        Ok(())
+    })
     .unwrap();
-    let report = Report::new(&analysis, None);
-    let truth = synth::read_truth(&common::fixture_series().join("truth.csv")).unwrap();
+    let report = Report::new(&s, &analysis, None);
+    let truth = read_truth(&common::fixture_series().join("truth.csv")).unwrap();
     assert_eq!(report.rows.len(), truth.len());
     for (row, true_area) in report.rows.iter().zip(&truth) {
         let error = row.area / true_area - 1.0;

@@ -8,12 +8,15 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use common::{column, read_csv, run, stderr, stdout};
-use contactscope::hertz;
-use contactscope::mechanics::friction::{
-    detect_slip, read_trace, run_friction, synthetic_trace, trace_csv, CsvLayout, FrictionRequest,
-    SlipCriterion, SlipOptions, SyntheticTrace, TraceParams, XAxis,
+use contactscope::io::mechanics::{read_squeeze, read_trace};
+use contactscope::jobs::friction::{run_friction, FrictionRequest};
+use contactscope::jobs::hertz::{run_hertz, HertzRequest};
+use contactscope::mechanics::friction::{detect_slip, SlipCriterion, SlipOptions, XAxis};
+use contactscope::mechanics::hertz;
+use contactscope::mechanics::squeeze::fit_hertz;
+use contactscope::synth::traces::{
+    synthetic_trace, trace_csv, CsvLayout, SyntheticTrace, TraceParams,
 };
-use contactscope::mechanics::squeeze::{fit_hertz, read_squeeze, run_hertz, HertzRequest};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use serde_json::Value;

@@ -7,13 +7,11 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{column, read_csv, run, stderr};
-use contactscope::optics::newton::{
-    analyse, fit_hertz_gap, synth_newton, NewtonAnalysis, NewtonOptions, NewtonSynth,
-    NewtonSynthParams, Phase,
-};
-use contactscope::stack::image::Image;
-use contactscope::stack::write::encode_u16_stack;
-use contactscope::stack::{PixelSize, PixelSizeSource};
+use contactscope::image::Image;
+use contactscope::image::{PixelSize, PixelSizeSource};
+use contactscope::io::tiff::write::encode_u16_stack;
+use contactscope::optics::newton::{analyse, fit_hertz_gap, NewtonAnalysis, NewtonOptions, Phase};
+use contactscope::synth::rings::{synth_newton, NewtonSynth, NewtonSynthParams};
 
 fn image(codes: &[u16], p: &NewtonSynthParams, name: &str) -> Image {
     Image {

@@ -10,12 +10,14 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Poisson};
 use serde_json::Value;
 
+use contactscope::image::Image;
+use contactscope::image::{PixelSize, PixelSizeSource};
+use contactscope::io::tiff::encode_u16_stack;
 use contactscope::optics::psf::{
-    fit_spot, measure_psf, synth_beads, BeadKind, BeadParams, PlaneView, PsfOptions, PsfReport,
-    Sampling, SkipReason, SpotOptions, SyntheticBeads, FWHM_PER_SIGMA,
+    fit_spot, measure_psf, PlaneView, PsfOptions, PsfReport, SkipReason, SpotOptions,
+    FWHM_PER_SIGMA,
 };
-use contactscope::stack::image::Image;
-use contactscope::stack::{PixelSize, PixelSizeSource};
+use contactscope::synth::beads::{synth_beads, BeadKind, BeadParams, Sampling, SyntheticBeads};
 
 const SIZE: usize = 41;
 const CENTRE: (f64, f64) = (20.37, 19.81);
@@ -253,7 +255,9 @@ fn pixel_integration_widens_sigma_squared_by_a_twelfth() {
 
 fn write_tiff(dir: &Path, name: &str, s: &SyntheticBeads, pixel_m: Option<f64>) -> PathBuf {
     let path = dir.join(name);
-    std::fs::write(&path, s.to_tiff(pixel_m).unwrap()).unwrap();
+    let pages: Vec<&[u16]> = s.planes.iter().map(Vec::as_slice).collect();
+    let tiff = encode_u16_stack(&pages, s.width, s.height, pixel_m.map(|p| (p, p)), "").unwrap();
+    std::fs::write(&path, tiff).unwrap();
     path
 }
 

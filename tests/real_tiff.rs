@@ -14,8 +14,8 @@ mod common;
 use std::path::PathBuf;
 
 use contactscope::analysis::global_threshold;
-use contactscope::stack::series;
-use contactscope::stack::tiff::TiffReader;
+use contactscope::io::series;
+use contactscope::io::tiff::TiffReader;
 use contactscope::Error;
 
 /// (path under real-tiff, channel, skimage threshold, exact threshold when skimage differs)
@@ -73,7 +73,7 @@ const INTEGER_FILES: &[(&str, Option<usize>, f64, Option<f64>)] = &[
 
 fn threshold_of(paths: &[PathBuf], channel: Option<usize>) -> contactscope::Result<(f64, u64)> {
     let s = series::from_files(paths, channel)?;
-    let (t, pixels, _) = global_threshold(&s, &|_, _, _| {})?;
+    let (t, pixels, _) = global_threshold(&s.planes(0), &|_, _, _| {})?;
     Ok((t.value, pixels))
 }
 

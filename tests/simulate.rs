@@ -1,8 +1,8 @@
 //! Load sweeps with the contact models, against analytic limits (validation.md B7, B9, B10, B19,
 //! B21). Dimensionless Hertz geometry: R = 20, E* = 102, L = 5.
 
-use contactscope::fit::fit_power_law;
-use contactscope::hertz;
+use contactscope::analysis::fit::fit_power_law;
+use contactscope::mechanics::hertz;
 use contactscope::solver::cg::SolverOptions;
 use contactscope::solver::halfspace::Boundary;
 use contactscope::solver::simulate::{sweep, LoadStep, Model, Setup};

@@ -6,7 +6,7 @@ use std::fs;
 use std::path::Path;
 
 use common::{column, read_csv, rough_surface, run, stderr, stdout};
-use contactscope::stack::tiff::TiffReader;
+use contactscope::io::tiff::TiffReader;
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()

@@ -1,7 +1,7 @@
 //! Contact solver against analytic solutions (validation.md B3, B4, B5, B8), at grid sizes that
 //! keep the suite fast; tolerances are stated per check.
 
-use contactscope::hertz;
+use contactscope::mechanics::hertz;
 use contactscope::solver::cg::{
     solve_displacement, solve_load, solve_load_bounded, Plasticity, Problem, SolverOptions,
 };

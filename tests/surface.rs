@@ -8,8 +8,8 @@ use std::path::Path;
 
 use ndarray::Array2;
 
+use contactscope::io::topography::{read_topography, write_gsf, write_npy};
 use contactscope::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
-use contactscope::surface::io::{read_topography, write_gsf, write_npy};
 use contactscope::surface::stats::{psd, radial_psd, rms_slope, rms_slope_spectral, SurfaceStats};
 use contactscope::surface::Topography;
 use contactscope::Error;

@@ -10,7 +10,7 @@ pub mod patches;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::stack::{Plane, Samples};
+use crate::image::{Plane, Samples};
 use crate::threshold::{ContactRule, Threshold};
 
 /// A binary contact mask, row-major, 1 = contact, 0 = not.
@@ -210,7 +210,7 @@ mod tests {
         let plane = Plane {
             width: 2,
             height: 1,
-            sample_type: crate::stack::SampleType::I16,
+            sample_type: crate::image::SampleType::I16,
             samples: Samples::Int {
                 codes: vec![32768 - 5, 32768 + 7],
                 offset: -32768,
@@ -228,7 +228,7 @@ mod tests {
         let plane = Plane {
             width: 4,
             height: 1,
-            sample_type: crate::stack::SampleType::F32,
+            sample_type: crate::image::SampleType::F32,
             samples: Samples::Float(vec![0.1, f32::NAN, 0.9, 1.0]),
         };
         let t = Threshold::manual(0.5, &plane.samples);

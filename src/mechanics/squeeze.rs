@@ -7,7 +7,7 @@
 //! Eq. 2 with E* instead of E*² under the cube root, which is not dimensionally consistent; the
 //! form used here is Johnson's (see `docs/mechanics.md`).
 //!
-//! # Input CSV
+//! # Input CSV ([`crate::io::mechanics::read_squeeze`])
 //! `force_mN` (or `force_N`) and `displacement_um`, the total plate displacement 2δ measured
 //! from first contact, one row per sample of the loading curve. Rows with P ≤ 0 (before contact)
 //! are ignored; among the rest, force must not decrease and displacement must increase from row
@@ -19,16 +19,8 @@
 //! the high loads dominate. A second fit with a free contact offset δ₀,
 //! P = (4/3)E*√R (δ − δ₀)^(3/2), minimises the same residual over δ₀ and is reported separately.
 
-use std::path::{Path, PathBuf};
-
-use serde_json::{json, Value};
-
-use crate::error::{Error, Location, Result};
-use crate::hertz;
-use crate::output::Staging;
-use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
-
-use super::table::Table;
+use crate::error::{Error, Result};
+use crate::numerics::golden::golden_section;
 
 /// Fewest loaded points (P > 0) a fit needs.
 pub const MIN_POINTS: usize = 3;
@@ -51,39 +43,8 @@ impl SqueezePoint {
     }
 }
 
-/// Read a squeeze CSV: the loaded rows (P > 0), checked for order (see the module docs).
-pub fn read_squeeze(path: &Path) -> Result<Vec<SqueezePoint>> {
-    let table = Table::read(path)?;
-    let force_column = table
-        .one_of(&["force_mN", "force_N"])?
-        .ok_or_else(|| table.missing("force", &["force_mN", "force_N"]))?;
-    let factor = if force_column == "force_mN" {
-        1e-3
-    } else {
-        1.0
-    };
-    if table.one_of(&["displacement_um"])?.is_none() {
-        return Err(table.missing("displacement", &["displacement_um"]));
-    }
-    let forces = table.numbers(force_column, factor)?;
-    let displacements = table.numbers("displacement_um", 1e-6)?;
-    let points: Vec<SqueezePoint> = forces
-        .iter()
-        .zip(&displacements)
-        .enumerate()
-        .filter(|(_, (f, _))| **f > 0.0)
-        .map(|(k, (&force_n, &displacement_m))| SqueezePoint {
-            force_n,
-            displacement_m,
-            line: table.line(k),
-        })
-        .collect();
-    check_points(&points).map_err(|reason| Error::bad_input(Location::file(path), reason))?;
-    Ok(points)
-}
-
 /// Enough points, positive displacements, loading order; the reason as text otherwise.
-fn check_points(points: &[SqueezePoint]) -> std::result::Result<(), String> {
+pub(crate) fn check_points(points: &[SqueezePoint]) -> std::result::Result<(), String> {
     if points.len() < MIN_POINTS {
         return Err(format!(
             "{} points with positive force; the Hertz fit needs at least {MIN_POINTS}",
@@ -181,7 +142,7 @@ fn no_fit() -> Error {
     Error::InvalidArgument("the squeeze data give no Hertz fit (all δ^(3/2) are zero)".into())
 }
 
-fn check_radius(radius_m: f64) -> Result<()> {
+pub(crate) fn check_radius(radius_m: f64) -> Result<()> {
     if radius_m.is_finite() && radius_m > 0.0 {
         Ok(())
     } else {
@@ -239,211 +200,29 @@ fn ss_res(points: &[SqueezePoint], fit: &HertzFit) -> f64 {
     fit.residuals(points).iter().map(|r| r * r).sum()
 }
 
-/// Minimum of `f` on [lo, hi]: the best of 200 grid points, then golden section in its bracket.
+/// Minimum of `f` on [lo, hi]: the best of 200 grid points, then golden section in its bracket
+/// down to 1e-12 of the range (below the rounding of δ for any loaded squeeze curve).
 fn minimise(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
     const GRID: usize = 200;
     let at = |i: usize| lo + (hi - lo) * i as f64 / GRID as f64;
     let best = (0..=GRID)
         .min_by(|&a, &b| f(at(a)).total_cmp(&f(at(b))))
         .unwrap_or(0);
-    let (mut a, mut b) = (at(best.saturating_sub(1)), at((best + 1).min(GRID)));
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    for _ in 0..100 {
-        let c = b - g * (b - a);
-        let d = a + g * (b - a);
-        if f(c) < f(d) {
-            b = d;
-        } else {
-            a = c;
-        }
-    }
-    0.5 * (a + b)
-}
-
-/// Everything `hertz` needs, already parsed.
-#[derive(Debug, Clone)]
-pub struct HertzRequest {
-    /// The squeeze CSV.
-    pub input: PathBuf,
-    /// Sphere radius R, m.
-    pub radius_m: f64,
-    /// Loads at which to predict the contact radius, N; the measured forces when `None`.
-    pub loads_n: Option<Vec<f64>>,
-    /// Output folder.
-    pub out_dir: PathBuf,
-    /// The command line, for the JSON.
-    pub command_line: Vec<String>,
-}
-
-/// What `hertz` computed and wrote.
-#[derive(Debug, Clone)]
-pub struct HertzOutcome {
-    /// Points used (P > 0).
-    pub points: Vec<SqueezePoint>,
-    /// Fit through the origin (the main result).
-    pub fit: HertzFit,
-    /// Fit with a free contact offset, when there are enough points.
-    pub offset_fit: Option<HertzFit>,
-    /// (load N, Hertz contact radius m) pairs.
-    pub predicted: Vec<(f64, f64)>,
-    /// Files written.
-    pub written: Vec<PathBuf>,
-}
-
-/// Run `hertz`: read, fit, predict a = (3PR/4E*)^(1/3) (paper Eq. 3) and write `hertz.json`,
-/// `hertz_fit.csv` and `squeeze_fit.png` (all or nothing).
-pub fn run_hertz(request: &HertzRequest) -> Result<HertzOutcome> {
-    check_radius(request.radius_m)?;
-    let points = read_squeeze(&request.input)?;
-    let fit = fit_hertz(&points, request.radius_m)?;
-    let offset_fit = fit_hertz_with_offset(&points, request.radius_m).ok();
-    let loads = match &request.loads_n {
-        Some(l) => l.clone(),
-        None => points.iter().map(|p| p.force_n).collect(),
-    };
-    if let Some(bad) = loads.iter().find(|l| !(**l > 0.0 && l.is_finite())) {
-        return Err(Error::InvalidArgument(format!(
-            "load {bad:e} N must be positive"
-        )));
-    }
-    let predicted = loads
-        .iter()
-        .map(|&p| (p, hertz::contact_radius(p, request.radius_m, fit.e_star_pa)))
-        .collect();
-    let mut outcome = HertzOutcome {
-        points,
-        fit,
-        offset_fit,
-        predicted,
-        written: Vec::new(),
-    };
-    outcome.written = write_outputs(request, &outcome)?;
-    Ok(outcome)
-}
-
-fn write_outputs(request: &HertzRequest, outcome: &HertzOutcome) -> Result<Vec<PathBuf>> {
-    let staging = Staging::new(&request.out_dir, std::slice::from_ref(&request.input))?;
-    let text = serde_json::to_string_pretty(&summary_json(request, outcome))
-        .map_err(|e| Error::InvalidArgument(format!("JSON: {e}")))?;
-    staging.write("hertz.json", text.as_bytes())?;
-    staging.write(
-        "hertz_fit.csv",
-        fit_csv(&outcome.points, &outcome.fit)?.as_bytes(),
-    )?;
-    staging.write(
-        "squeeze_fit.png",
-        &fit_chart(&outcome.points, &outcome.fit, request.radius_m).to_png()?,
-    )?;
-    staging.commit()
-}
-
-/// `hertz_fit.csv`: force_mN, displacement_um, delta_um, fitted_force_mN, residual_mN.
-pub fn fit_csv(points: &[SqueezePoint], fit: &HertzFit) -> Result<String> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let csv_err = |e: csv::Error| Error::InvalidArgument(format!("CSV: {e}"));
-    w.write_record([
-        "force_mN",
-        "displacement_um",
-        "delta_um",
-        "fitted_force_mN",
-        "residual_mN",
-    ])
-    .map_err(csv_err)?;
-    for ((p, f), r) in points.iter().zip(&fit.fitted_n).zip(fit.residuals(points)) {
-        w.write_record([
-            format!("{:.9}", p.force_n * 1e3),
-            format!("{:.9}", p.displacement_m * 1e6),
-            format!("{:.9}", p.delta_m() * 1e6),
-            format!("{:.9}", f * 1e3),
-            format!("{:.9}", r * 1e3),
-        ])
-        .map_err(csv_err)?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
-}
-
-fn fit_json(fit: &HertzFit) -> Value {
-    json!({
-        "contact_modulus_GPa": fit.e_star_pa * 1e-9,
-        "contact_modulus_se_GPa": fit.e_star_se_pa * 1e-9,
-        "r2": fit.r_squared,
-        "contact_offset_displacement_um": 2.0 * fit.offset_m * 1e6,
-    })
-}
-
-fn summary_json(request: &HertzRequest, outcome: &HertzOutcome) -> Value {
-    let fit = &outcome.fit;
-    let predicted: Vec<Value> = outcome
-        .predicted
-        .iter()
-        .map(|&(p, a)| {
-            json!({
-                "force_mN": p * 1e3,
-                "contact_radius_um": a * 1e6,
-                "contact_area_um2": std::f64::consts::PI * a * a * 1e12,
-            })
-        })
-        .collect();
-    json!({
-        "contactscope_version": env!("CARGO_PKG_VERSION"),
-        "command_line": request.command_line,
-        "input": request.input.display().to_string(),
-        "radius_um": request.radius_m * 1e6,
-        "method": {
-            "law": "P = (4/3) E* R^(1/2) delta^(3/2), delta = displacement/2 (two contacts in series); Johnson 1985 eq. 4.23. The paper's printed Eq. 2 lacks the square on E* and is not dimensionally consistent.",
-            "fit": "least squares in P of P on delta^(3/2) through the origin (unweighted); se from sqrt(SS_res/(n-1)/sum x^2); r2 about the mean",
-            "offset_fit": "same, with P = (4/3) E* R^(1/2) (delta - delta0)^(3/2) and delta0 minimising the residual (reported separately)",
-            "contact_radius": "a = (3PR/4E*)^(1/3) (paper Eq. 3)",
-        },
-        "points_used": outcome.points.len(),
-        "contact_modulus_GPa": fit.e_star_pa * 1e-9,
-        "contact_modulus_se_GPa": fit.e_star_se_pa * 1e-9,
-        "r2": fit.r_squared,
-        "max_abs_residual_mN": fit.residuals(&outcome.points).iter().fold(0.0f64, |m, r| m.max(r.abs())) * 1e3,
-        "offset_fit": outcome.offset_fit.as_ref().map(fit_json),
-        "predicted": predicted,
-    })
-}
-
-fn fit_chart(points: &[SqueezePoint], fit: &HertzFit, radius_m: f64) -> Chart {
-    let max_disp = points.iter().map(|p| p.displacement_m).fold(0.0, f64::max);
-    let curve: Vec<(f64, f64)> = (0..=100)
-        .map(|i| {
-            let disp = max_disp * 1.05 * i as f64 / 100.0;
-            let p = hertz::force_at_approach(0.5 * disp, radius_m, fit.e_star_pa);
-            (disp * 1e6, p * 1e3)
-        })
-        .collect();
-    Chart {
-        title: "Squeeze test: Hertz fit".into(),
-        x_label: "plate displacement 2δ (µm)".into(),
-        y_label: "force P (mN)".into(),
-        axes: Axes::Linear,
-        legend: Legend::UpperLeft,
-        points: vec![PointSet {
-            label: "measured".into(),
-            xy: points
-                .iter()
-                .map(|p| (p.displacement_m * 1e6, p.force_n * 1e3))
-                .collect(),
-        }],
-        curves: vec![Curve {
-            label: format!(
-                "Hertz, E* = {:.3} ± {:.3} GPa",
-                fit.e_star_pa * 1e-9,
-                fit.e_star_se_pa * 1e-9
-            ),
-            xy: curve,
-        }],
+    let (a, b) = (at(best.saturating_sub(1)), at((best + 1).min(GRID)));
+    let width = 1e-12 * (hi - lo);
+    let found = golden_section(a, b, width, &mut |x| {
+        Ok::<f64, std::convert::Infallible>(f(x))
+    });
+    match found {
+        Ok(m) => m.x,
+        Err(never) => match never {},
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mechanics::hertz;
 
     fn exact(e_star: f64, r: f64, d0: f64) -> Vec<SqueezePoint> {
         (1..=8)

@@ -8,5 +8,4 @@ pub mod cg;
 pub mod greens;
 pub mod gt;
 pub mod halfspace;
-pub mod job;
 pub mod simulate;

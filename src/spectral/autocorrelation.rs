@@ -144,6 +144,67 @@ pub fn first_crossing(profile: &[(f64, f64)], level: f64) -> Option<f64> {
     })
 }
 
+/// Radially averaged autocorrelation of one image with its correlation lengths.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AcfCurve {
+    /// Name in tables and legends: the file name, with `:page N` for multi-page files.
+    pub label: String,
+    /// `(lag in m, C)`, C(0) = 1.
+    pub profile: Vec<(f64, f64)>,
+    /// First lag where C ≤ 1/e, m.
+    pub xi_1e_m: Option<f64>,
+    /// First lag where C ≤ 0, m.
+    pub first_zero_m: Option<f64>,
+}
+
+impl AcfCurve {
+    /// The autocorrelation of `values` (`height` rows of `width`, pixel `dx_m × dy_m`) up to
+    /// `max_lag_m`.
+    pub fn of_grid(
+        label: &str,
+        values: &[f64],
+        (width, height): (usize, usize),
+        (dx_m, dy_m): (f64, f64),
+        max_lag_m: f64,
+    ) -> Result<Self> {
+        if !(max_lag_m.is_finite() && max_lag_m > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "largest lag {max_lag_m:e} m is not a positive length"
+            )));
+        }
+        let acf = autocorrelation(values, width, height)?;
+        let profile = radial_average(&acf, dx_m, dy_m, max_lag_m);
+        Ok(AcfCurve {
+            label: label.to_string(),
+            xi_1e_m: first_crossing(&profile, (-1.0f64).exp()),
+            first_zero_m: first_crossing(&profile, 0.0),
+            profile,
+        })
+    }
+
+    /// C interpolated linearly at `lag_m`, `None` outside the profile.
+    pub fn at(&self, lag_m: f64) -> Option<f64> {
+        self.profile.windows(2).find_map(|w| {
+            let ((r0, c0), (r1, c1)) = (w[0], w[1]);
+            (r0..=r1)
+                .contains(&lag_m)
+                .then(|| c0 + (c1 - c0) * (lag_m - r0) / (r1 - r0))
+        })
+    }
+
+    /// Root-mean-square difference between two curves over their common lags (sampled at this
+    /// curve's lags), or `None` if they share no lag.
+    pub fn rms_distance(&self, other: &AcfCurve) -> Option<f64> {
+        let diffs: Vec<f64> = self
+            .profile
+            .iter()
+            .filter_map(|&(r, c)| other.at(r).map(|o| c - o))
+            .collect();
+        (!diffs.is_empty())
+            .then(|| (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -199,7 +260,7 @@ mod tests {
         let noise: Vec<f64> = (0..n * n)
             .map(|_| rng.sample(rand_distr::StandardNormal))
             .collect();
-        let field = crate::synth::gaussian_blur(&noise, n, n, 4.0);
+        let field = crate::optics::blur::isotropic_blur(&noise, n, n, 4.0);
         let acf = autocorrelation(&field, n, n).unwrap();
         let profile = radial_average(&acf, 1.0, 1.0, 40.0);
         let xi = first_crossing(&profile, (-1f64).exp()).unwrap();

@@ -14,7 +14,6 @@
 //!   needs per thread.
 
 pub mod autocorrelation;
-pub mod job;
 pub mod register;
 
 use std::sync::Arc;

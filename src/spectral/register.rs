@@ -326,7 +326,7 @@ mod tests {
     fn random_image(n: usize, seed: u64) -> Vec<f64> {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let noise: Vec<f64> = (0..n * n).map(|_| rng.random_range(0.0..1.0)).collect();
-        crate::synth::gaussian_blur(&noise, n, n, 1.5)
+        crate::optics::blur::isotropic_blur(&noise, n, n, 1.5)
     }
 
     fn circular_shift(img: &[f64], n: usize, dx: i64, dy: i64) -> Vec<f64> {

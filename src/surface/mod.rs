@@ -9,11 +9,10 @@
 //!   the radially averaged power spectral density (Jacobs, Junge, Pastewka 2017).
 //! * [`generate`] — seeded self-affine random surfaces by Fourier filtering (Ramisetti et al.
 //!   2011; methods.md §5.2).
-//! * [`io`] — height maps from `.npy`, float TIFF, Gwyddion `.gsf`, text matrices, WSxM `.top`
-//!   and Bruker/Nanoscope files.
+//! * Reading and writing height maps (`.npy`, float TIFF, Gwyddion `.gsf`, text matrices, WSxM
+//!   `.top`, Bruker/Nanoscope) is I/O: [`crate::io::topography`].
 
 pub mod generate;
-pub mod io;
 pub mod stats;
 
 use ndarray::Array2;

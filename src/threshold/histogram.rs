@@ -6,7 +6,7 @@
 //! known in advance (the series' finite min..max); non-finite values are counted apart.
 
 use crate::error::{Error, Result};
-use crate::stack::{Plane, Samples};
+use crate::image::{Plane, Samples};
 
 /// Number of bins of an integer histogram: one per `u16` code.
 pub const INTEGER_BINS: usize = 1 << 16;

@@ -16,15 +16,16 @@ pub use histogram::{Binning, FloatBinning, Histogram};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::stack::Samples;
+use crate::image::Samples;
 
 /// Number of equal bins for float data over the series' finite min..max.
 pub const FLOAT_BINS: usize = 4096;
 
 /// How the threshold is chosen.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Method {
     /// One exact Otsu threshold over the pooled histogram of all images (the paper's rule).
+    #[default]
     GlobalOtsu,
     /// Each image its own Otsu threshold (for comparison).
     PerImageOtsu,
@@ -200,7 +201,7 @@ mod tests {
         assert!((101.0..900.0).contains(&t) && t.fract() == 0.0, "{t}");
     }
     use super::*;
-    use crate::stack::Plane;
+    use crate::image::Plane;
 
     #[test]
     fn per_image_histograms_merge_to_the_series_histogram() {

@@ -8,21 +8,17 @@
 //! fluorescent edge r_f gives the gap at which the molecules light up: the detection gap (the
 //! paper: 9 nm, averaged over 20 profiles).
 //!
-//! [`analyse`] does the measurement on two images in memory; [`run_newton`] reads the files and
+//! [`analyse`] does the measurement on two images in memory; [`crate::jobs::newton::run_newton`] reads the files and
 //! writes `newton.json`, `newton_rings.csv`, `newton_profiles.csv` and `newton_gap.png`.
 
 pub mod gap;
 pub mod profile;
-mod report;
-pub mod synth;
 
-pub use crate::stats::MeanSd;
+pub use crate::numerics::stats::MeanSd;
 pub use gap::{fit_hertz_gap, hertz_gap, ring_gap, GapFit, Phase};
-pub use report::{run_newton, NewtonOutcome, NewtonRequest};
-pub use synth::{synth_newton, NewtonSynth, NewtonSynthParams, NewtonTruth};
 
 use crate::error::{Error, Location, Result};
-use crate::stack::image::Image;
+use crate::image::Image;
 use profile::{edge_crossing, find_contact, noise_sd, peaks, smooth, Contact, HalfLine};
 
 /// Choices of the analysis. SI units.

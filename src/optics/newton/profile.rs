@@ -4,7 +4,7 @@
 //! found by prominence (`methods.md` §7.5, steps 1–3).
 
 use crate::error::{Error, Location, Result};
-use crate::stack::image::Image;
+use crate::image::Image;
 use crate::threshold::otsu_of_values;
 
 /// The fluorescent contact found in the fluorescence image.

@@ -2,9 +2,9 @@
 //! the smoothed planes of a stack) well above a robust background, with each bead's best-focus
 //! plane and a first guess of the spot width that sizes the fitting window.
 
-use crate::synth::gaussian_blur;
+use crate::optics::blur::isotropic_blur;
 
-use super::fit::median;
+use crate::numerics::stats::median_in_place as median;
 
 /// How candidates are found.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,7 +107,7 @@ fn smoothed_projection(
     let mut projection = vec![f64::NEG_INFINITY; width * height];
     let mut best = vec![0; width * height];
     for (k, plane) in planes.iter().enumerate() {
-        let smooth = gaussian_blur(plane, width, height, sigma);
+        let smooth = isotropic_blur(plane, width, height, sigma);
         for (i, &v) in smooth.iter().enumerate() {
             if v > projection[i] {
                 projection[i] = v;

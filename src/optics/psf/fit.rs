@@ -5,6 +5,7 @@
 //! two pixels has a half-integer centre.
 
 use super::lm::{self, LmOutcome, Problem};
+use crate::numerics::stats::median_in_place as median;
 
 /// A plane as a borrowed row-major grid.
 #[derive(Debug, Clone, Copy)]
@@ -220,20 +221,6 @@ impl Window {
             }
         }
         (sw > 0.0).then(|| (sx / sw, sy / sw))
-    }
-}
-
-/// Median (sorts the slice); NaN for an empty one.
-pub(crate) fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
     }
 }
 
@@ -478,12 +465,5 @@ mod tests {
             fit_spot(grid, 10, 10, &SpotOptions::default()),
             Err(SpotFailure::NoSignal)
         );
-    }
-
-    #[test]
-    fn median_of_even_and_odd() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), 2.5);
-        assert!(median(&mut []).is_nan());
     }
 }

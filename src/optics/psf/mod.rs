@@ -23,22 +23,18 @@
 mod detect;
 mod fit;
 mod lm;
-mod report;
 mod skip;
-mod synth;
 
 pub use detect::{detect, Candidate, DetectOptions, Detection};
 pub use fit::{fit_spot, Gauss2dFit, PlaneView, RadialFit, SpotFailure, SpotFit, SpotOptions};
-pub use report::{run_psf, PsfOutcome, PsfRequest};
 pub use skip::SkipReason;
 
-pub use crate::stats::MeanSd;
+pub use crate::numerics::stats::MeanSd;
 use skip::{implausible, pre_fit_skip};
-pub use synth::{synth_beads, BeadKind, BeadParams, BeadTruth, Sampling, SyntheticBeads};
 
 use crate::error::{Error, Location, Result};
-use crate::stack::image::Image;
-use crate::stack::PixelSize;
+use crate::image::Image;
+use crate::image::PixelSize;
 
 /// FWHM / σ of a Gaussian, 2√(2 ln 2).
 pub const FWHM_PER_SIGMA: f64 = 2.354_820_045_030_949;
@@ -353,7 +349,7 @@ fn summarise(beads: &[BeadMeasurement], pixel_m: f64) -> Option<PsfSummary> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stack::PixelSizeSource;
+    use crate::image::PixelSizeSource;
 
     fn image(width: usize, height: usize, value: f64, page: usize) -> Image {
         Image {

@@ -1,0 +1,384 @@
+//! The load-series analysis: planes → one threshold → measure, in two passes over a
+//! [`PlaneSource`], and the area–load fits ([`fit`]).
+//!
+//! Pass 1 visits every image once and accumulates the series histogram (per-image histograms
+//! merged into one; for float data the finite range first, then a second histogram pass). The
+//! threshold is chosen from the pooled histogram. Pass 2 classifies and measures each image.
+//!
+//! The analysis never opens a file: it asks its source for planes. A slice of in-memory
+//! [`Plane`]s is a source; the file-backed source of a load series
+//! ([`crate::io::series::SeriesPlanes`]) decodes pages on demand, in parallel runs of images of one
+//! file, and keeps decoded planes of compressed files between the passes up to a memory budget,
+//! so a 500-image series never needs 500 images in memory.
+
+pub mod fit;
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::image::{PixelSize, Plane, SampleType, Samples};
+use crate::measure::{measure, Mask, Measurement};
+use crate::threshold::{
+    histogram, Binning, FloatBinning, Histogram, Method, Threshold, FLOAT_BINS,
+};
+
+/// How to analyse a series.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AnalysisOptions {
+    /// Threshold method.
+    pub method: Method,
+    /// The series' pixel size (recorded with the result; areas are in pixels without one).
+    pub pixel_size: Option<PixelSize>,
+}
+
+/// A load series' planes as the analysis sees them: a number of images that share one sample
+/// type and size, visited in parallel.
+pub trait PlaneSource: Sync {
+    /// Number of images.
+    fn len(&self) -> usize;
+
+    /// Whether there are no images.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The sample type every image has.
+    fn sample_type(&self) -> SampleType;
+
+    /// Image `index` as messages name it (e.g. `a.tif (page 3)`).
+    fn label(&self, index: usize) -> String;
+
+    /// `f` applied to every image, possibly in parallel and in any order. Results come back in
+    /// image order; the first error in image order is returned. A plane that does not match the
+    /// series' first image (size, sample type) is an error.
+    fn scan<T: Send, F: Fn(usize, &Plane) -> Result<T> + Sync>(&self, f: F) -> Result<Vec<T>>;
+}
+
+/// In-memory planes, in load order.
+impl PlaneSource for [Plane] {
+    fn len(&self) -> usize {
+        <[Plane]>::len(self)
+    }
+
+    fn sample_type(&self) -> SampleType {
+        self.first().map_or(SampleType::U16, |p| p.sample_type)
+    }
+
+    fn label(&self, index: usize) -> String {
+        format!("image {index}")
+    }
+
+    fn scan<T: Send, F: Fn(usize, &Plane) -> Result<T> + Sync>(&self, f: F) -> Result<Vec<T>> {
+        let first = self.first();
+        self.par_iter()
+            .enumerate()
+            .map(|(i, plane)| {
+                if let Some(first) = first.filter(|p| {
+                    (p.width, p.height, p.sample_type)
+                        != (plane.width, plane.height, plane.sample_type)
+                }) {
+                    return Err(Error::InvalidArgument(format!(
+                        "image {i} is {}×{} {}; the series started with {}×{} {}",
+                        plane.width,
+                        plane.height,
+                        plane.sample_type.name(),
+                        first.width,
+                        first.height,
+                        first.sample_type.name()
+                    )));
+                }
+                f(i, plane)
+            })
+            .collect()
+    }
+}
+
+/// The result for one image.
+#[derive(Debug, Clone)]
+pub struct ImageResult {
+    /// The threshold applied to it.
+    pub threshold: Threshold,
+    /// What was measured.
+    pub measurement: Measurement,
+}
+
+/// The result for a series.
+#[derive(Debug, Clone)]
+pub struct Analysis {
+    /// Per-image results in input order.
+    pub images: Vec<ImageResult>,
+    /// The method used.
+    pub method: Method,
+    /// The series threshold (global Otsu or manual); `None` for per-image thresholds.
+    pub series_threshold: Option<Threshold>,
+    /// Pixels in the histogram the threshold came from (all finite pixels of the series).
+    pub histogram_pixels: u64,
+    /// The pixel size used for areas; `None` means areas are in pixels.
+    pub pixel_size: Option<PixelSize>,
+    /// Things the user should know (missing pixel size, non-finite pixels, …).
+    pub warnings: Vec<String>,
+}
+
+/// Which pass is running, for progress reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pass {
+    /// Reading and histogramming.
+    Histogram,
+    /// Classifying and measuring.
+    Measure,
+}
+
+/// Progress callback: (pass, images done, images in the series).
+pub type Progress<'a> = &'a (dyn Fn(Pass, usize, usize) + Sync);
+
+/// Called in pass 2 for each image with its index, plane and mask (for overlays and saved
+/// masks). Calls may come from several threads and in any order.
+pub type ImageSink<'a> = &'a (dyn Fn(usize, &Plane, &Mask) -> Result<()> + Sync);
+
+/// Analyse a series: one threshold by `options.method`, then every image measured.
+pub fn analyze<S: PlaneSource + ?Sized>(
+    source: &S,
+    options: &AnalysisOptions,
+    progress: Progress,
+    sink: ImageSink,
+) -> Result<Analysis> {
+    if source.is_empty() {
+        return Err(Error::InvalidArgument("the series has no images".into()));
+    }
+    let mut warnings = Vec::new();
+    let (thresholds, series_threshold, histogram_pixels) =
+        choose_thresholds(source, options.method, progress, &mut warnings)?;
+    let done = AtomicUsize::new(0);
+    let measurements = source.scan(|i, plane| {
+        let (m, mask) = measure(plane, &thresholds[i])?;
+        sink(i, plane, &mask)?;
+        progress(
+            Pass::Measure,
+            done.fetch_add(1, Ordering::Relaxed) + 1,
+            source.len(),
+        );
+        Ok(m)
+    })?;
+    let images = thresholds
+        .into_iter()
+        .zip(measurements)
+        .map(|(threshold, measurement)| ImageResult {
+            threshold,
+            measurement,
+        })
+        .collect();
+    Ok(Analysis {
+        images,
+        method: options.method,
+        series_threshold,
+        histogram_pixels,
+        pixel_size: options.pixel_size,
+        warnings,
+    })
+}
+
+/// The global Otsu threshold of a series without measuring (`contactscope threshold`): the
+/// threshold, the number of pixels in the pooled histogram, and warnings.
+pub fn global_threshold<S: PlaneSource + ?Sized>(
+    source: &S,
+    progress: Progress,
+) -> Result<(Threshold, u64, Vec<String>)> {
+    if source.is_empty() {
+        return Err(Error::InvalidArgument("the series has no images".into()));
+    }
+    let mut warnings = Vec::new();
+    let (_, threshold, pixels) =
+        choose_thresholds(source, Method::GlobalOtsu, progress, &mut warnings)?;
+    Ok((threshold.expect("global Otsu sets it"), pixels, warnings))
+}
+
+/// What pass 1 learns about one image: its own threshold (per-image method) and, for float
+/// data, its finite value range.
+type FirstPass = (Option<Threshold>, Option<(f64, f64)>);
+
+type Chosen = (Vec<Threshold>, Option<Threshold>, u64);
+
+fn choose_thresholds<S: PlaneSource + ?Sized>(
+    source: &S,
+    method: Method,
+    progress: Progress,
+    warnings: &mut Vec<String>,
+) -> Result<Chosen> {
+    let n = source.len();
+    let done = AtomicUsize::new(0);
+    let tick = || progress(Pass::Histogram, done.fetch_add(1, Ordering::Relaxed) + 1, n);
+    let integer = source.sample_type().is_integer();
+    let pooled = Mutex::new(Histogram::new(Binning::Integer {
+        offset: integer_offset(source.sample_type()),
+    }));
+    let per_image = source.scan(|i, plane| {
+        let own = if integer {
+            let mut h = Histogram::new(pooled.lock().expect("lock").binning());
+            h.add_plane(plane)?;
+            let own = per_image_otsu(method, &h, || source.label(i))?;
+            pooled.lock().expect("lock").merge(&h)?;
+            own
+        } else {
+            let range = histogram::finite_range(plane);
+            let own = match (method, range) {
+                (Method::PerImageOtsu, Some((lo, hi))) if hi > lo => {
+                    let mut h =
+                        Histogram::new(Binning::Float(FloatBinning::new(lo, hi, FLOAT_BINS)?));
+                    h.add_plane(plane)?;
+                    per_image_otsu(method, &h, || source.label(i))?
+                }
+                (Method::PerImageOtsu, r) => {
+                    return Err(Error::ConstantData {
+                        what: source.label(i),
+                        value: r.map_or(f64::NAN, |r| r.0),
+                    })
+                }
+                _ => None,
+            };
+            return Ok((own, range));
+        };
+        tick();
+        Ok((own, None))
+    })?;
+    let mut pooled = pooled.into_inner().expect("lock");
+    if !integer {
+        pooled = float_series_histogram(source, &per_image, &tick)?;
+        if pooled.non_finite() > 0 {
+            warnings.push(format!(
+                "{} NaN or infinite pixels were ignored (never contact)",
+                pooled.non_finite()
+            ));
+        }
+    }
+    let pixels = pooled.total();
+    let series_threshold = match method {
+        Method::GlobalOtsu => Some(Threshold::otsu(&pooled, "the series")?),
+        Method::Manual(t) => Some(Threshold::manual(t, &empty_samples(source.sample_type()))),
+        Method::PerImageOtsu => None,
+    };
+    let thresholds = per_image
+        .into_iter()
+        .map(|(own, _)| own.or(series_threshold).expect("one of the two is set"))
+        .collect();
+    Ok((thresholds, series_threshold, pixels))
+}
+
+fn float_series_histogram<S: PlaneSource + ?Sized>(
+    source: &S,
+    per_image: &[FirstPass],
+    tick: &(dyn Fn() + Sync),
+) -> Result<Histogram> {
+    let (lo, hi) = per_image
+        .iter()
+        .filter_map(|(_, r)| *r)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (lo, hi)| {
+            (a.min(lo), b.max(hi))
+        });
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+        return Err(Error::ConstantData {
+            what: "the series".into(),
+            value: if lo.is_finite() { lo } else { f64::NAN },
+        });
+    }
+    let binning = Binning::Float(FloatBinning::new(lo, hi, FLOAT_BINS)?);
+    let pooled = Mutex::new(Histogram::new(binning));
+    source.scan(|_, plane| {
+        let mut h = Histogram::new(binning);
+        h.add_plane(plane)?;
+        pooled.lock().expect("lock").merge(&h)?;
+        tick();
+        Ok(())
+    })?;
+    Ok(pooled.into_inner().expect("lock"))
+}
+
+fn per_image_otsu(
+    method: Method,
+    hist: &Histogram,
+    name: impl FnOnce() -> String,
+) -> Result<Option<Threshold>> {
+    match method {
+        Method::PerImageOtsu => Threshold::otsu(hist, &name()).map(Some),
+        _ => Ok(None),
+    }
+}
+
+/// No pixels, but the series' kind of samples (what a manual threshold needs to know).
+fn empty_samples(sample_type: SampleType) -> Samples {
+    if sample_type.is_integer() {
+        Samples::Int {
+            codes: Vec::new(),
+            offset: integer_offset(sample_type),
+        }
+    } else {
+        Samples::Float(Vec::new())
+    }
+}
+
+fn integer_offset(sample_type: SampleType) -> i32 {
+    match sample_type {
+        SampleType::I16 => -32768,
+        _ => 0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plane(width: usize, codes: Vec<u16>) -> Plane {
+        let height = codes.len() / width;
+        Plane::from_u16(width, height, codes)
+    }
+
+    #[test]
+    fn in_memory_planes_give_the_histogram_threshold() {
+        // Two 4×2 planes, background 10 and contact 50; one pixel of contact in the first,
+        // three in the second.
+        let planes = [
+            plane(4, vec![10, 10, 10, 50, 10, 10, 10, 10]),
+            plane(4, vec![50, 50, 10, 50, 10, 10, 10, 10]),
+        ];
+        let seen = AtomicUsize::new(0);
+        let sink = |_: usize, _: &Plane, _: &Mask| {
+            seen.fetch_add(1, Ordering::Relaxed);
+            Ok(())
+        };
+        let a = analyze(
+            &planes[..],
+            &AnalysisOptions::default(),
+            &|_, _, _| {},
+            &sink,
+        )
+        .unwrap();
+        let t = a.series_threshold.unwrap().value;
+        assert!((10.0..50.0).contains(&t), "{t}");
+        let counts: Vec<u64> = a
+            .images
+            .iter()
+            .map(|r| r.measurement.contact_pixels)
+            .collect();
+        assert_eq!(counts, vec![1, 3]);
+        assert_eq!((a.histogram_pixels, seen.into_inner()), (16, 2));
+    }
+
+    #[test]
+    fn in_memory_planes_must_agree_and_exist() {
+        let planes = [plane(4, vec![1; 8]), plane(2, vec![2; 8])];
+        let err = global_threshold(&planes[..], &|_, _, _| {})
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("image 1 is 2×4"), "{err}");
+        let none: [Plane; 0] = [];
+        assert!(analyze(
+            &none[..],
+            &AnalysisOptions::default(),
+            &|_, _, _| {},
+            &|_, _, _| Ok(())
+        )
+        .is_err());
+    }
+}

@@ -1,0 +1,206 @@
+//! Argument groups shared by several commands, defined once: the pixel-size override, the output
+//! folder, `--quiet`, the height-map options and the rough sphere (`--topography`, `--radius`,
+//! `--modulus`); and the conversions of their text into library types (SI units).
+
+use std::marker::PhantomData;
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::ValueEnum;
+
+use contactscope::io::topography::TopographySource;
+use contactscope::io::units::{self, Dimension};
+use contactscope::solver::cg::SolverOptions;
+use contactscope::surface::Detrend;
+
+/// `--pixel-size`: overrides the files' calibration.
+#[derive(clap::Args, Clone, Debug)]
+pub struct PixelSizeArg {
+    /// Pixel size overriding the files' metadata: 200nm, 0.2um, or 200x210nm (x × y).
+    #[arg(long)]
+    pub pixel_size: Option<String>,
+}
+
+impl PixelSizeArg {
+    /// (x, y) in metres, if given.
+    pub fn metres(&self) -> Result<Option<(f64, f64)>> {
+        optional_pixel_size(&self.pixel_size, "--pixel-size")
+    }
+}
+
+/// The default output folder of one command.
+pub trait DefaultOut: Clone + Send + Sync + 'static {
+    /// Folder used without `--out`.
+    const PATH: &'static str;
+}
+
+/// `--out`: the output folder, written all or nothing (`io::staging`).
+#[derive(clap::Args, Clone, Debug)]
+pub struct OutputFolder<D: DefaultOut> {
+    /// Output folder.
+    #[arg(long, default_value = D::PATH)]
+    pub out: PathBuf,
+    #[arg(skip)]
+    default: PhantomData<D>,
+}
+
+/// Declares the marker type of a command's default output folder.
+macro_rules! default_out {
+    ($name:ident, $path:literal) => {
+        #[derive(Clone, Debug)]
+        pub struct $name;
+        impl $crate::cli::args::DefaultOut for $name {
+            const PATH: &'static str = $path;
+        }
+    };
+}
+pub(crate) use default_out;
+
+/// The contact solver's stopping rule (`simulate`, `fit-hardening`).
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct SolverArgs {
+    /// Relative CG tolerance.
+    #[arg(long, default_value_t = 1e-8)]
+    pub tolerance: f64,
+    /// Most CG iterations per load.
+    #[arg(long, default_value_t = 5000)]
+    pub max_iterations: usize,
+}
+
+impl SolverArgs {
+    /// The solver options (no progress monitor).
+    pub fn options(&self) -> SolverOptions<'static> {
+        SolverOptions {
+            max_iterations: self.max_iterations,
+            tolerance: self.tolerance,
+            monitor: None,
+            ..SolverOptions::default()
+        }
+    }
+}
+
+/// `--quiet`, `-q`.
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct Quiet {
+    /// No progress output (bar or stage messages).
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Detrending of a height map.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum DetrendArg {
+    /// Keep the heights as read.
+    None,
+    /// Subtract the mean height.
+    Mean,
+    /// Subtract the least-squares plane.
+    Plane,
+}
+
+impl DetrendArg {
+    /// The library's detrending.
+    pub fn detrend(self) -> Detrend {
+        match self {
+            DetrendArg::None => Detrend::None,
+            DetrendArg::Mean => Detrend::Mean,
+            DetrendArg::Plane => Detrend::Plane,
+        }
+    }
+}
+
+/// How to read and level a height map.
+#[derive(clap::Args, Clone, Debug)]
+pub struct HeightMapOptions {
+    /// Pixel size (needed for .npy and text; overrides metadata): 32nm or 32x40nm.
+    #[arg(long)]
+    pub pixel_size: Option<String>,
+    /// Height unit of files that do not state one (.npy, text, TIFF), e.g. 1nm; default metres.
+    #[arg(long)]
+    pub height_unit: Option<String>,
+    /// Detrending before anything else.
+    #[arg(long, value_enum, default_value = "plane")]
+    pub detrend: DetrendArg,
+}
+
+impl HeightMapOptions {
+    /// The height map at `path`, read with these options.
+    pub fn source(&self, path: PathBuf) -> Result<TopographySource> {
+        Ok(TopographySource {
+            path,
+            pixel_size_m: optional_pixel_size(&self.pixel_size, "--pixel-size")?,
+            height_unit_m: optional_length(&self.height_unit, "--height-unit")?,
+            detrend: self.detrend.detrend(),
+        })
+    }
+}
+
+/// `--topography FILE` with its reading options.
+#[derive(clap::Args, Clone, Debug)]
+pub struct TopographyInput {
+    /// Height map: .npy, float TIFF, .gsf, text matrix (.txt/.csv/.dat), WSxM .top, Nanoscope .di.
+    #[arg(long = "topography")]
+    pub path: PathBuf,
+    #[command(flatten)]
+    pub options: HeightMapOptions,
+}
+
+/// The rough sphere and its material, as `simulate` and `fit-hardening` take them.
+#[derive(clap::Args, Clone, Debug)]
+pub struct BodyArgs {
+    #[command(flatten)]
+    pub input: TopographyInput,
+    /// Sphere radius added to a flattened map (and the GT sphere), e.g. 290um; centred at
+    /// ((N−1)/2, (N−1)/2) pixels.
+    #[arg(long)]
+    pub radius: Option<String>,
+    /// Contact modulus E*, e.g. 3.7GPa.
+    #[arg(long)]
+    pub modulus: String,
+}
+
+/// The validated body: topography source, optional sphere radius (m), E* (Pa).
+pub struct Body {
+    pub topography: TopographySource,
+    pub radius_m: Option<f64>,
+    pub e_star_pa: f64,
+}
+
+impl BodyArgs {
+    /// Parsed into library units.
+    pub fn body(&self) -> Result<Body> {
+        Ok(Body {
+            topography: self.input.options.source(self.input.path.clone())?,
+            radius_m: optional_length(&self.radius, "--radius")?,
+            e_star_pa: units::parse_positive(&self.modulus, Dimension::Pressure)
+                .context("--modulus")?,
+        })
+    }
+}
+
+/// An optional pixel size (x, y) in metres from `200nm` or `200x210nm`.
+pub fn optional_pixel_size(text: &Option<String>, flag: &str) -> Result<Option<(f64, f64)>> {
+    text.as_deref()
+        .map(units::parse_pixel_size)
+        .transpose()
+        .with_context(|| flag.to_string())
+}
+
+/// An optional positive length in metres.
+pub fn optional_length(text: &Option<String>, flag: &str) -> Result<Option<f64>> {
+    text.as_deref()
+        .map(|t| units::parse_positive(t, Dimension::Length).with_context(|| flag.to_string()))
+        .transpose()
+}
+
+/// A fraction in [0, 1) from `1%` or `0.01`.
+pub fn fraction(text: &str, flag: &str) -> Result<f64> {
+    let value = match text.trim().strip_suffix('%') {
+        Some(pct) => pct.trim().parse::<f64>().map(|p| p / 100.0),
+        None => text.trim().parse::<f64>(),
+    };
+    match value {
+        Ok(v) if (0.0..1.0).contains(&v) => Ok(v),
+        _ => bail!("{flag}: {text:?} is not a fraction in [0, 1) such as 1% or 0.01"),
+    }
+}

@@ -1,0 +1,117 @@
+//! TIFF files: the reader ([`read`]: header facts, pages, channels, pixel-size metadata), the
+//! ImageJ/OME metadata parsers ([`metadata`]) and the writer ([`mod@write`]); plus the single images
+//! and z stacks of the optics commands as [`Image`]s ([`read_pages`], [`read_image`]).
+
+pub mod metadata;
+pub mod read;
+pub mod write;
+
+use std::path::Path;
+
+pub use read::{ChannelLayout, TiffInfo, TiffReader};
+pub use write::{
+    encode_f32_stack, encode_u16_stack, encode_u16_stack_compressed, encode_u8_stack, Compression,
+};
+
+use crate::error::{Error, Location, Result};
+use crate::image::{pixel_size_or, Image};
+
+/// Every page of one channel of a TIFF file (a z stack, a time series or a single image), in
+/// page order. `channel` may be `None` for single-channel files only.
+pub fn read_pages(
+    path: &Path,
+    channel: Option<usize>,
+    pixel_size_m: Option<(f64, f64)>,
+) -> Result<Vec<Image>> {
+    let mut reader = TiffReader::open(path)?;
+    let info = reader.info().clone();
+    let channel = match channel {
+        None if info.channels > 1 => {
+            return Err(Error::bad_input(
+                Location::file(path),
+                format!(
+                    "file has {} channels ({}); choose one with --channel 0..{}",
+                    info.channels,
+                    info.channel_layout.describe(),
+                    info.channels - 1
+                ),
+            ))
+        }
+        Some(c) if c >= info.channels => {
+            return Err(Error::bad_input(
+                Location::file(path),
+                format!(
+                    "channel {c} requested but the file has {} channel(s)",
+                    info.channels
+                ),
+            ))
+        }
+        c => c.unwrap_or(0),
+    };
+    let pixel_size = pixel_size_or(info.pixel_size, pixel_size_m);
+    info.pages_of_channel(channel)
+        .into_iter()
+        .map(|page| {
+            let plane = reader.read_page(page, channel)?;
+            Ok(Image {
+                values: plane.to_f64(),
+                width: plane.width,
+                height: plane.height,
+                pixel_size,
+                path: path.to_path_buf(),
+                page,
+            })
+        })
+        .collect()
+}
+
+/// The one image of a single-page file (per channel); a file with several pages is an error
+/// naming the page count.
+pub fn read_image(
+    path: &Path,
+    channel: Option<usize>,
+    pixel_size_m: Option<(f64, f64)>,
+) -> Result<Image> {
+    let mut pages = read_pages(path, channel, pixel_size_m)?;
+    match pages.len() {
+        1 => Ok(pages.remove(0)),
+        0 => Err(Error::bad_input(
+            Location::file(path),
+            "file holds no image",
+        )),
+        n => Err(Error::bad_input(
+            Location::file(path),
+            format!("file holds {n} pages; a single 2-D image is expected here"),
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::image::PixelSizeSource;
+
+    #[test]
+    fn pages_and_single_image() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("two.tif");
+        let page = |k: u16| (0..6u16).map(|i| i + 10 * k).collect::<Vec<_>>();
+        let (p0, p1) = (page(0), page(1));
+        let bytes = encode_u16_stack(&[&p0, &p1], 3, 2, Some((0.2e-6, 0.2e-6)), "").unwrap();
+        std::fs::write(&path, bytes).unwrap();
+        let pages = read_pages(&path, None, None).unwrap();
+        assert_eq!(pages.len(), 2);
+        assert_eq!((pages[1].width, pages[1].height), (3, 2));
+        assert_eq!(pages[1].at(2, 1), 15.0);
+        let px = pages[0].require_pixel_size().unwrap();
+        assert!((px.x_m - 0.2e-6).abs() < 1e-12);
+        let err = read_image(&path, None, None).unwrap_err().to_string();
+        assert!(err.contains("2 pages") && err.contains("two.tif"), "{err}");
+        let over = read_pages(&path, None, Some((1e-7, 1e-7))).unwrap();
+        assert_eq!(
+            over[0].pixel_size.unwrap().source,
+            PixelSizeSource::CommandLine
+        );
+        assert!(read_pages(&path, Some(1), None).is_err());
+    }
+}

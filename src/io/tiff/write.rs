@@ -1,0 +1,164 @@
+//! Writing TIFF stacks with ImageJ calibration (for generated series and saved masks).
+//!
+//! The ImageJ convention (read back by [`super::read`]): ImageDescription on the first page
+//! with `ImageJ=`, `images=`, `slices=` and `unit=micron`, and X/YResolution as pixels per
+//! micron with ResolutionUnit = NONE.
+
+use std::io::Cursor;
+
+use tiff::encoder::{colortype, Compression as TiffCompression, Rational, TiffEncoder, TiffValue};
+use tiff::tags::{ResolutionUnit, Tag};
+
+use crate::error::{Error, Result};
+
+fn encode_error(e: tiff::TiffError) -> Error {
+    Error::Output {
+        path: "<tiff encoder>".into(),
+        reason: e.to_string(),
+    }
+}
+
+/// Pixels per micron as a rational with six decimal places.
+fn per_micron(size_m: f64) -> Rational {
+    let d = (size_m * 1e12).round().clamp(1.0, f64::from(u32::MAX)) as u32;
+    Rational { n: 1_000_000, d }
+}
+
+fn imagej_description(pages: usize, pixel_size: Option<(f64, f64)>, extra: &str) -> String {
+    let mut d = format!("ImageJ=1.11a\nimages={pages}\nslices={pages}\nloop=false\n");
+    if pixel_size.is_some() {
+        d.push_str("unit=micron\n");
+    }
+    d.push_str(extra);
+    d
+}
+
+/// Compression of written TIFF pages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Compression {
+    /// Uncompressed strips.
+    #[default]
+    None,
+    /// LZW, no predictor.
+    Lzw,
+    /// Adobe Deflate, no predictor.
+    Deflate,
+}
+
+impl Compression {
+    fn to_tiff(self) -> TiffCompression {
+        match self {
+            Compression::None => TiffCompression::Uncompressed,
+            Compression::Lzw => TiffCompression::Lzw,
+            Compression::Deflate => TiffCompression::Deflate(Default::default()),
+        }
+    }
+}
+
+fn encode_stack<C: colortype::ColorType>(
+    pages: &[&[C::Inner]],
+    width: usize,
+    height: usize,
+    pixel_size: Option<(f64, f64)>,
+    extra_description: &str,
+    compression: Compression,
+) -> Result<Vec<u8>>
+where
+    [C::Inner]: TiffValue,
+{
+    let mut bytes = Cursor::new(Vec::new());
+    let mut encoder = TiffEncoder::new(&mut bytes)
+        .map_err(encode_error)?
+        .with_compression(compression.to_tiff());
+    let description = imagej_description(pages.len(), pixel_size, extra_description);
+    for (i, page) in pages.iter().enumerate() {
+        if page.len() != width * height {
+            return Err(Error::InvalidArgument(format!(
+                "page {i} has {} values, expected {width}×{height}",
+                page.len()
+            )));
+        }
+        let mut image = encoder
+            .new_image::<C>(width as u32, height as u32)
+            .map_err(encode_error)?;
+        if i == 0 {
+            image
+                .encoder()
+                .write_tag(Tag::ImageDescription, description.as_str())
+                .map_err(encode_error)?;
+        }
+        if let Some((x, y)) = pixel_size {
+            image.resolution_unit(ResolutionUnit::None);
+            image.x_resolution(per_micron(x));
+            image.y_resolution(per_micron(y));
+        }
+        image.write_data(page).map_err(encode_error)?;
+    }
+    Ok(bytes.into_inner())
+}
+
+/// Encode 16-bit grey pages as one uncompressed multi-page TIFF with ImageJ calibration (pixel
+/// size in m).
+pub fn encode_u16_stack(
+    pages: &[&[u16]],
+    width: usize,
+    height: usize,
+    pixel_size: Option<(f64, f64)>,
+    extra_description: &str,
+) -> Result<Vec<u8>> {
+    encode_u16_stack_compressed(
+        pages,
+        width,
+        height,
+        pixel_size,
+        extra_description,
+        Compression::None,
+    )
+}
+
+/// [`encode_u16_stack`] with a choice of compression.
+pub fn encode_u16_stack_compressed(
+    pages: &[&[u16]],
+    width: usize,
+    height: usize,
+    pixel_size: Option<(f64, f64)>,
+    extra_description: &str,
+    compression: Compression,
+) -> Result<Vec<u8>> {
+    encode_stack::<colortype::Gray16>(
+        pages,
+        width,
+        height,
+        pixel_size,
+        extra_description,
+        compression,
+    )
+}
+
+/// Encode 8-bit grey pages (masks: 0 or 255) as one multi-page TIFF with ImageJ calibration.
+pub fn encode_u8_stack(
+    pages: &[&[u8]],
+    width: usize,
+    height: usize,
+    pixel_size: Option<(f64, f64)>,
+) -> Result<Vec<u8>> {
+    encode_stack::<colortype::Gray8>(pages, width, height, pixel_size, "", Compression::Deflate)
+}
+
+/// Encode 32-bit float grey pages (maps of the solver) as one TIFF with ImageJ calibration.
+pub fn encode_f32_stack(
+    pages: &[&[f32]],
+    width: usize,
+    height: usize,
+    pixel_size: Option<(f64, f64)>,
+    extra_description: &str,
+) -> Result<Vec<u8>> {
+    encode_stack::<colortype::Gray32Float>(
+        pages,
+        width,
+        height,
+        pixel_size,
+        extra_description,
+        Compression::Deflate,
+    )
+}
