@@ -14,6 +14,7 @@
 pub mod gap;
 pub mod profile;
 mod report;
+pub mod rings;
 pub mod synth;
 
 pub use crate::stats::MeanSd;
