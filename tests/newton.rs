@@ -7,6 +7,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{column, read_csv, run, stderr};
+use contactscope::error::Error;
 use contactscope::optics::newton::{
     analyse, fit_hertz_gap, synth_newton, NewtonAnalysis, NewtonOptions, NewtonSynth,
     NewtonSynthParams, Phase,
@@ -30,14 +31,21 @@ fn image(codes: &[u16], p: &NewtonSynthParams, name: &str) -> Image {
     }
 }
 
-fn analyse_synth(p: &NewtonSynthParams, options: &NewtonOptions) -> (NewtonSynth, NewtonAnalysis) {
-    let s = synth_newton(p).unwrap();
-    let a = analyse(
+fn analyse_pair(
+    s: &NewtonSynth,
+    p: &NewtonSynthParams,
+    options: &NewtonOptions,
+) -> contactscope::error::Result<NewtonAnalysis> {
+    analyse(
         &image(&s.reflection, p, "reflection.tif"),
         &image(&s.fluorescence, p, "fluorescence.tif"),
         options,
     )
-    .unwrap();
+}
+
+fn analyse_synth(p: &NewtonSynthParams, options: &NewtonOptions) -> (NewtonSynth, NewtonAnalysis) {
+    let s = synth_newton(p).unwrap();
+    let a = analyse_pair(&s, p, options).unwrap();
     (s, a)
 }
 
@@ -199,6 +207,8 @@ fn cli_writes_json_csv_and_png() {
     assert!((gap - 9.0).abs() < 2.0, "{gap}");
     assert!(v["detection_gap_nm_sd"].as_f64().unwrap() < 0.5);
     assert_eq!(v["profiles_used"], 20);
+    assert_eq!(v["profiles_needed"], 3);
+    assert_eq!(v["profiles"][0]["half_lines_used"], 2);
     let edge = v["edge_radius_um"].as_f64().unwrap();
     assert!(
         (edge - syn.truth.fluorescent_radius_m * 1e6).abs() < 0.05,
@@ -293,4 +303,56 @@ fn cli_bad_inputs_fail_cleanly() {
     let o = run(&ok.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(out.join("newton.json").exists());
+}
+
+/// The default contact in an n² field centred at `centre_px`.
+fn square_field(n: usize, centre_px: (f64, f64)) -> NewtonSynthParams {
+    NewtonSynthParams {
+        width: n,
+        height: n,
+        centre_px,
+        ..NewtonSynthParams::default()
+    }
+}
+
+/// A contact 0.5 µm beyond its fluorescent edge from the left border: the half-lines towards it
+/// have no outside plateau and no rings, the profiles still count with their other half-line.
+/// With a stricter minimum than the usable count the analysis refuses with the typed error.
+#[test]
+fn half_lines_cut_by_the_border_and_the_minimum_of_profiles() {
+    let p = square_field(320, (66.2, 160.6));
+    let (s, a) = analyse_synth(&p, &NewtonOptions::default());
+    report(&a);
+    let one_sided = a
+        .used()
+        .filter(|prof| prof.sides_used() != [true, true])
+        .count();
+    assert!(one_sided >= 4, "{one_sided} one-sided profiles");
+    assert_eq!(a.used().count(), 20);
+    assert!((a.detection_gap_m.mean - s.truth.detection_gap_m).abs() < 2e-9);
+
+    // The same contact in a field too small for three rings along the axes.
+    let small = square_field(180, (89.6, 90.3));
+    let (syn, a) = analyse_synth(&small, &NewtonOptions::default());
+    let usable = a.used().count();
+    assert!((3..20).contains(&usable), "{usable}");
+    let strict = NewtonOptions {
+        min_profiles: usable + 1,
+        ..NewtonOptions::default()
+    };
+    let err = analyse_pair(&syn, &small, &strict).unwrap_err();
+    match &err {
+        Error::TooFewProfiles {
+            usable: u,
+            total,
+            needed,
+            ..
+        } => assert_eq!((*u, *total, *needed), (usable, 20, usable + 1)),
+        other => panic!("{other:?}"),
+    }
+    let text = err.to_string();
+    assert!(
+        text.contains("reflection.tif") && text.contains("ring(s)"),
+        "{text}"
+    );
 }
