@@ -117,6 +117,22 @@ pub enum Error {
         /// The tolerance asked for.
         tolerance: f64,
     },
+    /// Too few line profiles through Newton rings could be measured (`optics::newton`).
+    #[error(
+        "{at}: only {usable} of {total} line profiles usable, at least {needed} needed: {reason}"
+    )]
+    TooFewProfiles {
+        /// The reflection image.
+        at: Location,
+        /// Profiles that gave a detection gap.
+        usable: usize,
+        /// Profiles measured.
+        total: usize,
+        /// The stated minimum.
+        needed: usize,
+        /// Why the others were skipped.
+        reason: String,
+    },
     /// Writing an output file failed.
     #[error("cannot write {path}: {reason}")]
     Output {

@@ -6,20 +6,26 @@
 //! rigidochromic molecules light up. Along line profiles through the contact centre, the ring
 //! radii r_m give gap points (r_m, d_m); a Hertz exterior gap fitted to them and evaluated at the
 //! fluorescent edge r_f gives the gap at which the molecules light up: the detection gap (the
-//! paper: 9 nm, averaged over 20 profiles).
+//! paper: 9 nm, averaged over 20 profiles). The edge is where the fluorescence profile crosses
+//! half-way between its plateaus ([`profile::half_level_edge`]); ring orders come from where the
+//! maxima lie, not from counting them ([`rings::assign_orders`]).
 //!
 //! [`analyse`] does the measurement on two images in memory; [`crate::jobs::newton::run_newton`] reads the files and
 //! writes `newton.json`, `newton_rings.csv`, `newton_profiles.csv` and `newton_gap.png`.
 
 pub mod gap;
 pub mod profile;
+pub mod rings;
 
 pub use crate::numerics::stats::MeanSd;
 pub use gap::{fit_hertz_gap, hertz_gap, ring_gap, GapFit, Phase};
 
 use crate::error::{Error, Location, Result};
 use crate::image::Image;
-use profile::{edge_crossing, find_contact, noise_sd, peaks, smooth, Contact, HalfLine};
+use profile::{
+    edge_crossing, find_contact, half_level_edge, noise_sd, peaks, smooth, Contact, HalfLine,
+};
+use rings::assign_orders;
 
 /// Choices of the analysis. SI units.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,6 +49,13 @@ pub struct NewtonOptions {
     pub min_prominence_fraction: f64,
     /// Profiles whose rms gap residual exceeds this are skipped, m.
     pub max_rms_residual_m: f64,
+    /// Distance from the fluorescent edge at which its inside and outside plateaus begin, m
+    /// (each plateau is twice as long). It must exceed the edge's blurred half-width: 3σ of the
+    /// PSF and the smoothing together.
+    pub edge_margin_m: f64,
+    /// Fewest usable profiles for a result (or all of them when fewer are asked for); with
+    /// fewer, [`analyse`] fails with [`Error::TooFewProfiles`].
+    pub min_profiles: usize,
 }
 
 impl Default for NewtonOptions {
@@ -59,6 +72,10 @@ impl Default for NewtonOptions {
             // A tenth of the fringe spacing λ/(2n) = 168.6 nm: a correct order assignment on
             // clean rings fits to a few nm, a shifted one by tens of nm.
             max_rms_residual_m: 17e-9,
+            // 3.2σ of a 450 nm PSF with σ = 1 px smoothing at 250 nm pixels, 4.7σ at 100 nm.
+            edge_margin_m: 1e-6,
+            // A mean and a spread with two degrees of freedom.
+            min_profiles: 3,
         }
     }
 }
@@ -68,6 +85,10 @@ pub const MIN_RINGS: usize = 3;
 
 /// Sampling step along a profile, in (smaller) pixels.
 const STEP_PX: f64 = 0.25;
+
+/// Ring tracking ends where the fringes come closer than this, pixels: below it the pixels
+/// alias them and the PSF washes them out (see [`rings`]).
+const MIN_FRINGE_SPACING_PX: f64 = 3.0;
 
 /// One ring maximum on one half-line.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -104,12 +125,25 @@ pub struct ProfileResult {
 }
 
 impl ProfileResult {
-    /// Mean of the two sides' edge radii, m (both must exist).
+    /// Which half-lines (+, −) the profile uses: those with a fluorescent edge and at least one
+    /// ring. A half-line cut short by the image border is left out, the other one still counts.
+    pub fn sides_used(&self) -> [bool; 2] {
+        [1i8, -1].map(|side| {
+            let slot = usize::from(side < 0);
+            self.edge_radius_sides_m[slot].is_some() && self.rings.iter().any(|r| r.side == side)
+        })
+    }
+
+    /// Mean edge radius of the half-lines used, m; with both, a centre error along the line
+    /// cancels to first order.
     pub fn edge_radius_m(&self) -> Option<f64> {
-        match self.edge_radius_sides_m {
-            [Some(a), Some(b)] => Some(0.5 * (a + b)),
-            _ => None,
-        }
+        let used: Vec<f64> = self
+            .sides_used()
+            .iter()
+            .zip(self.edge_radius_sides_m)
+            .filter_map(|(&used, edge)| edge.filter(|_| used))
+            .collect();
+        (!used.is_empty()).then(|| used.iter().sum::<f64>() / used.len() as f64)
     }
 
     /// rms residual with orders shifted by +1 over that with the paper's orders: well above 1
@@ -172,7 +206,8 @@ pub fn analyse(
     let profiles: Vec<ProfileResult> = (0..options.profiles)
         .map(|k| measure_profile(k, reflection, fluorescence, &contact, pixel_m, options))
         .collect();
-    summarise(reflection, contact, pixel_m, profiles)
+    let needed = options.min_profiles.min(options.profiles);
+    summarise(reflection, contact, pixel_m, profiles, needed)
 }
 
 fn check_options(o: &NewtonOptions) -> Result<()> {
@@ -191,6 +226,11 @@ fn check_options(o: &NewtonOptions) -> Result<()> {
     if o.line_width_px == 0 || o.smoothing_px.is_nan() || o.smoothing_px < 0.0 {
         return Err(Error::InvalidArgument(
             "line width must be at least 1 px and smoothing not negative".into(),
+        ));
+    }
+    if !(o.edge_margin_m.is_finite() && o.edge_margin_m > 0.0) || o.min_profiles == 0 {
+        return Err(Error::InvalidArgument(
+            "the edge margin must be positive and at least one profile must be required".into(),
         ));
     }
     Ok(())
@@ -232,14 +272,24 @@ fn measure_profile(
         };
         let sigma = o.smoothing_px / STEP_PX;
         let fluo = smooth(&line.sample(fluorescence), sigma);
-        let Some(edge) = edge_crossing(&fluo, contact.threshold) else {
+        // The Otsu crossing only seeds the search: its level sits anywhere between the
+        // plateaus, which moves the crossing by up to the blur width.
+        let margin = (o.edge_margin_m / step_m).ceil() as usize;
+        let Some(edge) = edge_crossing(&fluo, contact.threshold)
+            .and_then(|guess| half_level_edge(&fluo, guess, margin, 2 * margin))
+        else {
             continue;
         };
-        edges[slot] = Some(edge * step_m);
+        edges[slot] = Some(edge.position * step_m);
         let raw = line.sample(reflection);
-        let radii = ring_radii(&raw, sigma, edge, o);
-        rings.extend(radii.iter().enumerate().map(|(k, &s)| {
-            let order = o.phase.first_order() + k as u32;
+        let min_spacing = MIN_FRINGE_SPACING_PX / STEP_PX;
+        let tracked = assign_orders(
+            &ring_candidates(&raw, sigma, edge.position, o),
+            min_spacing,
+            raw.len().saturating_sub(1) as f64,
+        );
+        rings.extend(tracked.iter().map(|&(k, s)| {
+            let order = o.phase.first_order() + k;
             Ring {
                 side,
                 order,
@@ -262,8 +312,9 @@ fn measure_profile(
     result
 }
 
-/// Ring positions (samples) on one half-line, outward, outside the fluorescent edge.
-fn ring_radii(raw: &[f64], sigma: f64, edge: f64, o: &NewtonOptions) -> Vec<f64> {
+/// Positions (samples) of the maxima on one half-line that stand out enough to be rings,
+/// outward, outside the fluorescent edge; [`assign_orders`] numbers them.
+fn ring_candidates(raw: &[f64], sigma: f64, edge: f64, o: &NewtonOptions) -> Vec<f64> {
     let smoothed = smooth(raw, sigma);
     // The residual raw − smoothed carries most of the profile's noise; peaks of smoothed noise
     // reach about twice its deviation, real rings stand far above that.
@@ -281,9 +332,14 @@ fn ring_radii(raw: &[f64], sigma: f64, edge: f64, o: &NewtonOptions) -> Vec<f64>
 /// Fit the profile's rings (paper orders and orders + 1) and decide whether it is used.
 fn fit_profile(result: &mut ProfileResult, o: &NewtonOptions) {
     let Some(edge) = result.edge_radius_m() else {
-        result.skipped = Some("no fluorescent edge on one or both sides of the line".into());
+        result.skipped = Some(if result.edge_radius_sides_m.iter().all(Option::is_none) {
+            "no fluorescent edge on either half-line".into()
+        } else {
+            "0 ring(s) outside the contact edge on the half-lines with an edge".into()
+        });
         return;
     };
+    // Rings are only looked for beyond an edge, so every ring lies on a half-line used.
     if result.rings.len() < MIN_RINGS {
         result.skipped = Some(format!(
             "{} ring(s) outside the contact edge; {MIN_RINGS} needed to fit a and R",
@@ -327,14 +383,18 @@ fn fit_profile(result: &mut ProfileResult, o: &NewtonOptions) {
     }
 }
 
-/// Averages over the profiles used, or the error that explains why none was.
+/// Averages over the profiles used, or [`Error::TooFewProfiles`] when fewer than `needed` are.
 fn summarise(
     reflection: &Image,
     contact: Contact,
     pixel_m: (f64, f64),
     profiles: Vec<ProfileResult>,
+    needed: usize,
 ) -> Result<NewtonAnalysis> {
     let used: Vec<&ProfileResult> = profiles.iter().filter(|p| p.skipped.is_none()).collect();
+    if used.len() < needed {
+        return Err(too_few_profiles(reflection, &profiles, needed));
+    }
     let spread = |f: &dyn Fn(&ProfileResult) -> Option<f64>| {
         MeanSd::of(&used.iter().filter_map(|p| f(p)).collect::<Vec<_>>())
     };
@@ -344,7 +404,7 @@ fn summarise(
         spread(&|p| p.fit.map(|f| f.contact_radius_m)),
         spread(&|p| p.fit.map(|f| f.sphere_radius_m)),
     ) else {
-        return Err(no_profile_error(reflection, &profiles));
+        return Err(too_few_profiles(reflection, &profiles, needed));
     };
     Ok(NewtonAnalysis {
         contact,
@@ -357,7 +417,8 @@ fn summarise(
     })
 }
 
-fn no_profile_error(reflection: &Image, profiles: &[ProfileResult]) -> Error {
+fn too_few_profiles(reflection: &Image, profiles: &[ProfileResult], needed: usize) -> Error {
+    let usable = profiles.iter().filter(|p| p.skipped.is_none()).count();
     let most = profiles.iter().map(|p| p.rings.len()).max().unwrap_or(0);
     let reason = if most == 0 {
         "no Newton rings found outside the fluorescent contact on any line profile".to_string()
@@ -366,11 +427,21 @@ fn no_profile_error(reflection: &Image, profiles: &[ProfileResult]) -> Error {
     } else {
         let first = profiles
             .iter()
-            .find_map(|p| p.skipped.clone())
+            .find_map(|p| {
+                p.skipped
+                    .as_ref()
+                    .map(|why| format!("profile {} ({:.1}°): {why}", p.index, p.angle_deg))
+            })
             .unwrap_or_default();
-        format!("no line profile gave a usable fit (e.g. {first})")
+        format!("the first skipped is {first}")
     };
-    Error::bad_input(Location::file(&reflection.path), reason)
+    Error::TooFewProfiles {
+        at: Location::file(&reflection.path),
+        usable,
+        total: profiles.len(),
+        needed,
+        reason,
+    }
 }
 
 #[cfg(test)]
