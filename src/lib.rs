@@ -60,6 +60,7 @@ pub mod error;
 pub mod fit;
 pub mod fitting;
 pub mod hertz;
+pub mod io;
 pub mod measure;
 pub mod mechanics;
 pub mod optics;

@@ -1,0 +1,1 @@
+//! AFM and profilometer height maps (placeholder, filled below).
