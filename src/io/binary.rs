@@ -26,7 +26,7 @@ pub(crate) fn unsupported(path: &Path, reason: impl Into<String>) -> Error {
 pub(crate) fn checked_bytes(path: &Path, what: &str, dims: &[usize], size: usize) -> Result<usize> {
     let mut total = size;
     for &d in dims {
-        total = total.checked_mul(d).unwrap_or(usize::MAX);
+        total = total.saturating_mul(d);
     }
     if total > MAX_PLANE_BYTES {
         return Err(unsupported(
@@ -154,7 +154,13 @@ pub(crate) fn utf16le(bytes: &[u8]) -> String {
 
 /// Little-endian samples of `width` bytes to f64 (`float` marks IEEE floats, `signed` two's
 /// complement integers).
-pub(crate) fn decode_values(bytes: &[u8], width: usize, float: bool, signed: bool, big: bool) -> Vec<f64> {
+pub(crate) fn decode_values(
+    bytes: &[u8],
+    width: usize,
+    float: bool,
+    signed: bool,
+    big: bool,
+) -> Vec<f64> {
     bytes
         .chunks_exact(width)
         .map(|c| {
@@ -177,26 +183,6 @@ pub(crate) fn decode_values(bytes: &[u8], width: usize, float: bool, signed: boo
             }
         })
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn reads_are_bounds_checked() {
-        let p = Path::new("f.bin");
-        let data = [1u8, 0, 0, 0, 0xff];
-        let mut r = Reader::new(p, &data, 0);
-        assert_eq!(r.u32().unwrap(), 1);
-        assert!(r.u32().unwrap_err().to_string().contains("truncated"));
-        let mut r = Reader::new(p, &data, 0).big_endian(true);
-        assert_eq!(r.u16().unwrap(), 256);
-        assert!(checked_bytes(p, "plane", &[1 << 20, 1 << 20], 2).is_err());
-        assert_eq!(checked_bytes(p, "plane", &[3, 4], 2).unwrap(), 24);
-        assert_eq!(decode_values(&[0xff, 0xff], 2, false, true, false), vec![-1.0]);
-        assert_eq!(decode_values(&[0x01, 0x00], 2, false, false, true), vec![256.0]);
-    }
 }
 
 /// An open file read in pieces: every piece is checked against the file length before a buffer
@@ -246,5 +232,31 @@ impl FileSource {
     pub(crate) fn read_up_to(&mut self, offset: u64, len: usize) -> Result<Vec<u8>> {
         let available = self.len.saturating_sub(offset).min(len as u64) as usize;
         self.read_at(offset, available, "header")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_are_bounds_checked() {
+        let p = Path::new("f.bin");
+        let data = [1u8, 0, 0, 0, 0xff];
+        let mut r = Reader::new(p, &data, 0);
+        assert_eq!(r.u32().unwrap(), 1);
+        assert!(r.u32().unwrap_err().to_string().contains("truncated"));
+        let mut r = Reader::new(p, &data, 0).big_endian(true);
+        assert_eq!(r.u16().unwrap(), 256);
+        assert!(checked_bytes(p, "plane", &[1 << 20, 1 << 20], 2).is_err());
+        assert_eq!(checked_bytes(p, "plane", &[3, 4], 2).unwrap(), 24);
+        assert_eq!(
+            decode_values(&[0xff, 0xff], 2, false, true, false),
+            vec![-1.0]
+        );
+        assert_eq!(
+            decode_values(&[0x01, 0x00], 2, false, false, true),
+            vec![256.0]
+        );
     }
 }

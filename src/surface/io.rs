@@ -75,6 +75,10 @@ pub fn read_topography(
     pixel_size_m: Option<(f64, f64)>,
     height_unit_m: Option<f64>,
 ) -> Result<Topography> {
+    // Vendor AFM/profilometer formats, recognised by content (crate::io::topography).
+    if let Some(t) = crate::io::topography::read_for_surface(path, pixel_size_m, height_unit_m)? {
+        return Ok(t);
+    }
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -220,25 +224,14 @@ pub(crate) fn latin1(bytes: &[u8]) -> String {
     bytes.iter().map(|&b| char::from(b)).collect()
 }
 
-/// Bytes `offset..offset + len` of `data`, or a "truncated" error.
+/// Bytes `offset..offset + len` of `data`, or a "truncated" error ([`crate::io::binary::slice`]).
 pub(crate) fn slice<'a>(
     path: &Path,
     data: &'a [u8],
     offset: usize,
     len: usize,
 ) -> Result<&'a [u8]> {
-    offset
-        .checked_add(len)
-        .and_then(|end| data.get(offset..end))
-        .ok_or_else(|| {
-            bad(
-                path,
-                format!(
-                    "file is truncated: {len} bytes of data expected at offset {offset}, the file has {}",
-                    data.len()
-                ),
-            )
-        })
+    crate::io::binary::slice(path, data, offset, len, "the data")
 }
 
 /// Build the [`Topography`], turning its argument errors into errors naming the file.

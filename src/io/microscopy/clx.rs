@@ -73,7 +73,10 @@ impl Clx {
 /// Parse a whole chunk: a sequence of items, returned as one level.
 pub(crate) fn parse(path: &Path, data: &[u8]) -> Result<Clx> {
     if data.first() == Some(&76) {
-        return Err(bad(path, "compressed (deflated) ND2 metadata is not supported"));
+        return Err(bad(
+            path,
+            "compressed (deflated) ND2 metadata is not supported",
+        ));
     }
     let mut r = Reader::new(path, data, 0);
     let mut items = Vec::new();

@@ -199,12 +199,7 @@ impl CziReader {
             .entries
             .iter()
             .map(|&i| self.entries[i].clone())
-            .filter(|e| {
-                scene
-                    .origin
-                    .keys()
-                    .all(|name| e.start(name) == want(name))
-            })
+            .filter(|e| scene.origin.keys().all(|name| e.start(name) == want(name)))
             .collect();
         tiles.sort_by_key(|e| (e.start("M"), e.position));
         let (bx, by, width, height) = scene.bbox;
@@ -216,7 +211,10 @@ impl CziReader {
             let (tx, ty, _, _, sw, sh) = tile.rect();
             let (dtype, spp) = pixel_layout(tile.pixel_type).map_err(|e| unsupported(&path, e))?;
             if dtype != info.dtype || spp != scene.samples {
-                return Err(bad(&path, "subblocks of one plane have different pixel types"));
+                return Err(bad(
+                    &path,
+                    "subblocks of one plane have different pixel types",
+                ));
             }
             let data = self.read_tile(&tile, sw, sh, spp * bytes)?;
             let pixel = spp * bytes;
@@ -243,7 +241,9 @@ impl CziReader {
     fn read_tile(&mut self, e: &Entry, sw: usize, sh: usize, pixel: usize) -> Result<Vec<u8>> {
         let path = self.source.path.clone();
         let expected = checked_bytes(&path, "subblock", &[sw, sh], pixel)?;
-        let head = self.source.read_at(e.position, 32 + 16, "a subblock header")?;
+        let head = self
+            .source
+            .read_at(e.position, 32 + 16, "a subblock header")?;
         if !head.starts_with(b"ZISRAWSUBBLOCK") {
             return Err(bad(
                 &path,
@@ -515,15 +515,17 @@ impl Metadata {
             };
             meta.scaling[k] = VoxelSize::valid(number(find(d, "Value")));
         }
-        if let Some(dims) = doc
-            .descendants()
-            .find(|n| n.has_tag_name("Dimensions") && n.parent().is_some_and(|p| p.has_tag_name("Image")))
-        {
+        if let Some(dims) = doc.descendants().find(|n| {
+            n.has_tag_name("Dimensions") && n.parent().is_some_and(|p| p.has_tag_name("Image"))
+        }) {
             if let Some(chs) = find(dims, "Channels") {
                 for ch in chs.children().filter(|n| n.has_tag_name("Channel")) {
                     let nm = |tag| number(find(ch, tag)).map(|v: f64| v * 1e-9);
                     meta.channels.push(ChannelInfo {
-                        name: ch.attribute("Name").map(str::to_string),
+                        name: ch
+                            .attribute("Name")
+                            .filter(|n| !n.is_empty())
+                            .map(str::to_string),
                         emission_wavelength_m: nm("EmissionWavelength"),
                         excitation_wavelength_m: nm("ExcitationWavelength"),
                     });
@@ -562,7 +564,10 @@ fn series_info(
             .iter()
             .map(|&i| entries[i].start(name))
             .collect();
-        let (lo, hi) = (starts.first().copied().unwrap_or(0), starts.last().copied().unwrap_or(0));
+        let (lo, hi) = (
+            starts.first().copied().unwrap_or(0),
+            starts.last().copied().unwrap_or(0),
+        );
         counts.insert(name.clone(), (i64::from(hi) - i64::from(lo) + 1) as usize);
     }
     let take = |counts: &mut BTreeMap<String, usize>, k: &str| counts.remove(k).unwrap_or(1);
@@ -583,9 +588,32 @@ fn series_info(
         x: scene.bbox.2,
         extra: counts,
     };
-    let total: usize = axes.planes();
-    if total > scene.entries.len().max(1) * 4096 {
-        return Err(bad(path, format!("directory spans {total} planes for {} subblocks", scene.entries.len())));
+    // Corrupt coordinates show as axes far longer than the subblocks can fill, or a bounding
+    // box far larger than its tiles: refuse before planes of zeros are decoded.
+    let (total, tiles) = (axes.planes() / spp, scene.entries.len());
+    if total > 2 * tiles {
+        return Err(bad(
+            path,
+            format!("the subblock coordinates span {total} planes for {tiles} subblocks (corrupt directory?)"),
+        ));
+    }
+    let tile_area: u64 = scene
+        .entries
+        .iter()
+        .map(|&i| {
+            let (_, _, w, h, _, _) = entries[i].rect();
+            (w.max(0) as u64).saturating_mul(h.max(0) as u64)
+        })
+        .fold(0u64, u64::saturating_add);
+    let box_area = (axes.x as u64).saturating_mul(axes.y as u64);
+    if box_area > (64 * tile_area / total.max(1) as u64).max(1 << 20) {
+        return Err(bad(
+            path,
+            format!(
+                "scene bounding box of {}×{} pixels is far larger than its tiles (corrupt directory?)",
+                axes.x, axes.y
+            ),
+        ));
     }
     let [x, y, z_m] = meta.scaling;
     let source = (x.is_some() || y.is_some())

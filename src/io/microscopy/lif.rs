@@ -151,7 +151,10 @@ impl LifReader {
         if x_stride != l.sample_bytes {
             return Err(unsupported(
                 &self.source.path,
-                format!("LIF X stride of {x_stride} bytes for {}-byte samples", l.sample_bytes),
+                format!(
+                    "LIF X stride of {x_stride} bytes for {}-byte samples",
+                    l.sample_bytes
+                ),
             ));
         }
         let y_stride = if h > 1 { y_stride } else { w * l.sample_bytes };
@@ -177,7 +180,11 @@ fn child<'a, 'i>(node: roxmltree::Node<'a, 'i>, tag: &str) -> Option<roxmltree::
 }
 
 /// Memory block id → (data offset, data length).
-fn index_blocks(source: &mut FileSource, mut pos: u64, version: u32) -> Result<HashMap<String, (u64, u64)>> {
+fn index_blocks(
+    source: &mut FileSource,
+    mut pos: u64,
+    version: u32,
+) -> Result<HashMap<String, (u64, u64)>> {
     let path = source.path.clone();
     let mut blocks = HashMap::new();
     let size_len = if version >= 2 { 8 } else { 4 };
@@ -189,7 +196,11 @@ fn index_blocks(source: &mut FileSource, mut pos: u64, version: u32) -> Result<H
         }
         r.u32()?;
         r.u8()?;
-        let len = if size_len == 8 { r.u64()? } else { u64::from(r.u32()?) };
+        let len = if size_len == 8 {
+            r.u64()?
+        } else {
+            u64::from(r.u32()?)
+        };
         r.u8()?;
         let units = r.usize_u32()?;
         let id_pos = pos + head.len() as u64;
@@ -241,7 +252,11 @@ fn describe(
         .ok_or_else(|| bad(path, format!("image '{name}' has no ImageDescription")))?;
     let num = |n: roxmltree::Node, k: &str| -> Option<f64> { n.attribute(k)?.trim().parse().ok() };
     let channels: Vec<roxmltree::Node> = child(desc, "Channels")
-        .map(|c| c.children().filter(|n| n.has_tag_name("ChannelDescription")).collect())
+        .map(|c| {
+            c.children()
+                .filter(|n| n.has_tag_name("ChannelDescription"))
+                .collect()
+        })
         .unwrap_or_default();
     let first = channels
         .first()
@@ -255,7 +270,10 @@ fn describe(
         _ => {
             return Err(unsupported(
                 path,
-                format!("image '{name}': {bits}-bit {} samples", if float { "float" } else { "integer" }),
+                format!(
+                    "image '{name}': {bits}-bit {} samples",
+                    if float { "float" } else { "integer" }
+                ),
             ))
         }
     };
@@ -263,14 +281,21 @@ fn describe(
     let mut sizes = BTreeMap::new();
     let mut step: HashMap<String, f64> = HashMap::new();
     for d in child(desc, "Dimensions")
-        .map(|c| c.children().filter(|n| n.has_tag_name("DimensionDescription")).collect::<Vec<_>>())
+        .map(|c| {
+            c.children()
+                .filter(|n| n.has_tag_name("DimensionDescription"))
+                .collect::<Vec<_>>()
+        })
         .unwrap_or_default()
     {
         let axis = axis_name(d.attribute("DimID").unwrap_or(""));
         let count = num(d, "NumberOfElements").unwrap_or(0.0);
         let stride = num(d, "BytesInc").unwrap_or(-1.0);
-        if !(count >= 1.0 && count < 1e9 && stride >= 0.0 && stride < 1e15) {
-            return Err(bad(path, format!("image '{name}': dimension {axis} with {count} elements, stride {stride}")));
+        if !((1.0..1e9).contains(&count) && (0.0..1e15).contains(&stride)) {
+            return Err(bad(
+                path,
+                format!("image '{name}': dimension {axis} with {count} elements, stride {stride}"),
+            ));
         }
         let unit = length_unit_factor(d.attribute("Unit").unwrap_or("m")).unwrap_or(f64::NAN);
         if count > 1.0 {
@@ -294,7 +319,10 @@ fn describe(
     checked_bytes(path, "LIF plane", &[x, y], sample_bytes)?;
     sizes.retain(|_, n| *n > 1);
     // The last byte any plane reaches must lie inside the memory block.
-    let reach: usize = dims.iter().map(|d| (d.count - 1).saturating_mul(d.stride)).fold(0usize, usize::saturating_add)
+    let reach: usize = dims
+        .iter()
+        .map(|d| (d.count - 1).saturating_mul(d.stride))
+        .fold(0usize, usize::saturating_add)
         + channel_offsets.iter().max().copied().unwrap_or(0)
         + sample_bytes;
     if reach as u64 > data_len {
@@ -303,7 +331,10 @@ fn describe(
             format!("image '{name}' needs {reach} bytes, its memory block holds {data_len}"),
         ));
     }
-    let xy = (VoxelSize::valid(step.get("X").copied()), VoxelSize::valid(step.get("Y").copied()));
+    let xy = (
+        VoxelSize::valid(step.get("X").copied()),
+        VoxelSize::valid(step.get("Y").copied()),
+    );
     let info = SeriesInfo {
         index,
         name,

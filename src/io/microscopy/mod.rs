@@ -15,8 +15,8 @@
 //!
 //! The format is detected from the first bytes of the file ([`detect`]), not the extension.
 
-pub mod czi;
 mod clx;
+pub mod czi;
 pub mod lif;
 pub mod nd2;
 pub mod summary;
@@ -27,8 +27,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::binary::{bad, checked_bytes, unsupported};
 pub use super::binary::MAX_PLANE_BYTES;
+use super::binary::{bad, checked_bytes, unsupported};
 use crate::error::Result;
 use crate::stack::{Plane, SampleType, Samples};
 
@@ -220,7 +220,10 @@ impl PlaneIndex {
             if i >= n {
                 return Err(bad(
                     path,
-                    format!("series {}: {name} = {i} requested, the series has {n}", series.index),
+                    format!(
+                        "series {}: {name} = {i} requested, the series has {n}",
+                        series.index
+                    ),
                 ));
             }
         }
@@ -235,10 +238,10 @@ impl PlaneIndex {
 }
 
 enum Backend {
-    Czi(czi::CziReader),
-    Nd2(nd2::Nd2Reader),
-    Lif(lif::LifReader),
-    Tiff(tiff::TiffBackend),
+    Czi(Box<czi::CziReader>),
+    Nd2(Box<nd2::Nd2Reader>),
+    Lif(Box<lif::LifReader>),
+    Tiff(Box<tiff::TiffBackend>),
 }
 
 /// An open microscopy file: its series, and a reader of their planes.
@@ -276,19 +279,19 @@ impl MicroscopyFile {
         let (series, backend) = match format {
             MicroscopyFormat::Czi => {
                 let r = czi::CziReader::open(source)?;
-                (r.series(), Backend::Czi(r))
+                (r.series(), Backend::Czi(Box::new(r)))
             }
             MicroscopyFormat::Nd2 => {
                 let r = nd2::Nd2Reader::open(source)?;
-                (r.series(), Backend::Nd2(r))
+                (r.series(), Backend::Nd2(Box::new(r)))
             }
             MicroscopyFormat::Lif => {
                 let r = lif::LifReader::open(source)?;
-                (r.series(), Backend::Lif(r))
+                (r.series(), Backend::Lif(Box::new(r)))
             }
             MicroscopyFormat::Tiff => {
                 let r = tiff::TiffBackend::open(path)?;
-                (r.series(), Backend::Tiff(r))
+                (r.series(), Backend::Tiff(Box::new(r)))
             }
         };
         Ok(MicroscopyFile {
@@ -400,8 +403,14 @@ mod tests {
 
     #[test]
     fn detects_by_magic() {
-        assert_eq!(detect(b"ZISRAWFILE\0\0\0\0\0\0"), Some(MicroscopyFormat::Czi));
-        assert_eq!(detect(&[0xda, 0xce, 0xbe, 0x0a, 0]), Some(MicroscopyFormat::Nd2));
+        assert_eq!(
+            detect(b"ZISRAWFILE\0\0\0\0\0\0"),
+            Some(MicroscopyFormat::Czi)
+        );
+        assert_eq!(
+            detect(&[0xda, 0xce, 0xbe, 0x0a, 0]),
+            Some(MicroscopyFormat::Nd2)
+        );
         assert_eq!(
             detect(&[0x70, 0, 0, 0, 1, 2, 3, 4, 0x2a]),
             Some(MicroscopyFormat::Lif)
@@ -435,7 +444,11 @@ mod tests {
         assert!(all[11].check(p, &series).is_ok());
         let mut over = PlaneIndex::tzc(0, 0, 0);
         over.extra.insert("H".into(), 3);
-        assert!(over.check(p, &series).unwrap_err().to_string().contains("H = 3"));
+        assert!(over
+            .check(p, &series)
+            .unwrap_err()
+            .to_string()
+            .contains("H = 3"));
         assert!(PlaneIndex::tzc(0, 1, 0).check(p, &series).is_err());
     }
 

@@ -113,14 +113,20 @@ impl Nd2Reader {
             _ => {
                 return Err(unsupported(
                     &path,
-                    format!("{bits}-bit {} ND2 pixels", if float { "float" } else { "integer" }),
+                    format!(
+                        "{bits}-bit {} ND2 pixels",
+                        if float { "float" } else { "integer" }
+                    ),
                 ))
             }
         };
         let lossless = match a.get("eCompression").and_then(Clx::number) {
-            Some(v) if v == 0.0 => true,
-            Some(v) if v == 1.0 => {
-                return Err(unsupported(&path, "lossy-compressed ND2 (JPEG 2000 frames)"))
+            Some(0.0) => true,
+            Some(1.0) => {
+                return Err(unsupported(
+                    &path,
+                    "lossy-compressed ND2 (JPEG 2000 frames)",
+                ))
             }
             _ => false,
         };
@@ -128,7 +134,9 @@ impl Nd2Reader {
         if components == 0 || row_bytes < width * components * bytes {
             return Err(bad(
                 &path,
-                format!("ND2 row of {row_bytes} bytes for {width} pixels × {components} components"),
+                format!(
+                    "ND2 row of {row_bytes} bytes for {width} pixels × {components} components"
+                ),
             ));
         }
         checked_bytes(&path, "ND2 frame", &[row_bytes, height], 1)?;
@@ -144,7 +152,13 @@ impl Nd2Reader {
                 count: sequences,
             }];
         }
-        let series = series_info(&loops, (width, height, components), dtype, picture.as_ref(), experiment.as_ref());
+        let series = series_info(
+            &loops,
+            (width, height, components),
+            dtype,
+            picture.as_ref(),
+            experiment.as_ref(),
+        );
         Ok(Nd2Reader {
             source,
             chunks,
@@ -198,7 +212,10 @@ impl Nd2Reader {
         if pixels.len() < expected {
             return Err(bad(
                 &path,
-                format!("{name} holds {} bytes, the frame needs {expected}", pixels.len()),
+                format!(
+                    "{name} holds {} bytes, the frame needs {expected}",
+                    pixels.len()
+                ),
             ));
         }
         let bytes = match self.dtype {

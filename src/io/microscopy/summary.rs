@@ -93,8 +93,13 @@ pub fn plane_statistics(plane: &Plane) -> (f64, f64, f64, f64) {
     match &plane.samples {
         Samples::Int { codes, offset } => {
             // Exact: integer sums stay below 2^53 for any plane under the size limit.
-            let s: i64 = codes.iter().map(|&c| i64::from(c) + i64::from(*offset)).sum();
-            codes.iter().for_each(|&c| add(f64::from(i32::from(c) + offset)));
+            let s: i64 = codes
+                .iter()
+                .map(|&c| i64::from(c) + i64::from(*offset))
+                .sum();
+            codes
+                .iter()
+                .for_each(|&c| add(f64::from(i32::from(c) + offset)));
             sum = s as f64;
         }
         Samples::Float(v) => v.iter().for_each(|&x| add(f64::from(x))),
