@@ -410,3 +410,59 @@ fn corrupted_bytes_never_panic() {
         }
     }
 }
+
+#[test]
+fn czi_compressions_other_than_zstd_are_refused_by_name() {
+    let Some(dir) = common::shared_data("real-formats") else {
+        return;
+    };
+    // A temporary copy of a sample whose directory entries claim JPEG-XR (4) or LZW (2).
+    let mut bytes = std::fs::read(dir.join("czi/s_1_t_1_c_1_z_1.czi")).unwrap();
+    let dir_pos = i64::from_le_bytes(bytes[84..92].try_into().unwrap()) as usize;
+    let compression_at = dir_pos + 160 + 18;
+    assert_eq!(&bytes[dir_pos + 160..dir_pos + 162], b"DV");
+    let tmp = tempfile::tempdir().unwrap();
+    for (code, name) in [(4u8, "JPEG-XR"), (2, "LZW")] {
+        bytes[compression_at] = code;
+        let path = tmp.path().join("refused.czi");
+        std::fs::write(&path, &bytes).unwrap();
+        let mut file = MicroscopyFile::open(&path).unwrap();
+        let err = file
+            .read_plane(0, &contactscope::io::microscopy::PlaneIndex::tzc(0, 0, 0))
+            .unwrap_err();
+        let text = err.to_string();
+        assert!(
+            matches!(err, contactscope::Error::Unsupported { .. }),
+            "{text}"
+        );
+        assert!(
+            text.contains(name) && text.contains("refused.czi"),
+            "{text}"
+        );
+    }
+}
+
+#[test]
+fn tiff_is_described_by_the_same_model() {
+    use contactscope::stack::write::encode_u16_stack;
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("stack.tif");
+    let pages: Vec<Vec<u16>> = (0..3u16)
+        .map(|k| (0..12u16).map(|i| i * (k + 1)).collect())
+        .collect();
+    let refs: Vec<&[u16]> = pages.iter().map(|p| p.as_slice()).collect();
+    let bytes = encode_u16_stack(&refs, 4, 3, Some((0.2e-6, 0.25e-6)), "").unwrap();
+    std::fs::write(&path, bytes).unwrap();
+    let s = info_summary(&path, true).unwrap();
+    assert_eq!(s.format, "tiff");
+    let series = &s.series[0];
+    let a = &series.axes;
+    assert_eq!((a.t, a.z, a.c, a.y, a.x), (1, 3, 1, 3, 4));
+    assert!(rel(series.pixel_size_um.y.unwrap(), 0.25) < 1e-9);
+    assert!(series.pixel_size_source.is_some());
+    let planes = series.planes.as_ref().unwrap();
+    // Sum of 0..12 is 66; page k holds (k + 1)·i.
+    let sums: Vec<f64> = planes.iter().map(|p| p.sum).collect();
+    assert_eq!(sums, vec![66.0, 132.0, 198.0]);
+    assert_eq!((planes[2].min, planes[2].max), (0.0, 33.0));
+}

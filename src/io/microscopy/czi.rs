@@ -634,3 +634,34 @@ fn series_info(
         channels,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn zstd1_undoes_the_hi_lo_packing() {
+        let p = std::path::Path::new("x.czi");
+        // Two 16-bit samples 0x0201 and 0x0403: low bytes first, then high bytes.
+        let packed = [0x01u8, 0x03, 0x02, 0x04];
+        let mut raw = vec![3u8, 1, 1];
+        raw.extend(zstd::bulk::compress(&packed, 3).unwrap());
+        assert_eq!(
+            zstd1_decode(p, &raw, 4, 2).unwrap(),
+            vec![0x01, 0x02, 0x03, 0x04]
+        );
+        let mut plain = vec![1u8];
+        plain.extend(zstd::bulk::compress(&packed, 3).unwrap());
+        assert_eq!(zstd1_decode(p, &plain, 4, 2).unwrap(), packed.to_vec());
+        // A frame that decodes to more than the tile needs is an error, not a large buffer.
+        assert!(zstd_decode(p, &zstd::bulk::compress(&[0u8; 64], 3).unwrap(), 8).is_err());
+        assert!(zstd1_decode(p, &[9u8, 1], 4, 2).is_err());
+    }
+
+    #[test]
+    fn pixel_types_and_compression_names() {
+        assert_eq!(pixel_layout(3).unwrap(), (SampleType::U8, 3));
+        assert!(pixel_layout(12).unwrap_err().contains("Gray32"));
+        assert_eq!(compression_name(4), "JPEG-XR");
+    }
+}

@@ -115,3 +115,35 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
         (dx, dy),
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn nid(unit: &str) -> Vec<u8> {
+        let header = format!(
+            "[DataSet]\r\nGroupCount=1\r\nGr0-Name=Scan forward\r\nGr0-Count=1\r\n\
+             Gr0-Ch0=DataSet-0:0\r\n\r\n[DataSet-0:0]\r\nPoints=2\r\nLines=1\r\nDim0Range=4e-06\r\n\
+             Dim0Unit=m\r\nDim1Range=1e-06\r\nDim1Unit=m\r\nDim2Name=Z-Axis\r\nDim2Unit={unit}\r\n\
+             Dim2Range=2e-06\r\nDim2Min=-1e-06\r\nSaveBits=16\r\nSaveSign=Signed\r\n#!"
+        );
+        let mut bytes = header.into_bytes();
+        bytes.extend(i16::MIN.to_le_bytes());
+        bytes.extend(0i16.to_le_bytes());
+        bytes
+    }
+
+    #[test]
+    fn the_integer_range_spans_dim2_range() {
+        let p = Path::new("n.nid");
+        let m = read(p, &nid("m"), None).unwrap();
+        assert_eq!(m.channel, "Scan forward (Z-Axis)");
+        assert!((m.heights[[0, 0]] + 1e-6).abs() < 1e-20);
+        assert!(m.heights[[0, 1]].abs() < 1e-20);
+        assert_eq!((m.dx_m, m.dy_m), (2e-6, 1e-6));
+        let err = read(p, &nid("V"), None).unwrap_err().to_string();
+        assert!(err.contains("no height channel"), "{err}");
+        let truncated = nid("m");
+        assert!(read(p, &truncated[..truncated.len() - 1], None).is_err());
+    }
+}

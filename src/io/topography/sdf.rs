@@ -73,7 +73,8 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
         height: true,
     }];
     let index = choose(path, &channels, channel)?;
-    let heights = values.into_iter().map(|v| v * z).collect();
+    let to_m = crate::surface::io::to_metres(z);
+    let heights = values.into_iter().map(to_m).collect();
     let (dx, dy) = (
         positive(path, "Xscale", num("Xscale")?)?,
         positive(path, "Yscale", num("Yscale")?)?,
@@ -86,4 +87,24 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
         heights,
         (dx, dy),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_the_ascii_layout_with_bad_points() {
+        let text = "aISO-1.0\nNumPoints = 3\nNumProfiles = 2\nXscale = 2.0E-6\nYscale = 1.0E-6\n\
+                    Zscale = 1.0E-9\n*\n1 2 3\n4 BAD 6\n*\ntrailer\n";
+        let p = Path::new("s.sdf");
+        let m = read(p, text.as_bytes(), None).unwrap();
+        assert_eq!((m.nx(), m.ny(), m.invalid_points), (3, 2, 1));
+        assert_eq!((m.heights[[1, 2]], m.dx_m), (6e-9, 2e-6));
+        let short = text.replace("4 BAD 6\n*\ntrailer\n", "");
+        assert!(read(p, short.as_bytes(), None)
+            .unwrap_err()
+            .to_string()
+            .contains("3 values"));
+    }
 }

@@ -132,3 +132,52 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
         (dx, dy),
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    fn x3p(dir: &Path, with_valid: bool) -> std::path::PathBuf {
+        let path = dir.join(format!("t{with_valid}.x3p"));
+        let mut zip = zip::ZipWriter::new(std::fs::File::create(&path).unwrap());
+        let opts = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Stored);
+        let valid = if with_valid {
+            "<ValidPointsLink>bindata/valid.bin</ValidPointsLink>"
+        } else {
+            ""
+        };
+        let xml = format!(
+            "<p:ISO5436_2 xmlns:p=\"x\"><Record1><FeatureType>SUR</FeatureType><Axes>\
+             <CX><Increment>1e-6</Increment></CX><CY><Increment>2e-6</Increment></CY>\
+             <CZ><DataType>I</DataType><Increment>1e-9</Increment><Offset>1e-6</Offset></CZ>\
+             </Axes></Record1><Record3><MatrixDimension><SizeX>3</SizeX><SizeY>2</SizeY>\
+             <SizeZ>1</SizeZ></MatrixDimension><DataLink><PointDataLink>bindata/data.bin\
+             </PointDataLink>{valid}</DataLink></Record3></p:ISO5436_2>"
+        );
+        zip.start_file("main.xml", opts).unwrap();
+        zip.write_all(xml.as_bytes()).unwrap();
+        zip.start_file("bindata/data.bin", opts).unwrap();
+        for v in [0i16, 1, 2, 3, 4, -5] {
+            zip.write_all(&v.to_le_bytes()).unwrap();
+        }
+        zip.start_file("bindata/valid.bin", opts).unwrap();
+        zip.write_all(&[0b0011_1011]).unwrap();
+        zip.finish().unwrap();
+        path
+    }
+
+    #[test]
+    fn scales_integer_points_and_reads_the_validity_bits() {
+        let dir = tempfile::tempdir().unwrap();
+        let m = read(&x3p(dir.path(), false), None).unwrap();
+        assert_eq!((m.nx(), m.ny(), m.invalid_points), (3, 2, 0));
+        assert!((m.heights[[1, 2]] - (1e-6 - 5e-9)).abs() < 1e-18);
+        assert_eq!((m.dx_m, m.dy_m), (1e-6, 2e-6));
+        // Bit 2 (point 2) is 0: invalid.
+        let v = read(&x3p(dir.path(), true), None).unwrap();
+        assert_eq!(v.invalid_points, 1);
+        assert!(v.heights[[0, 2]].is_nan());
+    }
+}
