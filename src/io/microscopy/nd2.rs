@@ -11,7 +11,7 @@
 //! length u32, data length u64), the name, then the data. The last 40 bytes are the signature
 //! `ND2 CHUNK MAP SIGNATURE 0000001!` and the position of the chunk map, whose entries are
 //! `name!` + position (u64) + data length (u64). Metadata chunks hold CLX-lite trees
-//! ([`super::clx`]): `ImageAttributesLV!` (width, row bytes, height, components, bits per
+//! (`clx` module): `ImageAttributesLV!` (width, row bytes, height, components, bits per
 //! component, sequence count, compression), `ImageMetadataLV!` (the experiment loops, outermost
 //! first: time `T`, stage positions `P`, `Z`; the frame number is row-major over them) and
 //! `ImageMetadataSeqLV|0!` (`dCalibration`, µm per pixel, and the channel names in
