@@ -396,16 +396,15 @@ fn real_afm_files_reproduce_the_reference_numbers() {
 }
 
 #[test]
-fn unreadable_real_files_fail_cleanly() {
+fn vendor_real_files_read_through_the_content_hook() {
     let Some(dir) = common::shared_data("real-afm") else {
         return;
     };
-    // IFD 0 of the Park Systems TIFF is an 8-bit palette preview (README).
-    let err = read_topography(&dir.join("example_ps.tiff"), None, None).unwrap_err();
-    assert!(err.to_string().contains("example_ps.tiff"), "{err}");
-    let err = read_topography(&dir.join("nid-1.nid"), None, None).unwrap_err();
-    assert!(
-        err.to_string().contains("unknown height-map extension"),
-        "{err}"
-    );
+    // IFD 0 of the Park Systems TIFF is an 8-bit palette preview (README); the heights in its
+    // private tags and the .nid are read by contactscope::io::topography, found from the
+    // content (tests/formats_real.rs checks their numbers).
+    let park = read_topography(&dir.join("example_ps.tiff"), None, None).unwrap();
+    assert_eq!((park.nx(), park.ny()), (512, 512));
+    let nid = read_topography(&dir.join("nid-1.nid"), None, None).unwrap();
+    assert!(rel(nid.rms_height(), 2.396e-7) < 1e-3);
 }

@@ -11,12 +11,15 @@
 //! | [`table`] | small CSV tables whose column names carry the unit (`force_mN`), `areas.csv` |
 //! | [`tiff`] | TIFF reading (pages, channels, pixel-size metadata) and writing |
 //! | [`series`] | files, folders and manifests → which page is which load; the file-backed plane source of the series analysis |
-//! | [`topography`] | height maps: `.npy`, float TIFF, `.gsf`, text, WSxM, Nanoscope |
+//! | [`topography`] | height maps: `.npy`, float TIFF, `.gsf`, text, WSxM, Nanoscope, and vendor AFM/profilometer formats (`.ibw`, `.nid`, `.mi`, Park TIFF, `.gwy`, `.x3p`, `.sdf`, `.opd`, `.plu`, `.sur`, `.frt`) |
+//! | [`microscopy`] | confocal files: Zeiss CZI, Nikon ND2, Leica LIF, and TIFF described the same way |
 //! | [`plot`] | charts (PNG/SVG) and micrograph panels (PNG) |
 //! | [`mechanics`] | the mechanics CSVs: friction traces, squeeze tests |
 //! | [`results`] | one command's outputs read by another: `areas.csv`, a `simulate` folder, `psf.json` |
 
+pub(crate) mod binary;
 pub mod mechanics;
+pub mod microscopy;
 pub mod plot;
 pub mod results;
 pub mod series;

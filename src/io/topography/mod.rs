@@ -16,6 +16,50 @@
 //! overrides the file's. A height unit may only be given for formats that do not state one;
 //! for the others it is an error, because two units for one number is a contradiction.
 //! Every error names the file.
+//!
+//! ## Vendor AFM and profilometer formats
+//!
+//! Recognised from their content (magic bytes) before the extension table above is consulted,
+//! and read into a [`HeightMap`]: heights in metres, positive towards the counter-surface as
+//! stored by the instrument, pixel size in metres, row-major `(y, x)` in the order the file
+//! stores its lines ([`read`], [`detect_file`]).
+//!
+//! | format | module | magic | heights | pixel size | invalid points |
+//! |---|---|---|---|---|---|
+//! | Igor binary wave (Asylum) `.ibw` | [`ibw`] | version 5 header | wave data × data units | `sfA` (dimension deltas) | NaN |
+//! | Nanosurf `.nid` | [`nid`] | `[DataSet]` | `Dim2Min + Dim2Range·(raw + 2^(b−1))/2^b` | `Dim0Range/Points` | none |
+//! | Molecular Imaging / Agilent `.mi` | [`mi`] | `fileType      Image` | `raw·bufferRange/2^(b−1)` in `bufferUnit` | `xLength/xPixels` | none |
+//! | Park Systems TIFF | [`park`] | TIFF + tag 50432 = `0x0E031301` | `(raw + offset/scale)·scale·gain` in the header's unit | scan size / pixels | none |
+//! | Gwyddion `.gwy` | [`gwy`] | `GWYP` | data field in `si_unit_z` | `xreal/xres` | mask field → NaN |
+//! | ISO 25178-72 `.x3p` | [`x3p`] | zip with `main.xml` | `CZ` data × increment (m) | `CX/CY` increments | NaN or `valid.bin` |
+//! | ISO 25178-71 `.sdf` (ASCII) | [`sdf`] | `aISO-1.0` | value × `Zscale` (m) | `Xscale`, `Yscale` | `BAD` / non-numbers |
+//! | Wyko `.opd` | [`opd`] | `Directory` at byte 2 | `raw·λ/Mult` (λ in nm) | `Pixel_size` (mm), `Aspect` | ≥ 32766 / ≥ 1e38 |
+//! | Sensofar `.plu` | [`plu`] | (none: size check of the 2012 layout) | µm | `micrometers_per_pixel` | 1000001 |
+//! | Digital Surf `.sur` | [`sur`] | `DIGITAL SURF` | `raw·scale` in `delta_data_unit` | grid spacing | `zmin − 2` when flagged |
+//! | FRT MicroProf `.frt` | [`frt`] | `FRTM_GLIDERV1.0` | `raw·scale` (m) | block 0x67 size / pixels | raw = 1 |
+//!
+//! **Invalid points** are stored as NaN in [`HeightMap::heights`] and counted in
+//! [`HeightMap::invalid_points`]; [`HeightMap::into_topography`] refuses a map with invalid
+//! points (a contact calculation needs every height), naming the count.
+//!
+//! **Channels**: [`read`] takes an optional channel name. An exact (case-insensitive) match wins,
+//! else the first channel whose name contains the request; without one, the first channel whose
+//! values are heights (a length unit, or a name with "height", "topograph" or "z-axis"). When no
+//! channel matches, the error lists them all.
+
+pub mod frt;
+pub mod gwy;
+pub mod ibw;
+pub mod mi;
+pub mod nid;
+pub mod opd;
+pub mod park;
+pub mod plu;
+pub mod sdf;
+pub mod summary;
+pub mod sur;
+mod vendor;
+pub mod x3p;
 
 mod gsf;
 mod nanoscope;
@@ -38,6 +82,12 @@ pub use gsf::{read_gsf, write_gsf};
 pub use nanoscope::read_nanoscope;
 pub use npy::{read_npy, write_npy};
 pub use text::read_text;
+pub use vendor::MAX_FILE_BYTES;
+pub(crate) use vendor::{
+    choose, count, grid_bytes, height_like, height_map, length_factor, length_scale, positive,
+    ChannelEntry,
+};
+pub use vendor::{detect, detect_file, read, read_for_surface, HeightMap, TopographyFormat};
 pub use wsxm::read_wsxm;
 
 /// Extensions [`read_topography`] knows (Nanoscope files also use three-digit extensions).
@@ -75,6 +125,10 @@ pub fn read_topography(
     pixel_size_m: Option<(f64, f64)>,
     height_unit_m: Option<f64>,
 ) -> Result<Topography> {
+    // Vendor AFM/profilometer formats, recognised by content (the second table above).
+    if let Some(t) = read_for_surface(path, pixel_size_m, height_unit_m)? {
+        return Ok(t);
+    }
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -144,10 +198,7 @@ pub fn read_tiff(
     topography(path, (plane.height, plane.width), heights, (dx, dy))
 }
 
-/// A bad-input error naming the file.
-pub(crate) fn bad(path: &Path, reason: impl Into<String>) -> Error {
-    Error::bad_input(Location::file(path), reason)
-}
+pub(crate) use crate::io::binary::bad;
 
 /// Read a whole file.
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>> {
@@ -227,18 +278,7 @@ pub(crate) fn slice<'a>(
     offset: usize,
     len: usize,
 ) -> Result<&'a [u8]> {
-    offset
-        .checked_add(len)
-        .and_then(|end| data.get(offset..end))
-        .ok_or_else(|| {
-            bad(
-                path,
-                format!(
-                    "file is truncated: {len} bytes of data expected at offset {offset}, the file has {}",
-                    data.len()
-                ),
-            )
-        })
+    crate::io::binary::slice(path, data, offset, len, "the data")
 }
 
 /// Build the [`Topography`], turning its argument errors into errors naming the file.

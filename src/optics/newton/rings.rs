@@ -12,10 +12,10 @@
 
 /// A maximum is taken for the predicted order when it lies within this fraction of the local
 /// fringe spacing of the predicted radius.
-const ORDER_TOLERANCE: f64 = 0.3;
+pub const ORDER_TOLERANCE: f64 = 0.3;
 
 /// Orders in a row without a maximum near the prediction after which the half-line ends.
-const MAX_MISSES: u32 = 2;
+pub const MAX_MISSES: u32 = 2;
 
 /// Orders (counted from the innermost ring, 0, 1, 2, …) of ring maxima at `candidates`
 /// (radii, ascending, all outside the contact edge; any length unit). The first two candidates
