@@ -50,6 +50,7 @@ struct Args {
     restart: Restart,
     applies: usize,
     rolloff_m: f64,
+    hardness_pa: f64,
 }
 
 fn parse_args() -> Args {
@@ -62,6 +63,7 @@ fn parse_args() -> Args {
         restart: Restart::default(),
         applies: 10,
         rolloff_m: 4e-6,
+        hardness_pa: HARDNESS_PA,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -100,6 +102,12 @@ fn parse_args() -> Args {
             "--rolloff" => {
                 args.rolloff_m = value("--rolloff").parse::<f64>().expect("--rolloff in µm") * 1e-6;
             }
+            "--hardness" => {
+                args.hardness_pa = value("--hardness")
+                    .parse::<f64>()
+                    .expect("--hardness in MPa")
+                    * 1e6;
+            }
             _ => {}
         }
     }
@@ -131,11 +139,11 @@ fn body(grid: usize, rolloff_m: f64) -> (Topography, f64) {
     (t, roughness_rms_m)
 }
 
-fn model(name: &str) -> Model {
+fn model(name: &str, hardness_pa: f64) -> Model {
     match name {
         "elastic" => Model::Elastic,
         "hardness" => Model::Hardness {
-            hardness_pa: HARDNESS_PA,
+            hardness_pa,
             volume_conserving: None,
         },
         "hardening" => Model::Hardening {
@@ -223,7 +231,7 @@ fn main() {
                 topography: &topo,
                 e_star_pa: E_STAR_PA,
                 boundary: Boundary::Free,
-                model: model(name),
+                model: model(name, args.hardness_pa),
                 options: SolverOptions {
                     max_iterations: 20_000,
                     tolerance: args.tolerance,

@@ -123,6 +123,17 @@ pub fn sweep(
     check_setup(setup)?;
     let topo = setup.topography;
     let (ny, nx) = (topo.ny(), topo.nx());
+    if let Model::Hardness { hardness_pa, .. } = setup.model {
+        // Refused before any load is solved: a fit probing a low hardness learns at once that
+        // the ramp is infeasible.
+        let capacity = hardness_pa * (nx * ny) as f64 * topo.dx_m * topo.dy_m;
+        let heaviest = loads_n.iter().copied().fold(0.0, f64::max);
+        if heaviest >= capacity {
+            return Err(Error::InvalidArgument(format!(
+                "load {heaviest:.4e} N exceeds what the hardness can carry on the whole map ({capacity:.4e} N)"
+            )));
+        }
+    }
     let operator = ElasticOperator::new(
         ny,
         nx,
