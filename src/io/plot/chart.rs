@@ -1,5 +1,7 @@
 //! Line-and-marker charts with units on both axes, drawn with plotters to PNG or SVG.
 
+use std::cell::Cell;
+
 use std::sync::OnceLock;
 
 use plotters::coord::ranged1d::ValueFormatter;
@@ -206,14 +208,34 @@ impl Chart {
         X: Ranged<ValueType = f64> + ValueFormatter<f64>,
         Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
-        chart
-            .configure_mesh()
-            .x_desc(self.x_label.as_str())
+        let mut mesh = chart.configure_mesh();
+        mesh.x_desc(self.x_label.as_str())
             .y_desc(self.y_label.as_str())
             .label_style((FONT, 15))
-            .axis_desc_style((FONT, 18))
-            .x_label_formatter(&|v| tick_label(snap_zero(*v, data.x_range)))
-            .y_label_formatter(&|v| tick_label(snap_zero(*v, data.y_range)))
+            .axis_desc_style((FONT, 18));
+        let log = matches!(self.axes, Axes::LogLog);
+        // plotters lists each power of ten twice among many log key points: label it once.
+        let (x_last, y_last) = (Cell::new(f64::NAN), Cell::new(f64::NAN));
+        let x_label = |v: &f64| match log {
+            true if x_last.replace(*v) == *v => String::new(),
+            true => log_tick_label(*v, data.x_range),
+            false => tick_label(snap_zero(*v, data.x_range)),
+        };
+        let y_label = |v: &f64| match log {
+            true if y_last.replace(*v) == *v => String::new(),
+            true => log_tick_label(*v, data.y_range),
+            false => tick_label(snap_zero(*v, data.y_range)),
+        };
+        if log {
+            // plotters labels log axes only at powers of ten unless asked for many key points;
+            // it then puts one at every 1…9 × 10^k, and `log_tick_label` keeps the readable ones.
+            mesh.x_labels(LOG_KEY_POINTS)
+                .y_labels(LOG_KEY_POINTS)
+                .max_light_lines(0)
+                .bold_line_style(BLACK.mix(0.15));
+        }
+        mesh.x_label_formatter(&x_label)
+            .y_label_formatter(&y_label)
             .draw()
             .map_err(plot_err)?;
 
@@ -337,6 +359,36 @@ fn snap_zero(v: f64, (lo, hi): (f64, f64)) -> f64 {
         0.0
     } else {
         v
+    }
+}
+
+/// Key points asked of a log axis: enough for a tick at every 1…9 × 10^k over the few
+/// decades a chart spans (plotters fills in 9 per decade once asked for 10 per decade).
+const LOG_KEY_POINTS: usize = 100;
+
+/// The label of a log-axis tick at `v`: 1, 2 and 5 × 10^k over up to three decades (1 × 10^k
+/// only beyond, every integer mantissa within one), empty for the other ticks.
+fn log_tick_label(v: f64, (lo, hi): (f64, f64)) -> String {
+    if v.is_nan() || v <= 0.0 {
+        return String::new();
+    }
+    let decades = (hi / lo).log10();
+    let mantissa = v / 10f64.powf(v.log10().floor());
+    let nearest = mantissa.round();
+    if (mantissa - nearest).abs() > 1e-6 * mantissa {
+        return String::new();
+    }
+    let shown: &[f64] = if decades <= 1.2 {
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
+    } else if decades <= 3.5 {
+        &[1.0, 2.0, 5.0]
+    } else {
+        &[1.0]
+    };
+    if shown.contains(&nearest) || nearest == 10.0 {
+        tick_label(v)
+    } else {
+        String::new()
     }
 }
 
@@ -530,6 +582,24 @@ mod tests {
         assert_eq!(pad_linear(0.0, 10.0).unwrap(), (-0.5, 10.5));
         assert_eq!(pad_linear(0.0, 0.0).unwrap(), (-1.0, 1.0));
         assert!(pad_linear(-f64::MAX, f64::MAX).is_err());
+    }
+
+    #[test]
+    fn log_ticks_are_labelled_at_one_two_five() {
+        let two_decades = (3.0, 500.0);
+        let labels: Vec<String> = [5.0, 6.0, 10.0, 20.0, 30.0, 50.0, 100.0, 200.0, 300.0]
+            .iter()
+            .map(|&v| log_tick_label(v, two_decades))
+            .collect();
+        assert_eq!(labels, ["5", "", "10", "20", "", "50", "100", "200", ""]);
+        // Over many decades only the powers of ten; within one, every integer mantissa.
+        assert_eq!(log_tick_label(2.0, (1.0, 1e6)), "");
+        assert_eq!(log_tick_label(1000.0, (1.0, 1e6)), "1000");
+        assert_eq!(log_tick_label(3.0, (2.0, 8.0)), "3");
+        // Not a key point of a 1…9 × 10^k ladder, or not positive: no label.
+        assert_eq!(log_tick_label(2.5, two_decades), "");
+        assert_eq!(log_tick_label(0.0, two_decades), "");
+        assert_eq!(log_tick_label(f64::NAN, two_decades), "");
     }
 
     #[test]
