@@ -313,3 +313,48 @@ fn the_gap_is_after_the_plastic_update_for_every_model() {
         }
     }
 }
+
+#[test]
+fn sweep_each_hands_over_each_load_and_stops_on_the_consumers_error() {
+    let topo = sphere(64, 5.0);
+    let setup = Setup {
+        topography: &topo,
+        e_star_pa: E,
+        boundary: Boundary::Free,
+        model: Model::Hardening {
+            modulus_pa_per_m: 200.0,
+            initial_pa: 2.0,
+        },
+        options: SolverOptions::default(),
+    };
+    let loads = [5.0, 10.0, 15.0];
+    let kept = sweep(&setup, &loads, &|_, _| {}).unwrap();
+    // The streamed steps are the kept ones (the plastic state carries over the same way).
+    let mut seen = Vec::new();
+    contactscope::solver::simulate::sweep_each(&setup, &loads, &mut |i, step| {
+        seen.push((i, step.area_m2, step.plastic_m.iter().sum::<f64>()));
+        Ok(())
+    })
+    .unwrap();
+    let expected: Vec<_> = kept
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (i, s.area_m2, s.plastic_m.iter().sum::<f64>()))
+        .collect();
+    assert_eq!(seen, expected);
+    assert!(expected[2].2 > 0.0, "the ramp is plastic");
+    let mut calls = 0;
+    let stopped = contactscope::solver::simulate::sweep_each(&setup, &loads, &mut |i, _| {
+        calls += 1;
+        match i {
+            1 => Err(contactscope::error::Error::InvalidArgument(
+                "disk full".into(),
+            )),
+            _ => Ok(()),
+        }
+    });
+    assert!(
+        matches!(stopped, Err(contactscope::error::Error::InvalidArgument(m)) if m == "disk full")
+    );
+    assert_eq!(calls, 2, "no load is solved after the consumer's error");
+}

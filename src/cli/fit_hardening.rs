@@ -1,6 +1,7 @@
 //! `contactscope fit-hardening`: fit contact models to a measured area–load curve.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use anyhow::{bail, Context, Result};
 
@@ -8,10 +9,13 @@ use contactscope::compare::CompareSettings;
 use contactscope::io::units::{self, Dimension};
 use contactscope::jobs::compare::ExperimentInput;
 use contactscope::jobs::fit_hardening::{run_fit, FitRequest, Sweep, SweepMicrographs};
-use contactscope::model_fit::{Family, Imaging, Search};
+use contactscope::model_fit::{Family, Imaging, ProgressHook, RampEvent, Search};
 
 use super::args::{default_out, optional_pixel_size, BodyArgs, OutputFolder, SolverArgs};
-use super::{command_line, print_warnings, print_written};
+use indicatif::ProgressStyle;
+
+use super::args::Quiet;
+use super::{command_line, print_warnings, print_written, progress_bar};
 
 default_out!(Out, "contactscope-out/fit");
 
@@ -55,6 +59,23 @@ pub struct Args {
     solver: SolverArgs,
     #[command(flatten)]
     out: OutputFolder<Out>,
+    #[command(flatten)]
+    quiet: Quiet,
+}
+
+/// `hardening k = 4.02 MPa/nm, load 3/8`.
+fn ramp_label(event: &RampEvent) -> String {
+    let parameter = match (event.family, event.parameter) {
+        (Family::Hardening, Some(k)) => format!(" k = {:.3} MPa/nm", k * 1e-15),
+        (Family::Hardness, Some(p)) => format!(" p_Y = {:.1} MPa", p * 1e-6),
+        _ => String::new(),
+    };
+    format!(
+        "{}{parameter}, load {}/{}",
+        event.family.name(),
+        event.load,
+        event.loads
+    )
 }
 
 fn searches(args: &Args) -> Result<Vec<(Family, Search)>> {
@@ -149,8 +170,33 @@ pub fn run(args: Args) -> Result<()> {
         options: args.solver.options(),
         out_dir: args.out.out.clone(),
         command_line: command_line(),
+        progress: None,
     };
-    let outcome = run_fit(&request)?;
+    let mut request = request;
+    let bar = progress_bar(1, 1, args.quiet.quiet);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "[{bar:30}] {pos}/~{len} loads solved ({elapsed}, about {eta} left) {msg}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    bar.set_length(0);
+    let ramps = request.expected_ramps() as u64;
+    let hook_bar = bar.clone();
+    request.progress = Some(ProgressHook(Arc::new(move |event: &RampEvent| {
+        if hook_bar.length() == Some(0) {
+            hook_bar.set_length(ramps * event.loads as u64);
+        }
+        if hook_bar.position() + 1 >= hook_bar.length().unwrap_or(0) {
+            hook_bar.inc_length(event.loads as u64);
+        }
+        hook_bar.inc(1);
+        hook_bar.set_message(ramp_label(event));
+    })));
+    let outcome = run_fit(&request);
+    bar.finish_and_clear();
+    let outcome = outcome?;
     print_warnings(&outcome.warnings);
     println!("{:>10} {:>22} {:>10}", "model", "parameter", "misfit");
     for fit in &outcome.fits {

@@ -115,9 +115,11 @@ pub fn run(args: Args) -> Result<()> {
     };
     let bar = progress_bar(request.loads_n.len(), 1, args.quiet.quiet);
     bar.set_style(
-        ProgressStyle::with_template("[{bar:30}] {pos}/{len} loads ({elapsed}) {msg}")
-            .expect("valid template")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "[{bar:30}] {pos}/{len} loads ({elapsed}, about {eta} left) {msg}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
     );
     let monitor = |iteration: usize, residual: f64| {
         bar.set_message(format!("CG iteration {iteration}, residual {residual:.2e}"));

@@ -16,7 +16,7 @@ use crate::io::topography::TopographySource;
 use crate::io::units::{self, Dimension};
 use crate::jobs::compare::{load_micrographs, ExperimentInput};
 use crate::model_fit::{
-    fit_parameter, Evaluation, Family, Imaging, Measured, ModelBody, ModelFit, Search,
+    fit_parameter, Evaluation, Family, Imaging, Measured, ModelBody, ModelFit, ProgressHook, Search,
 };
 use crate::optics::blur::Grid;
 use crate::solver::cg::SolverOptions;
@@ -109,6 +109,31 @@ pub struct FitRequest {
     pub out_dir: PathBuf,
     /// The command line.
     pub command_line: Vec<String>,
+    /// Told of every load solved by every ramp ([`FitRequest::expected_ramps`] estimates how
+    /// many ramps there will be).
+    pub progress: Option<ProgressHook>,
+}
+
+impl FitRequest {
+    /// About how many load ramps the fit will run: for progress bars and their time
+    /// estimates; the true count differs by a few.
+    pub fn expected_ramps(&self) -> usize {
+        let ramps: usize = self
+            .families
+            .iter()
+            .map(|&family| match family.has_parameter() {
+                true => self
+                    .searches
+                    .iter()
+                    .find(|(f, _)| *f == family)
+                    .map_or_else(|| Search::default_for(family), |(_, s)| *s)
+                    .expected_ramps(),
+                false => 1,
+            })
+            .sum::<usize>()
+            + self.sweep.as_ref().map_or(0, |s| s.values.len());
+        ramps
+    }
 }
 
 /// One sweep value at one load.
@@ -231,6 +256,7 @@ fn model_body(request: &FitRequest) -> Result<ModelBody> {
     )?;
     body.periodic = request.periodic;
     body.imaging = request.imaging;
+    body.progress = request.progress.clone();
     Ok(body)
 }
 
@@ -363,7 +389,7 @@ fn model_label(fit: &ModelFit) -> String {
         Family::Elastic => "elastic".to_string(),
         Family::GreenwoodTripp => "Greenwood–Tripp".to_string(),
         Family::Hardness => format!(
-            "hardness p_Y = {:.0} MPa",
+            "hardness {:.0} MPa",
             display(Family::Hardness, fit.best.parameter.unwrap_or(f64::NAN))
         ),
         Family::Hardening => format!(
@@ -477,7 +503,7 @@ fn misfit_chart(fits: &[ModelFit]) -> Option<Chart> {
     Some(Chart {
         title: "Hardening fit: misfit vs k".into(),
         x_label: "hardening coefficient k (MPa/nm)".into(),
-        y_label: "RMS of ln(A_sim / A_exp)".into(),
+        y_label: "misfit: RMS of ln(simulated / measured area)".into(),
         axes: Axes::LogLog,
         legend: Legend::UpperRight,
         points: vec![PointSet {
@@ -500,7 +526,7 @@ fn sweep_chart(family: Family, measured: &Measured, rows: &[SweepRow]) -> Chart 
             label: format!(
                 "{} = {:.3} {}",
                 if family == Family::Hardness {
-                    "p_Y"
+                    "hardness"
                 } else {
                     "k"
                 },
@@ -583,7 +609,7 @@ fn summary_json(
             }),
             None => json!({ "counted": "raw: simulation pixels with g = 0 (p > 0)" }),
         },
-        "method": "least squares in log area: misfit = RMS of ln(A_sim/A_exp) over the measured loads; one-parameter models by a parallel log grid then golden-section search on ln(parameter); SE by Gauss-Newton at the optimum; hardening has p_Y0 = 0 as in the paper",
+        "method": "least squares in log area: misfit = RMS of ln(A_sim/A_exp) over the measured loads; one-parameter models by a parallel log grid then Brent's method on ln(parameter); SE by Gauss-Newton at the optimum; hardening has p_Y0 = 0 as in the paper",
         "models": models,
         "best_model": best,
         "sweep_rows": sweep.len(),

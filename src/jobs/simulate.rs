@@ -19,7 +19,7 @@ use crate::surface::Topography;
 use crate::solver::cg::{Monitor, SolverOptions};
 use crate::solver::gt::{gt_bearing_area, gt_profile, GtParams};
 use crate::solver::halfspace::Boundary;
-use crate::solver::simulate::{separation, sweep, LoadStep, Model, Setup};
+use crate::solver::simulate::{separation, sweep_each, LoadStep, Model, Setup};
 
 /// Which model to run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -171,28 +171,21 @@ fn run_halfspace(
     };
     let base = separation(body);
     let total = request.loads_n.len();
-    let written = std::sync::Mutex::new(Ok(()));
-    let steps = sweep(&setup, &request.loads_n, &|i, step| {
-        let result = write_maps(staging, body, &base, i, step);
-        if result.is_err() {
-            *written.lock().expect("lock") = result;
-        }
-        progress(i + 1, total);
-    })?;
-    written.into_inner().expect("lock")?;
     let mut warnings = Vec::new();
-    let rows = steps
-        .iter()
-        .map(|s| {
-            if s.edge_contact {
-                warnings.push(format!(
-                    "at {:.4} mN the contact reaches the border of the map: the free-boundary result is not valid; use a larger map or smaller loads",
-                    s.force_n * 1e3
-                ));
-            }
-            row_of(body, s)
-        })
-        .collect();
+    let mut rows = Vec::with_capacity(total);
+    // Each load's maps are written and its fields dropped before the next load is solved.
+    sweep_each(&setup, &request.loads_n, &mut |i, step| {
+        write_maps(staging, body, &base, i, &step)?;
+        if step.edge_contact {
+            warnings.push(format!(
+                "at {:.4} mN the contact reaches the border of the map: the free-boundary result is not valid; use a larger map or smaller loads",
+                step.force_n * 1e3
+            ));
+        }
+        rows.push(row_of(body, &step));
+        progress(i + 1, total);
+        Ok(())
+    })?;
     Ok((rows, warnings))
 }
 
