@@ -37,8 +37,10 @@ pub(super) fn write_report(dir: &Path, facts: &Facts) -> Result<()> {
 }
 
 /// One Fig. 2 panel per load: micrograph | GT | elastic | hardness | hardening, the
-/// micrograph's contact edges in green on all. Returns the file names.
-fn write_panels(dir: &Path, facts: &Facts) -> Result<Vec<String>> {
+/// micrograph's contact edges in green on all, cropped to a square around the micrograph's
+/// contact (so the patches of the lightest load are as visible as the disc of the heaviest) and
+/// magnified to about 700 pixels. Returns the file names and the crop sides in micrograph pixels.
+fn write_panels(dir: &Path, facts: &Facts) -> Result<Vec<(String, usize)>> {
     let Some((_, first)) = facts.comparisons.first() else {
         return Ok(Vec::new());
     };
@@ -50,13 +52,66 @@ fn write_panels(dir: &Path, facts: &Facts) -> Result<Vec<String>> {
             panels.push(c.prepared[i].simulated_on_scale(&c.loads[i]));
         }
         let mask = contact_mask(facts, i);
+        let crop = Crop::around(&mask, w, h);
+        let panels: Vec<Vec<f64>> = panels.iter().map(|p| crop.apply(p, w)).collect();
+        let mask = crop.apply(&mask, w);
         let refs: Vec<&[f64]> = panels.iter().map(Vec::as_slice).collect();
-        let png = edge_panels_png(&refs, w, h, &mask, 4)?;
+        let scale = (700 / crop.side).clamp(1, 8);
+        let png = edge_panels_png(&refs, crop.side, crop.side, &mask, scale)?;
         let name = format!("fig2_load_{:02}.png", i + 1);
         write_atomic(&dir.join(&name), &png)?;
-        names.push(name);
+        names.push((name, crop.side));
     }
     Ok(names)
+}
+
+/// A square window of an image.
+struct Crop {
+    x0: usize,
+    y0: usize,
+    side: usize,
+}
+
+impl Crop {
+    /// The smallest square holding the true pixels of `mask` with a margin of a quarter of its
+    /// side (at least 16 pixels), inside the `w × h` image; the whole image's square when the
+    /// mask is empty.
+    fn around(mask: &[bool], w: usize, h: usize) -> Crop {
+        let (mut x_lo, mut x_hi, mut y_lo, mut y_hi) = (usize::MAX, 0, usize::MAX, 0);
+        for (k, _) in mask.iter().enumerate().filter(|(_, &m)| m) {
+            let (x, y) = (k % w, k / w);
+            (x_lo, x_hi, y_lo, y_hi) = (x_lo.min(x), x_hi.max(x), y_lo.min(y), y_hi.max(y));
+        }
+        let most = w.min(h);
+        if x_lo > x_hi {
+            return Crop {
+                x0: 0,
+                y0: 0,
+                side: most,
+            };
+        }
+        let extent = (x_hi - x_lo).max(y_hi - y_lo) + 1;
+        let side = (extent + 2 * (extent / 4).max(16)).min(most);
+        let place = |lo: usize, hi: usize, n: usize| {
+            let centre = (lo + hi) / 2;
+            centre.saturating_sub(side / 2).min(n - side)
+        };
+        Crop {
+            x0: place(x_lo, x_hi, w),
+            y0: place(y_lo, y_hi, h),
+            side,
+        }
+    }
+
+    fn apply<T: Copy>(&self, image: &[T], w: usize) -> Vec<T> {
+        (self.y0..self.y0 + self.side)
+            .flat_map(|y| {
+                image[y * w + self.x0..y * w + self.x0 + self.side]
+                    .iter()
+                    .copied()
+            })
+            .collect()
+    }
 }
 
 /// The micrograph's contact pixels (above the series threshold) of load `i`.
@@ -135,7 +190,7 @@ fn figure(out: &mut String, src: &str, caption: &str) {
     );
 }
 
-fn page(facts: &Facts, panels: &[String]) -> String {
+fn page(facts: &Facts, panels: &[(String, usize)]) -> String {
     let p = facts.params;
     let mut s = String::new();
     s.push_str(HEAD);
@@ -153,8 +208,33 @@ fn page(facts: &Facts, panels: &[String]) -> String {
     let names: Vec<String> = facts.comparisons.iter().map(|(n, _)| escape(n)).collect();
     s.push_str(&names.join(" | "));
     s.push_str(". Simulated maps are blurred with the PSF, integrated onto the micrograph pixels, registered by phase correlation and put on the micrograph's grey scale; the micrograph's contact edges (global Otsu threshold) are green on every panel.</p>\n");
-    for (i, name) in panels.iter().enumerate() {
-        figure(&mut s, name, &format!("N = {:.3} mN", p.loads_n[i] * 1e3));
+    let n = panels.len();
+    let shown = if n > 3 {
+        vec![0, n / 2, n - 1]
+    } else {
+        (0..n).collect()
+    };
+    for &i in &shown {
+        let (name, side) = &panels[i];
+        figure(
+            &mut s,
+            name,
+            &format!(
+                "N = {:.3} mN, field {:.1} µm wide",
+                p.loads_n[i] * 1e3,
+                *side as f64 * p.image_pixel_m * 1e6
+            ),
+        );
+    }
+    if n > shown.len() {
+        s.push_str("<p>All loads: ");
+        let links: Vec<String> = panels
+            .iter()
+            .enumerate()
+            .map(|(i, (name, _))| format!("<a href=\"{name}\">{:.3} mN</a>", p.loads_n[i] * 1e3))
+            .collect();
+        s.push_str(&links.join(" · "));
+        s.push_str("</p>\n");
     }
     dice_table(&mut s, facts);
 
@@ -232,7 +312,7 @@ fn inputs_table(s: &mut String, p: &DemoParams) {
             format!("{:.2} GPa", p.e_star_pa * 1e-9),
         ),
         (
-            "hardening k (p_Y = k·h_pl)",
+            "hardening k (yield pressure = k × plastic depth)",
             format!("{:.2} MPa/nm", p.k_pa_per_m * 1e-15),
         ),
         (
@@ -301,22 +381,56 @@ fn dice_table(s: &mut String, facts: &Facts) {
     }
     s.push_str("</tr>\n");
     let loads = facts.comparisons.first().map_or(0, |(_, c)| c.loads.len());
+    let mut missed = false;
     for i in 0..loads {
         let _ = write!(
             s,
             "<tr><td>{:.4}</td>",
             facts.comparisons[0].1.loads[i].force_n * 1e3
         );
-        for (_, c) in facts.comparisons {
-            let _ = write!(s, "<td>{:.3}</td>", c.loads[i].dice);
+        // Every model's map sits at the same place on the micrograph; a registration far from
+        // the others' median shift has locked onto the wrong peak.
+        let shifts: Vec<(f64, f64)> = facts
+            .comparisons
+            .iter()
+            .map(|(_, c)| c.loads[i].shift_px)
+            .collect();
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        let centre = (
+            median(shifts.iter().map(|s| s.0).collect()),
+            median(shifts.iter().map(|s| s.1).collect()),
+        );
+        for ((_, c), shift) in facts.comparisons.iter().zip(&shifts) {
+            let off = (shift.0 - centre.0).hypot(shift.1 - centre.1);
+            if off > 4.0 {
+                missed = true;
+                let _ = write!(
+                    s,
+                    "<td>{:.3} <b>*</b> ({off:.0} px off)</td>",
+                    c.loads[i].dice
+                );
+            } else {
+                let _ = write!(s, "<td>{:.3}</td>", c.loads[i].dice);
+            }
         }
         s.push_str("</tr>\n");
     }
     s.push_str("</table>\n");
+    if missed {
+        s.push_str("<p><b>*</b> Registration missed: phase correlation aligns edges, and a model whose contact is much wider than the measured one (the penetration hardness at the highest loads) has no edge to align, so the correlation peak lands elsewhere. The Dice value of such a load measures the misregistration, not the model; its panel above shows the misplaced map.</p>\n");
+    }
+    for (name, c) in facts.comparisons {
+        for w in &c.warnings {
+            let _ = writeln!(s, "<p>{}: {}</p>", escape(name), escape(w));
+        }
+    }
 }
 
 fn fits_table(s: &mut String, fits: &[ModelFit]) {
-    s.push_str("<table>\n<tr><th>model</th><th>fitted parameter</th><th>misfit (RMS of ln A_sim/A_exp)</th></tr>\n");
+    s.push_str("<table>\n<tr><th>model</th><th>fitted parameter</th><th>misfit (RMS of ln A<sub>sim</sub>/A<sub>exp</sub>)</th></tr>\n");
     for fit in fits {
         let parameter = match (fit.family, fit.best.parameter) {
             (Family::Hardening, Some(k)) => format!(
@@ -326,7 +440,7 @@ fn fits_table(s: &mut String, fits: &[ModelFit]) {
                     .map_or(String::new(), |e| format!(" ± {:.2}", e * 1e-15))
             ),
             (Family::Hardness, Some(p)) => format!(
-                "p_Y = {:.0}{} MPa",
+                "p<sub>Y</sub> = {:.0}{} MPa",
                 p * 1e-6,
                 fit.parameter_se
                     .map_or(String::new(), |e| format!(" ± {:.0}", e * 1e-6))
