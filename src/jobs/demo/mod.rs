@@ -10,9 +10,10 @@
 //! `fit-hardening`, `compare`, `autocorr`), simulates all four models, and writes a report folder
 //! with `index.html`. Every recovered number is listed next to its truth.
 //!
-//! The sphere is smaller than the paper's (R = 50 µm instead of 290 µm) and the loads lower, so
-//! that the contact fits a 10 µm simulation map and the demo runs in seconds; the physics and the
-//! pipeline are the same.
+//! The standard demo is in the paper's regime ([`DemoParams::standard`]: R = 290 µm, 4–400 mN,
+//! a patchy contact at the lightest load and a near-Hertzian disc ~55 µm across at the heaviest,
+//! 200 nm micrographs); it takes one to two minutes on 2 cores, most of it in `fit-hardening`
+//! (about 30 load ramps). [`DemoParams::reduced`] (`--small`) is a 10 µm toy for the tests.
 
 mod html;
 
