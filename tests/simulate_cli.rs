@@ -40,11 +40,20 @@ fn surface_topography_and_elastic_simulation() {
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["nx"], 128);
+    assert_eq!(v["format"], "npy");
+    assert_eq!(v["valid_points"], 128 * 128);
+    let d = &v["detrended"];
     assert!(
-        (v["h_prime_rms"].as_f64().unwrap() - 0.1).abs() < 1e-9,
+        (d["h_prime_rms"].as_f64().unwrap() - 0.1).abs() < 1e-9,
         "generator's slope target"
     );
-    assert!((v["pixel_size_x_nm"].as_f64().unwrap() - 32.0).abs() < 1e-9);
+    assert!((d["pixel_size_x_nm"].as_f64().unwrap() - 32.0).abs() < 1e-9);
+    assert!((v["pixel_size_um"]["x"].as_f64().unwrap() - 0.032).abs() < 1e-12);
+    // Without detrending, the stored map's summary and the roughness statistics agree.
+    let slope = v["slope_rms"].as_f64().unwrap();
+    assert!((slope / d["h_prime_rms"].as_f64().unwrap() - 1.0).abs() < 1e-9);
+    let h_rms_um = v["h_rms_um"].as_f64().unwrap();
+    assert!((h_rms_um * 1e3 / d["h_rms_nm"].as_f64().unwrap() - 1.0).abs() < 1e-6);
 
     let out = dir.path().join("sim");
     let o = run(&[

@@ -1,27 +1,39 @@
-//! `contactscope info`: describe a TIFF file.
+//! `contactscope info`: describe a micrograph file: TIFF in detail; Zeiss CZI, Nikon ND2 and
+//! Leica LIF (and TIFF with `--json`/`--stats`) by series, axes, sample type and pixel size.
 
-use std::path::PathBuf;
+use std::io::Read;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
+use contactscope::io::microscopy::summary::{info_summary, InfoSummary};
 use contactscope::io::units;
 use contactscope::jobs::info::{run_info, InfoRequest};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// A TIFF file.
+    /// A TIFF, CZI, ND2 or LIF file.
     file: PathBuf,
-    /// Print JSON.
+    /// Print JSON: {"file", "format", "series": [{"index", "name", "axes", "dtype",
+    /// "pixel_size_um": {"x", "y", "z"}, "pixel_size_source", "planes"}]} (docs/formats.md).
     #[arg(long)]
     json: bool,
+    /// Decode every plane and add its min, max, mean and sum ("planes").
+    #[arg(long)]
+    stats: bool,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let i = run_info(&InfoRequest { file: args.file })?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&i)?);
+    if args.json || args.stats || !is_tiff(&args.file) {
+        let summary = info_summary(&args.file, args.stats)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&summary)?);
+        } else {
+            print_summary(&summary);
+        }
         return Ok(());
     }
+    let i = run_info(&InfoRequest { file: args.file })?;
     println!("file:         {}", i.path.display());
     println!("pages:        {}", i.pages.len());
     println!(
@@ -60,4 +72,56 @@ pub fn run(args: Args) -> Result<()> {
         println!("note:         {note}");
     }
     Ok(())
+}
+
+/// A TIFF by its signature (classic or BigTIFF, either byte order); unreadable files are left to
+/// the readers, whose errors name them.
+fn is_tiff(path: &Path) -> bool {
+    let mut head = [0u8; 4];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|()| matches!(&head, b"II*\0" | b"MM\0*" | b"II+\0" | b"MM\0+"))
+}
+
+fn print_summary(summary: &InfoSummary) {
+    println!("file:         {}", summary.file);
+    println!("format:       {}", summary.format);
+    for s in &summary.series {
+        let a = &s.axes;
+        let name = if s.name.is_empty() {
+            String::new()
+        } else {
+            format!(" '{}'", s.name)
+        };
+        println!(
+            "series {}{name}: T {} × Z {} × C {} × Y {} × X {}, {}",
+            s.index, a.t, a.z, a.c, a.y, a.x, s.dtype
+        );
+        let p = &s.pixel_size_um;
+        match (p.x, p.y) {
+            (Some(x), Some(y)) => println!(
+                "  pixel size: {} × {}{} from {}",
+                units::format_length(x * 1e-6),
+                units::format_length(y * 1e-6),
+                p.z.map_or(String::new(), |z| format!(
+                    ", z step {}",
+                    units::format_length(z * 1e-6)
+                )),
+                s.pixel_size_source.as_deref().unwrap_or("the file")
+            ),
+            _ => println!("  pixel size: none in the metadata (use --pixel-size)"),
+        }
+        for plane in s.planes.iter().flatten() {
+            println!(
+                "  t {} z {} c {}: min {} max {} mean {:.4} sum {}",
+                plane.index.t,
+                plane.index.z,
+                plane.index.c,
+                plane.min,
+                plane.max,
+                plane.mean,
+                plane.sum
+            );
+        }
+    }
 }

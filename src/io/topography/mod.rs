@@ -117,6 +117,25 @@ impl TopographySource {
     }
 }
 
+/// The name of the extension reader [`read_topography`] uses for `path` (`npy`, `tiff`, `gsf`,
+/// `text`, `wsxm`, `nanoscope`), for summaries; `None` for an unknown extension.
+pub fn extension_format(path: &Path) -> Option<&'static str> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    Some(match ext.as_str() {
+        "npy" => "npy",
+        "tif" | "tiff" => "tiff",
+        "gsf" => "gsf",
+        "txt" | "csv" | "dat" => "text",
+        "top" => "wsxm",
+        "di" | "spm" => "nanoscope",
+        e if e.len() == 3 && e.bytes().all(|b| b.is_ascii_digit()) => "nanoscope",
+        _ => return None,
+    })
+}
+
 /// Read a height map, choosing the reader by the file extension (table in the module docs).
 /// `pixel_size_m` = (x, y) in metres overrides the file's; `height_unit_m` gives metres per
 /// stored unit for formats without a unit (default 1: metres).

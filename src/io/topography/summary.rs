@@ -17,6 +17,7 @@
 
 use std::path::Path;
 
+use ndarray::Array2;
 use serde::Serialize;
 
 use super::{read, HeightMap};
@@ -64,22 +65,35 @@ pub struct PixelSizeXy {
 
 /// Statistics of a height map over its valid points.
 pub fn summarise(file: &str, map: &HeightMap) -> TopographySummary {
-    let valid: Vec<f64> = map
-        .heights
-        .iter()
-        .copied()
-        .filter(|h| h.is_finite())
-        .collect();
+    summarise_heights(
+        file,
+        map.format.name(),
+        &map.channel,
+        &map.heights,
+        (map.dx_m, map.dy_m),
+    )
+}
+
+/// Statistics of heights (m, NaN where invalid) on a grid of `(dx, dy)` metres, for a map of
+/// any format (`format` and `channel` are only reported).
+pub fn summarise_heights(
+    file: &str,
+    format: &str,
+    channel: &str,
+    heights: &Array2<f64>,
+    (dx_m, dy_m): (f64, f64),
+) -> TopographySummary {
+    let valid: Vec<f64> = heights.iter().copied().filter(|h| h.is_finite()).collect();
     let n = valid.len() as f64;
     let mean = valid.iter().sum::<f64>() / n;
     let rms = (valid.iter().map(|h| (h - mean) * (h - mean)).sum::<f64>() / n).sqrt();
     let min = valid.iter().copied().fold(f64::INFINITY, f64::min);
     let max = valid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let h = &map.heights;
+    let h = heights;
     let (ny, nx) = h.dim();
     let (mut s2, mut c2, mut count) = (0.0, 0.0, 0usize);
-    let (a, b) = (0.5 / map.dx_m, 0.5 / map.dy_m);
-    let (ax, by) = (1.0 / (map.dx_m * map.dx_m), 1.0 / (map.dy_m * map.dy_m));
+    let (a, b) = (0.5 / dx_m, 0.5 / dy_m);
+    let (ax, by) = (1.0 / (dx_m * dx_m), 1.0 / (dy_m * dy_m));
     for i in 1..ny.saturating_sub(1) {
         for j in 1..nx.saturating_sub(1) {
             let (c, l, r, u, d) = (
@@ -103,13 +117,13 @@ pub fn summarise(file: &str, map: &HeightMap) -> TopographySummary {
     let per = |s: f64| (count > 0).then(|| (s / count as f64).sqrt());
     TopographySummary {
         file: file.to_string(),
-        format: map.format.name().to_string(),
-        channel: map.channel.clone(),
+        format: format.to_string(),
+        channel: channel.to_string(),
         nx,
         ny,
         pixel_size_um: PixelSizeXy {
-            x: map.dx_m * 1e6,
-            y: map.dy_m * 1e6,
+            x: dx_m * 1e6,
+            y: dy_m * 1e6,
         },
         valid_points: valid.len(),
         height_min_um: min * 1e6,
