@@ -53,7 +53,9 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let result = match Cli::parse().command {
+    let command = Cli::parse().command;
+    cli::signals::discard_on_interrupt();
+    let result = match command {
         Command::Analyze(args) => cli::analyze::run(args),
         Command::Threshold(args) => cli::threshold::run(args),
         Command::Info(args) => cli::info::run(args),
@@ -72,6 +74,10 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(_) if cli::signals::interrupted() => loop {
+            // The signal handler reports and exits; the run's error is a consequence.
+            std::thread::park();
+        },
         Err(e) => {
             eprintln!("contactscope: error: {e:#}");
             ExitCode::FAILURE

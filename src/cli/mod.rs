@@ -14,6 +14,7 @@ pub mod hertz;
 pub mod info;
 pub mod newton;
 pub mod psf;
+pub mod signals;
 pub mod simulate;
 pub mod surface;
 pub mod synth_series;

@@ -184,6 +184,7 @@ pub type DemoProgress<'a> = &'a dyn Fn(&str);
 pub fn run_demo(out_dir: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutcome> {
     let work = prepare_folder(out_dir)?;
     let result = build(&work, p, progress);
+    crate::io::staging::unregister(&work);
     match result {
         Ok(mut outcome) => {
             replace_folder(&work, out_dir)?;
@@ -222,6 +223,8 @@ fn prepare_folder(out_dir: &Path) -> Result<PathBuf> {
     let work = parent.join(format!(".{name}.demo-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&work);
     std::fs::create_dir_all(&work).map_err(|e| Error::io(&work, e))?;
+    // Removed by the command line's signal handler if the demo is interrupted.
+    crate::io::staging::register(&work);
     Ok(work)
 }
 
