@@ -4,8 +4,8 @@
 //!
 //! Misfit: the RMS over the measured loads of ln(A_sim/A_exp) (least squares in log area, so every
 //! load counts alike whatever its area). One-parameter models (hardening k with p_Y0 = 0, as the
-//! paper; penetration hardness p_Y) are fitted by a log-spaced grid evaluated in parallel, then a
-//! Brent's search (`argmin`) on ln(parameter) around the best grid point. The standard error comes from
+//! paper; penetration hardness p_Y) are fitted by a log-spaced grid evaluated in parallel, then
+//! Brent's method (`argmin`) on ln(parameter) around the best grid point. The standard error comes from
 //! the Gauss–Newton approximation at the optimum: var(ln p) = s²/ΣJ², with J = ∂ ln A_sim/∂ ln p by
 //! central differences and s² = Σr²/(n − 1). The parameter-free models (elastic, GT) are evaluated
 //! once. Hardening and hardness runs load in increasing force order, carrying the plastic
@@ -416,9 +416,7 @@ impl Search {
             ln_tolerance: 0.01,
         }
     }
-}
 
-impl Search {
     /// About how many ramps [`fit_parameter`] runs, at most: the grid, the golden-section steps
     /// from a bracket of two grid spacings down to `ln_tolerance` (Brent's parabolic steps
     /// usually need fewer), the final evaluation and the two of the standard error. For progress
