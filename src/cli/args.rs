@@ -171,9 +171,13 @@ impl BodyArgs {
     pub fn body(&self) -> Result<Body> {
         Ok(Body {
             topography: self.input.options.source(self.input.path.clone())?,
-            radius_m: optional_length(&self.radius, "--radius")?,
-            e_star_pa: units::parse_positive(&self.modulus, Dimension::Pressure)
-                .context("--modulus")?,
+            radius_m: optional_length(&self.radius, "--radius")?
+                .map(|r| contactscope::io::ranges::Quantity::Radius.check(r, "--radius"))
+                .transpose()?,
+            e_star_pa: contactscope::io::ranges::Quantity::Modulus.check(
+                units::parse_positive(&self.modulus, Dimension::Pressure).context("--modulus")?,
+                "--modulus",
+            )?,
         })
     }
 }

@@ -70,9 +70,10 @@ pub fn run(args: Args) -> Result<()> {
     };
     let psf_fwhm_m = match (&args.psf, &args.psf_fwhm) {
         (Some(path), _) => fwhm_from_psf_json(path)?,
-        (None, Some(text)) => {
-            units::parse_positive(text, Dimension::Length).context("--psf-fwhm")?
-        }
+        (None, Some(text)) => contactscope::io::ranges::Quantity::Fwhm.check(
+            units::parse_positive(text, Dimension::Length).context("--psf-fwhm")?,
+            "--psf-fwhm",
+        )?,
         (None, None) => bail!("give --psf psf.json or --psf-fwhm"),
     };
     if args.upsample == 0 {

@@ -118,7 +118,10 @@ fn sweep_micrographs(args: &Args) -> Result<Option<SweepMicrographs>> {
         channel: None,
         pixel_size_m: optional_pixel_size(&args.micrograph_pixel_size, "--micrograph-pixel-size")?,
         settings: CompareSettings {
-            psf_fwhm_m: units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+            psf_fwhm_m: contactscope::io::ranges::Quantity::Fwhm.check(
+                units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+                "--psf-fwhm",
+            )?,
             dihedral: false,
             upsample: 20,
             force_tolerance: 0.01,
@@ -134,7 +137,10 @@ fn imaging(args: &Args) -> Result<Option<Imaging>> {
         bail!("--imaged-areas needs --psf-fwhm and --micrograph-pixel-size");
     };
     Ok(Some(Imaging {
-        fwhm_m: units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+        fwhm_m: contactscope::io::ranges::Quantity::Fwhm.check(
+            units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+            "--psf-fwhm",
+        )?,
         pixel_m: units::parse_pixel_size(pixel).context("--micrograph-pixel-size")?,
     }))
 }

@@ -29,7 +29,10 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let request = HertzRequest {
         input: args.input.clone(),
-        radius_m: units::parse_positive(&args.radius, Dimension::Length).context("--radius")?,
+        radius_m: contactscope::io::ranges::Quantity::Radius.check(
+            units::parse_positive(&args.radius, Dimension::Length).context("--radius")?,
+            "--radius",
+        )?,
         loads_n: args
             .loads
             .as_deref()

@@ -53,8 +53,11 @@ pub fn run(args: Args) -> Result<()> {
         fluorescence: args.contact,
         pixel_size_m: args.pixel_size.metres()?,
         options: NewtonOptions {
-            wavelength_m: units::parse_positive(&args.wavelength, Dimension::Length)
-                .context("--wavelength")?,
+            wavelength_m: contactscope::io::ranges::Quantity::Wavelength.check(
+                units::parse_positive(&args.wavelength, Dimension::Length)
+                    .context("--wavelength")?,
+                "--wavelength",
+            )?,
             medium_index: args.medium_index,
             profiles: args.profiles,
             phase: match args.phase {

@@ -59,8 +59,9 @@ pub struct Args {
 }
 
 fn model_of(args: &Args) -> Result<ModelChoice> {
-    let pressure = |t: &str, flag: &str| {
-        units::parse_positive(t, Dimension::Pressure).with_context(|| flag.to_string())
+    let pressure = |t: &str, flag: &str| -> Result<f64> {
+        let p = units::parse_positive(t, Dimension::Pressure).with_context(|| flag.to_string())?;
+        Ok(contactscope::io::ranges::Quantity::Hardness.check(p, flag)?)
     };
     Ok(match args.model {
         ModelArg::Elastic => ModelChoice::HalfSpace(Model::Elastic),
@@ -82,7 +83,10 @@ fn model_of(args: &Args) -> Result<ModelChoice> {
                 Dimension::Pressure,
                 Dimension::Length,
             )
-            .context("--hardening")?,
+            .context("--hardening")
+            .and_then(|k| {
+                Ok(contactscope::io::ranges::Quantity::Hardening.check(k, "--hardening")?)
+            })?,
             initial_pa: units::parse_quantity(&args.initial_hardness, Dimension::Pressure)
                 .context("--initial-hardness")?,
         }),

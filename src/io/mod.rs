@@ -7,6 +7,7 @@
 //! | module | what |
 //! |---|---|
 //! | [`units`] | quantities as text: `290um`, `3.7GPa`, `4,10,20mN`, ranges and ratios |
+//! | [`ranges`] | plausible ranges of forces, pixel sizes, radii, moduli, hardness, k, wavelengths, FWHMs |
 //! | [`staging`] | output folders written to a staging folder and renamed into place atomically |
 //! | [`table`] | small CSV tables whose column names carry the unit (`force_mN`), `areas.csv` |
 //! | [`tiff`] | TIFF reading (pages, channels, pixel-size metadata) and writing |
@@ -21,6 +22,7 @@ pub(crate) mod binary;
 pub mod mechanics;
 pub mod microscopy;
 pub mod plot;
+pub mod ranges;
 pub mod results;
 pub mod series;
 pub mod staging;

@@ -21,6 +21,7 @@ use super::tiff::{TiffInfo, TiffReader};
 use crate::analysis::PlaneSource;
 use crate::error::{Error, Location, Result};
 use crate::image::{PixelSize, PixelSizeSource, Plane, SampleType};
+use crate::io::ranges::Quantity;
 
 /// One image of a series.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -307,7 +308,11 @@ pub fn from_manifest(manifest: &Path, channel: Option<usize>) -> Result<Series> 
         let path = base.join(file);
         let force = manifest_number(&row, Some(force_col), "force_mN", &at)?
             .ok_or_else(|| Error::bad_input(at.clone(), "missing force_mN"))?;
+        Quantity::Force.check_at(force * 1e-3, &at)?;
         let friction = manifest_number(&row, friction_col, "friction_mN", &at)?;
+        if let Some(f) = friction {
+            Quantity::Force.check_at(f * 1e-3, &at)?;
+        }
         let page = resolve_page(&mut table, &path, &row, page_col, &at)?;
         images.push(ImageRef {
             path,
@@ -436,6 +441,11 @@ pub fn pixel_size(
     }
     for f in &series.files {
         warnings.extend(f.notes.iter().map(|n| format!("{}: {n}", f.path.display())));
+    }
+    if let Some(p) = &first.pixel_size {
+        let at = Location::file(&first.path);
+        Quantity::PixelSize.check_at(p.x_m, &at)?;
+        Quantity::PixelSize.check_at(p.y_m, &at)?;
     }
     if first.pixel_size.is_none() {
         warnings.push(

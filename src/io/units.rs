@@ -5,6 +5,7 @@
 //! unit is required, because a silently assumed unit is the most expensive mistake a lab can make.
 
 use crate::error::{Error, Result};
+use crate::io::ranges::Quantity;
 
 /// The kind of quantity a string must express.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -172,6 +173,9 @@ pub fn parse_quantity_list(text: &str, dim: Dimension) -> Result<Vec<f64>> {
         };
         pending_unit = Some(factor);
         values[i] = scale(value, factor);
+        if dim == Dimension::Force {
+            Quantity::Force.check(values[i], &format!("'{item}'"))?;
+        }
     }
     Ok(values)
 }
@@ -208,6 +212,9 @@ pub fn parse_loads(text: &str) -> Result<Vec<f64>> {
         return Err(Error::InvalidArgument(format!(
             "load {bad} N must be positive"
         )));
+    }
+    for &v in &values {
+        Quantity::Force.check(v, &format!("'{text}'"))?;
     }
     Ok(values)
 }
@@ -301,6 +308,8 @@ pub fn parse_pixel_size(text: &str) -> Result<(f64, f64)> {
     } else {
         parse_positive(x_part, Dimension::Length)?
     };
+    Quantity::PixelSize.check(x, &format!("'{text}'"))?;
+    Quantity::PixelSize.check(y, &format!("'{text}'"))?;
     Ok((x, y))
 }
 
