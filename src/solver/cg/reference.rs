@@ -151,19 +151,7 @@ pub fn solve_load_bounded(
     plasticity: Plasticity,
     options: &SolverOptions,
 ) -> Result<Solution> {
-    if !(force > 0.0 && force.is_finite()) {
-        return Err(Error::InvalidArgument(format!(
-            "load must be positive (got {force})"
-        )));
-    }
-    if let Plasticity::Cap(cap) = plasticity {
-        let capacity = cap.iter().sum::<f64>() * problem.pixel_area;
-        if force >= capacity {
-            return Err(Error::InvalidArgument(format!(
-                "load {force:.6e} exceeds what the hardness can carry on the whole map ({capacity:.6e})"
-            )));
-        }
-    }
+    super::check_load(problem, force, plasticity)?;
     let mut iterations = 0;
     let mut solve = |delta: f64, warm: Option<&[f64]>| -> Result<Solution> {
         let s = solve_displacement(problem, delta, plasticity, warm, options)?;

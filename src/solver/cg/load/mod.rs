@@ -77,19 +77,7 @@ pub fn solve_load_with(
     warm: Option<&[f64]>,
     options: &SolverOptions,
 ) -> Result<Solution> {
-    if !(force > 0.0 && force.is_finite()) {
-        return Err(Error::InvalidArgument(format!(
-            "load must be positive (got {force})"
-        )));
-    }
-    if let Plasticity::Cap(cap) = plasticity {
-        let capacity = cap.iter().sum::<f64>() * problem.pixel_area;
-        if force >= capacity {
-            return Err(Error::InvalidArgument(format!(
-                "load {force:.6e} exceeds what the hardness can carry on the whole map ({capacity:.6e})"
-            )));
-        }
-    }
+    super::check_load(problem, force, plasticity)?;
     match (options.method, plasticity) {
         (Method::Reference, Plasticity::Elastic) => {
             reference::solve_load_pk(problem, force, options)
