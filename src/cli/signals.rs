@@ -39,7 +39,13 @@ pub fn discard_on_interrupt() {
                         removed.iter().map(|p| p.display().to_string()).collect();
                     format!("discarded the unfinished output {}", names.join(", "))
                 };
-                eprintln!("contactscope: interrupted by {name}; {what}");
+                // Not eprintln!: with stderr gone (a closed pipe) it would panic this thread
+                // and the process would never exit.
+                use std::io::Write as _;
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "contactscope: interrupted by {name}; {what}"
+                );
                 std::process::exit(128 + signal);
             }
         });
