@@ -67,6 +67,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod limits;
 
 // (a) algorithms on in-memory data
 pub mod analysis;

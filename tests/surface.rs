@@ -270,7 +270,7 @@ fn float_tiff_with_and_without_calibration() {
     assert_eq!((t.ny(), t.nx()), (3, 4));
     assert!(rel(t.dx_m, 0.25e-6) < 1e-9 && rel(t.dy_m, 0.25e-6) < 1e-9);
     assert!(rel(t.heights[[2, 3]], 5.5e-9) < 1e-12);
-    let t = read_topography(&path, Some((1e-9, 2e-9)), None).unwrap();
+    let t = read_topography(&path, Some((1e-9, 2e-9)), Some(1e-9)).unwrap();
     assert_eq!((t.dx_m, t.dy_m), (1e-9, 2e-9));
 
     let bare = dir.path().join("bare.tiff");
@@ -280,12 +280,20 @@ fn float_tiff_with_and_without_calibration() {
         err.contains("bare.tiff") && err.contains("pixel size"),
         "{err}"
     );
-    assert!(read_topography(&bare, Some((1e-9, 1e-9)), None).is_ok());
+    assert!(read_topography(&bare, Some((1e-9, 1e-9)), Some(1e-9)).is_ok());
+    // Heights of up to 5.5 taken for metres: refused at the first beyond 1 m, with the way out.
+    let err = read_topography(&bare, Some((1e-9, 1e-9)), None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("row 0, column 3 is 1.5e0 m") && err.contains("--height-unit"),
+        "{err}"
+    );
 
     let mut nan = data.clone();
     nan[5] = f32::NAN;
     write_float_tiff(&bare, 4, 3, &nan, None);
-    let err = read_topography(&bare, Some((1e-9, 1e-9)), None)
+    let err = read_topography(&bare, Some((1e-9, 1e-9)), Some(1e-9))
         .unwrap_err()
         .to_string();
     assert!(

@@ -7,7 +7,7 @@ use crate::error::{Error, Location, Result};
 
 /// Largest decoded plane or height map any reader allocates (bytes), as
 /// [`crate::io::tiff::read::MAX_PAGE_BYTES`]: a header promising more is refused before allocating.
-pub const MAX_PLANE_BYTES: usize = 1 << 30;
+pub const MAX_PLANE_BYTES: usize = crate::limits::Limits::DEFAULT.max_plane_bytes;
 
 /// A bad-input error naming the file.
 pub(crate) fn bad(path: &Path, reason: impl Into<String>) -> Error {
@@ -198,6 +198,7 @@ pub(crate) struct FileSource {
 impl FileSource {
     /// Open `path`.
     pub(crate) fn open(path: &Path) -> Result<Self> {
+        crate::io::staging::note_input(path);
         let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
         let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
         Ok(FileSource {

@@ -26,6 +26,11 @@ pub enum Quantity {
     Wavelength,
     /// PSF FWHM, m: [1 nm, 100 µm].
     Fwhm,
+    /// A lateral length (roll-off and cutoff wavelengths, lags, bead diameters, lever arms), m:
+    /// [0.1 nm, 1 m].
+    Length,
+    /// A height (rms roughness, metres per stored height unit), m: [1 fm, 1 m].
+    Height,
 }
 
 impl Quantity {
@@ -40,6 +45,8 @@ impl Quantity {
             Quantity::Hardening => (1e9, 1e21),
             Quantity::Wavelength => (1e-7, 1e-5),
             Quantity::Fwhm => (1e-9, 1e-4),
+            Quantity::Length => (1e-10, 1.0),
+            Quantity::Height => (1e-15, 1.0),
         }
     }
 
@@ -54,6 +61,8 @@ impl Quantity {
             Quantity::Hardening => ("hardening coefficient", 1e-15, "MPa/nm"),
             Quantity::Wavelength => ("wavelength", 1e9, "nm"),
             Quantity::Fwhm => ("PSF FWHM", 1e9, "nm"),
+            Quantity::Length => ("length", 1e6, "µm"),
+            Quantity::Height => ("height", 1e9, "nm"),
         }
     }
 

@@ -7,6 +7,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
+use super::ranges::Quantity;
 use super::table::Table;
 use super::tiff::read_image;
 use crate::compare::SimulatedMap;
@@ -35,6 +36,21 @@ pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
     if forces.is_empty() {
         return Err(Error::bad_input(table.location(), "no rows"));
     }
+    for (k, (&force, &area)) in forces.iter().zip(&areas).enumerate() {
+        let at = Location::file(format!("{}:{}", path.display(), table.line(k)));
+        Quantity::Force.check_at(force, &at)?;
+        // A load without contact gives an infinite stress (friction) and no size to fit.
+        if !(area > 0.0 && area <= 1.0) {
+            return Err(Error::bad_input(
+                at,
+                format!(
+                    "area_um2 = {:e} µm²: an area must be positive and at most 1 m² (remove a \
+                     row without contact)",
+                    area * 1e12
+                ),
+            ));
+        }
+    }
     Ok(forces.into_iter().zip(areas).collect())
 }
 
@@ -42,6 +58,7 @@ pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
 pub fn simulated_maps(dir: &Path) -> Result<Vec<SimulatedMap>> {
     let table = dir.join("areas.csv");
     let at = Location::file(&table);
+    crate::io::staging::note_input(&table);
     let text = std::fs::read_to_string(&table).map_err(|e| {
         Error::bad_input(
             Location::file(dir),
@@ -70,6 +87,8 @@ pub fn simulated_maps(dir: &Path) -> Result<Vec<SimulatedMap>> {
                     format!("row {}: force_mN is not a number", i + 1),
                 )
             })?;
+        let line = Location::file(format!("{}:{}", table.display(), i + 2));
+        Quantity::Force.check_at(force_mn * 1e-3, &line)?;
         let map = dir.join(format!("load_{:03}_contact.tif", i + 1));
         if !map.is_file() {
             return Err(Error::bad_input(
@@ -85,6 +104,9 @@ pub fn simulated_maps(dir: &Path) -> Result<Vec<SimulatedMap>> {
 fn read_map(path: &Path, force_n: f64) -> Result<SimulatedMap> {
     let image = read_image(path, None, None)?;
     let px = image.require_pixel_size()?;
+    let at = Location::file(path);
+    Quantity::PixelSize.check_at(px.x_m, &at)?;
+    Quantity::PixelSize.check_at(px.y_m, &at)?;
     let map = Grid::new(image.values, image.width, image.height, px.x_m, px.y_m)
         .map_err(|e| Error::bad_input(Location::file(path), e.to_string()))?;
     Ok(SimulatedMap {
@@ -97,14 +119,15 @@ fn read_map(path: &Path, force_n: f64) -> Result<SimulatedMap> {
 /// The PSF FWHM (m) recorded by `contactscope psf` in its `psf.json` (`fwhm_nm_mean`).
 pub fn fwhm_from_psf_json(path: &Path) -> Result<f64> {
     let at = Location::file(path);
+    crate::io::staging::note_input(path);
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     let value: Value = serde_json::from_str(&text)
         .map_err(|e| Error::bad_input(at.clone(), format!("not JSON: {e}")))?;
     match value.get("fwhm_nm_mean").and_then(Value::as_f64) {
-        Some(nm) if nm > 0.0 && nm.is_finite() => Ok(nm * 1e-9),
-        _ => Err(Error::bad_input(
+        Some(nm) => Quantity::Fwhm.check_at(nm * 1e-9, &at),
+        None => Err(Error::bad_input(
             at,
-            "no positive fwhm_nm_mean (expected the psf.json written by `contactscope psf`)",
+            "no number fwhm_nm_mean (expected the psf.json written by `contactscope psf`)",
         )),
     }
 }

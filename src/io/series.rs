@@ -275,6 +275,7 @@ fn manifest_number(
 /// Read a manifest CSV (`file`, optional `page`, `force_mN`, optional `friction_mN`).
 pub fn from_manifest(manifest: &Path, channel: Option<usize>) -> Result<Series> {
     let at_manifest = Location::file(manifest);
+    crate::io::staging::note_input(manifest);
     let text = std::fs::read_to_string(manifest).map_err(|e| Error::io(manifest, e))?;
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)

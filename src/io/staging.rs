@@ -62,13 +62,8 @@ impl Staging {
     /// Stage `bytes` as output file `name` (a plain file name).
     pub fn write(&self, name: &str, bytes: &[u8]) -> Result<PathBuf> {
         let target = self.final_path(name);
-        if let Ok(existing) = target.canonicalize() {
-            if self.protected.contains(&existing) {
-                return Err(Error::Output {
-                    path: target,
-                    reason: "it is an input file of this run; choose another --out".into(),
-                });
-            }
+        if is_input(&target, &self.protected) {
+            return Err(input_refusal(target));
         }
         let staged = self.staging_dir.join(name);
         let _open = open_gate(&staged)?;
@@ -92,14 +87,8 @@ impl Staging {
                     });
                 }
                 Ok(_) => {
-                    if let Ok(existing) = target.canonicalize() {
-                        if self.protected.contains(&existing) {
-                            return Err(Error::Output {
-                                path: target,
-                                reason: "it is an input file of this run; choose another --out"
-                                    .into(),
-                            });
-                        }
+                    if is_input(&target, &self.protected) {
+                        return Err(input_refusal(target));
                     }
                 }
                 Err(_) => {}
@@ -150,6 +139,43 @@ impl Staging {
         drop(unfinished);
         let _ = fs::remove_dir_all(&self.staging_dir);
         Ok(moved.into_iter().map(|(_, target, _)| target).collect())
+    }
+}
+
+/// Every file this process has opened for reading (canonical paths): the main inputs, and the
+/// files named inside manifests, PSF JSONs and simulation folders alike. No output of the
+/// process is written over one of them ([`Staging`], [`write_atomic`]). In a long-lived process
+/// (Python) this means a file read once is never overwritten by a later call either.
+static READ_INPUTS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Record that `path` is read as an input (call before opening it).
+pub fn note_input(path: &Path) {
+    if let Ok(canonical) = path.canonicalize() {
+        if let Ok(mut list) = READ_INPUTS.lock() {
+            if !list.contains(&canonical) {
+                list.push(canonical);
+            }
+        }
+    }
+}
+
+/// Whether `target` (an existing file) is an input: named to [`Staging::new`] or read by the
+/// process.
+fn is_input(target: &Path, protected: &[PathBuf]) -> bool {
+    let Ok(existing) = target.canonicalize() else {
+        return false;
+    };
+    protected.contains(&existing)
+        || READ_INPUTS
+            .lock()
+            .map(|list| list.contains(&existing))
+            .unwrap_or(false)
+}
+
+fn input_refusal(target: PathBuf) -> Error {
+    Error::Output {
+        path: target,
+        reason: "it is an input file of this run; choose another --out".into(),
     }
 }
 
@@ -226,6 +252,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let name = path
         .file_name()
         .map_or("out".into(), |n| n.to_string_lossy().into_owned());
+    if is_input(path, &[]) {
+        return Err(input_refusal(path.to_path_buf()));
+    }
     let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
     let _open = open_gate(&tmp)?;
     fs::write(&tmp, bytes).map_err(|e| output_error(&tmp, e))?;

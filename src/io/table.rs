@@ -16,6 +16,7 @@ pub(crate) struct Table {
 impl Table {
     /// Read `path`; an unreadable file or a malformed CSV is an error naming the file.
     pub(crate) fn read(path: &Path) -> Result<Table> {
+        crate::io::staging::note_input(path);
         let at = || Location::file(path);
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)

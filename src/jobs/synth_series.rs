@@ -106,6 +106,7 @@ fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
 
 /// True areas (µm²) from a `truth.csv` written by [`write_series`], in row order.
 pub fn read_truth(path: &Path) -> Result<Vec<f64>> {
+    crate::io::staging::note_input(path);
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     let mut reader = csv::Reader::from_reader(text.as_bytes());
     let bad = |reason: String| Error::bad_input(crate::error::Location::file(path), reason);

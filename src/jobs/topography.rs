@@ -66,6 +66,7 @@ pub fn run_topography(request: &TopographyRequest) -> Result<TopographyOutcome> 
         );
         (summary, Ok(raw))
     };
+    summary.check_finite(path)?;
     match topography {
         Ok(mut topography) => {
             topography.detrend(source.detrend);

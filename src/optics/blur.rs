@@ -20,6 +20,7 @@
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::limits::Limits;
 
 /// FWHM / σ of a Gaussian, 2√(2 ln 2).
 pub const FWHM_PER_SIGMA: f64 = 2.354_820_045_030_949_4;
@@ -88,7 +89,11 @@ pub fn gaussian_kernel(sigma_px: f64) -> Vec<f64> {
     if sigma_px <= 0.0 || !sigma_px.is_finite() {
         return vec![1.0];
     }
-    let radius = (4.0 * sigma_px).ceil() as i64;
+    // Callers check σ against `Limits::kernel_radius` with their own message; the clamp keeps a
+    // missed check from allocating without bound.
+    let radius = (4.0 * sigma_px)
+        .ceil()
+        .min(Limits::DEFAULT.max_kernel_radius as f64) as i64;
     let kernel: Vec<f64> = (-radius..=radius)
         .map(|k| (-((k * k) as f64) / (2.0 * sigma_px * sigma_px)).exp())
         .collect();
@@ -105,8 +110,17 @@ pub fn gaussian_blur(
     edges: Edges,
 ) -> Vec<f64> {
     assert_eq!(data.len(), width * height, "blur: image size mismatch");
-    let kx = gaussian_kernel(sigma_x_px);
-    let ky = gaussian_kernel(sigma_y_px);
+    // With zero edges, taps farther than the image is long never meet a pixel: drop them (the
+    // kernel stays normalised over its full support).
+    let trim = |kernel: Vec<f64>, n: usize| match edges {
+        Edges::Zero if kernel.len() > 2 * n + 1 => {
+            let r = kernel.len() / 2;
+            kernel[r - n..=r + n].to_vec()
+        }
+        _ => kernel,
+    };
+    let kx = trim(gaussian_kernel(sigma_x_px), width);
+    let ky = trim(gaussian_kernel(sigma_y_px), height);
     let mut rows = vec![0.0; data.len()];
     rows.par_chunks_mut(width.max(1))
         .zip(data.par_chunks(width.max(1)))
@@ -196,6 +210,14 @@ pub fn resample_area(grid: &Grid, dx_m: f64, dy_m: f64) -> Result<Grid> {
             "target pixel size {dx_m:e} × {dy_m:e} m is not positive"
         )));
     }
+    for (n, d_in, d_out) in [
+        (grid.width, grid.dx_m, dx_m),
+        (grid.height, grid.dy_m, dy_m),
+    ] {
+        Limits::DEFAULT
+            .samples(n as f64 * d_in, d_out)
+            .map_err(|reason| Error::InvalidArgument(format!("resampling: {reason}")))?;
+    }
     let wx = overlap_weights(grid.width, grid.dx_m, dx_m);
     let wy = overlap_weights(grid.height, grid.dy_m, dy_m);
     let (out_w, out_h) = (wx.len(), wy.len());
@@ -234,13 +256,18 @@ pub fn microscope_image(map: &Grid, fwhm_m: f64, pixel_m: (f64, f64)) -> Result<
         )));
     }
     let sigma_m = fwhm_m / FWHM_PER_SIGMA;
-    let blurred = gaussian_blur(
-        &map.values,
-        map.width,
-        map.height,
-        (sigma_m / map.dx_m, sigma_m / map.dy_m),
-        Edges::Zero,
-    );
+    let sigma_px = (sigma_m / map.dx_m, sigma_m / map.dy_m);
+    for s in [sigma_px.0, sigma_px.1] {
+        Limits::DEFAULT.kernel_radius(s).map_err(|reason| {
+            Error::InvalidArgument(format!(
+                "PSF FWHM {:.4} µm on a grid of {:.4e} × {:.4e} m pixels: {reason}",
+                fwhm_m * 1e6,
+                map.dx_m,
+                map.dy_m
+            ))
+        })?;
+    }
+    let blurred = gaussian_blur(&map.values, map.width, map.height, sigma_px, Edges::Zero);
     let blurred = Grid::new(blurred, map.width, map.height, map.dx_m, map.dy_m)?;
     resample_area(&blurred, pixel_m.0, pixel_m.1)
 }

@@ -76,6 +76,10 @@ impl SelfAffineParams {
                 self.nx, self.ny
             )));
         }
+        // The spectrum is complex (16 bytes per value).
+        crate::limits::Limits::DEFAULT
+            .plane_bytes(self.nx, self.ny, 16)
+            .map_err(|reason| invalid(format!("surface size: {reason}")))?;
         if !(self.dx_m.is_finite() && self.dx_m > 0.0) {
             return Err(invalid(format!(
                 "pixel size must be positive and finite (got {} m)",
@@ -95,6 +99,12 @@ impl SelfAffineParams {
         if !(value.is_finite() && value > 0.0) {
             return Err(invalid(format!(
                 "target rms must be positive and finite (got {value})"
+            )));
+        }
+        // A finite target whose square overflows would make every height infinite.
+        if value > 1.0 {
+            return Err(invalid(format!(
+                "target rms {value:e} is above 1 (an rms height above 1 m or an rms slope above 1; a unit typo?)"
             )));
         }
         Ok(())

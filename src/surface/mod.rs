@@ -30,6 +30,11 @@ pub struct Topography {
     pub dy_m: f64,
 }
 
+/// Largest height magnitude a topography may hold, m: low enough that sums of squares of heights
+/// can never overflow (a finite height of 1e154 m once gave h_rms = ∞). Height maps read from
+/// files are held to a much tighter, physical bound (`io::topography::MAX_FILE_HEIGHT_M`).
+pub const MAX_ABS_HEIGHT_M: f64 = 1e100;
+
 impl Topography {
     /// A topography; heights must be finite and the pixel size positive.
     pub fn new(heights: Array2<f64>, dx_m: f64, dy_m: f64) -> Result<Self> {
@@ -47,6 +52,15 @@ impl Topography {
                 "height at row {}, column {} is not finite (NaN or ∞)",
                 bad / nx,
                 bad % nx
+            )));
+        }
+        if let Some(bad) = heights.iter().position(|h| h.abs() > MAX_ABS_HEIGHT_M) {
+            let nx = heights.ncols();
+            return Err(Error::InvalidArgument(format!(
+                "height at row {}, column {} is {:e} m, beyond ±{MAX_ABS_HEIGHT_M:e} m",
+                bad / nx,
+                bad % nx,
+                heights.iter().nth(bad).copied().unwrap_or(f64::NAN)
             )));
         }
         Ok(Topography {
@@ -213,10 +227,10 @@ mod tests {
 
     #[test]
     fn mean_and_rms() {
-        let h = Array2::from_shape_vec((2, 2), vec![1.0, 3.0, 1.0, 3.0]).unwrap();
+        let h = Array2::from_shape_vec((2, 2), vec![0.25, 0.75, 0.25, 0.75]).unwrap();
         let mut t = Topography::new(h, 1.0, 1.0).unwrap();
-        assert_eq!(t.mean(), 2.0);
-        assert_eq!(t.rms_height(), 1.0);
+        assert_eq!(t.mean(), 0.5);
+        assert_eq!(t.rms_height(), 0.25);
         t.detrend(Detrend::Mean);
         assert_eq!(t.mean(), 0.0);
         assert_eq!(t.area_m2(), 4.0);

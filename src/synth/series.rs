@@ -97,12 +97,25 @@ impl SynthParams {
     fn check(&self) -> Result<()> {
         let ok = self.width >= 8
             && self.height >= 8
-            && self.width * self.height <= 1 << 26
+            && self
+                .width
+                .checked_mul(self.height)
+                .is_some_and(|n| n <= 1 << 26)
             && self.pixel_size_m > 0.0
             && !self.forces_n.is_empty()
             && self.forces_n.iter().all(|f| f.is_finite() && *f > 0.0);
         if ok {
-            Ok(())
+            // The widest blur: the coarse roughness (1.5 µm) or the PSF, in pixels.
+            let widest = (1.5e-6f64).max(self.psf_fwhm_m / 2.3548) / self.pixel_size_m;
+            crate::limits::Limits::DEFAULT
+                .kernel_radius(widest)
+                .map(|_| ())
+                .map_err(|reason| {
+                    Error::InvalidArgument(format!(
+                        "pixel size {:.4e} m is too small for the generator's blurs: {reason}",
+                        self.pixel_size_m
+                    ))
+                })
         } else {
             Err(Error::InvalidArgument(
                 "synthetic series needs at least 8×8 pixels (at most 2^26), a positive pixel size and positive forces".into(),

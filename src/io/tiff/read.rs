@@ -20,7 +20,7 @@ use crate::error::{Error, Location, Result};
 use crate::image::{PixelSize, PixelSizeSource, Plane, SampleType, Samples};
 
 /// Largest decoded page we accept (bytes); guards allocations against absurd header dimensions.
-pub const MAX_PAGE_BYTES: usize = 1 << 30;
+pub const MAX_PAGE_BYTES: usize = crate::limits::Limits::DEFAULT.max_plane_bytes;
 
 /// How the channels of a file are stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -170,6 +170,7 @@ fn rational(value: Option<tiff::decoder::ifd::Value>) -> Option<f64> {
 impl TiffReader {
     /// Open a TIFF file and read its headers (every IFD, no pixel data).
     pub fn open(path: &Path) -> Result<Self> {
+        crate::io::staging::note_input(path);
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let mut decoder =
             Decoder::new(BufReader::new(file)).map_err(|e| tiff_error(Location::file(path), e))?;

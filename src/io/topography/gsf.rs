@@ -8,6 +8,7 @@ use std::path::Path;
 use crate::error::Result;
 use crate::surface::Topography;
 
+use super::vendor::grid_bytes;
 use super::{
     bad, length_unit, read_bytes, refuse_height_unit, slice, to_metres, topography, unitless_scale,
 };
@@ -71,7 +72,7 @@ pub fn read_gsf(
     {
         return Err(bad(path, "GSF header padding is not NUL bytes"));
     }
-    let data = slice(path, &bytes, data_start, nx * ny * 4)?;
+    let data = slice(path, &bytes, data_start, grid_bytes(path, nx, ny, 4)?)?;
     let heights = data
         .chunks_exact(4)
         .map(|c| z(f64::from(f32::from_le_bytes(c.try_into().unwrap()))))
@@ -189,7 +190,7 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("XReal"));
-        let t = read_gsf(&path, Some((1.0, 1.0)), Some(1e-6)).unwrap();
+        let t = read_gsf(&path, Some((1e-6, 1e-6)), Some(1e-6)).unwrap();
         assert_eq!(t.heights[[0, 1]], 2e-6);
     }
 
@@ -198,18 +199,18 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let cases = [
             (
-                "XRes = 2\nYRes = 2\nXReal = 1\nYReal = 1\n",
+                "XRes = 2\nYRes = 2\nXReal = 1e-6\nYReal = 1e-6\n",
                 vec![1.0f32; 3],
                 "truncated",
             ),
             ("XRes = 0\nYRes = 2\n", vec![], "XRes"),
             (
-                "XRes = 1\nYRes = 1\nXReal = 1\nYReal = 1\nZUnits = V\n",
+                "XRes = 1\nYRes = 1\nXReal = 1e-6\nYReal = 1e-6\nZUnits = V\n",
                 vec![1.0],
                 "not a length",
             ),
             (
-                "XRes = 1\nYRes = 1\nXReal = 1\nYReal = 1\n",
+                "XRes = 1\nYRes = 1\nXReal = 1e-6\nYReal = 1e-6\n",
                 vec![f32::NAN],
                 "not finite",
             ),

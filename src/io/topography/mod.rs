@@ -73,6 +73,7 @@ use ndarray::Array2;
 
 use crate::error::{Error, Location, Result};
 use crate::image::{SampleType, Samples};
+use crate::io::ranges::Quantity;
 use crate::io::tiff::metadata::length_unit_factor;
 use crate::io::tiff::TiffReader;
 
@@ -221,6 +222,7 @@ pub(crate) use crate::io::binary::bad;
 
 /// Read a whole file.
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    crate::io::staging::note_input(path);
     std::fs::read(path).map_err(|e| Error::io(path, e))
 }
 
@@ -300,6 +302,28 @@ pub(crate) fn slice<'a>(
     crate::io::binary::slice(path, data, offset, len, "the data")
 }
 
+/// Largest height magnitude of a height map read from a file, m: no rough surface reaches it,
+/// and a map that does was almost always stored in another unit than the one assumed.
+pub const MAX_FILE_HEIGHT_M: f64 = 1.0;
+
+/// An error naming the file when a height lies beyond ±[`MAX_FILE_HEIGHT_M`].
+pub(crate) fn plausible_heights(path: &Path, heights: &Array2<f64>) -> Result<()> {
+    let nx = heights.ncols().max(1);
+    match heights.iter().position(|h| h.abs() > MAX_FILE_HEIGHT_M) {
+        None => Ok(()),
+        Some(k) => Err(bad(
+            path,
+            format!(
+                "height at row {}, column {} is {:e} m, beyond ±{MAX_FILE_HEIGHT_M} m (heights \
+                 in another unit? see --height-unit)",
+                k / nx,
+                k % nx,
+                heights.iter().nth(k).copied().unwrap_or(f64::NAN)
+            ),
+        )),
+    }
+}
+
 /// Build the [`Topography`], turning its argument errors into errors naming the file.
 pub(crate) fn topography(
     path: &Path,
@@ -313,6 +337,10 @@ pub(crate) fn topography(
             format!("data do not fill a {}×{} grid: {e}", shape.0, shape.1),
         )
     })?;
+    let at = Location::file(path);
+    Quantity::PixelSize.check_at(pixel_size_m.0, &at)?;
+    Quantity::PixelSize.check_at(pixel_size_m.1, &at)?;
+    plausible_heights(path, &array)?;
     Topography::new(array, pixel_size_m.0, pixel_size_m.1).map_err(|e| match e {
         Error::InvalidArgument(reason) => bad(path, reason),
         other => other,

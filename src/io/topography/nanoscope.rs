@@ -15,6 +15,7 @@ use std::path::Path;
 use crate::error::{Error, Location, Result};
 use crate::surface::Topography;
 
+use super::vendor::grid_bytes;
 use super::{bad, latin1, length_unit, read_bytes, refuse_height_unit, slice, topography};
 
 /// One `\*Ciao image list` section.
@@ -53,13 +54,14 @@ pub fn read_nanoscope(
     let channel = default_channel(path, &header)?;
     refuse_height_unit(path, height_unit_m, &channel.unit)?;
     let (nx, ny, b) = (channel.nx, channel.ny, channel.bytes_per_pixel);
-    let data = slice(path, &bytes, channel.offset, nx * ny * b).map_err(|e| match e {
-        Error::BadInput { at, reason } => Error::BadInput {
-            at,
-            reason: format!("channel '{}': {reason}", channel.name),
-        },
-        other => other,
-    })?;
+    let data =
+        slice(path, &bytes, channel.offset, grid_bytes(path, nx, ny, b)?).map_err(|e| match e {
+            Error::BadInput { at, reason } => Error::BadInput {
+                at,
+                reason: format!("channel '{}': {reason}", channel.name),
+            },
+            other => other,
+        })?;
     let mut heights = Vec::with_capacity(nx * ny);
     for row in data.chunks_exact(nx * b).rev() {
         heights.extend(

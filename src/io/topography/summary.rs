@@ -63,6 +63,40 @@ pub struct PixelSizeXy {
     pub y: f64,
 }
 
+impl TopographySummary {
+    /// An error naming `path` when a statistic is not finite (no valid point, or heights or
+    /// pixel sizes so extreme that sums of squares overflow): nothing non-finite is printed.
+    pub fn check_finite(&self, path: &std::path::Path) -> crate::error::Result<()> {
+        let values = [
+            ("pixel size x", Some(self.pixel_size_um.x)),
+            ("pixel size y", Some(self.pixel_size_um.y)),
+            ("minimum height", Some(self.height_min_um)),
+            ("maximum height", Some(self.height_max_um)),
+            ("mean height", Some(self.height_mean_um)),
+            ("rms height", Some(self.h_rms_um)),
+            ("rms slope", self.slope_rms),
+            ("rms curvature", self.curvature_rms),
+        ];
+        match values
+            .iter()
+            .find(|(_, v)| v.is_some_and(|v| !v.is_finite()))
+        {
+            None => Ok(()),
+            Some((what, v)) => Err(crate::error::Error::bad_input(
+                crate::error::Location::file(path),
+                format!(
+                    "the {what} of the stored heights is {} ({} valid of {} points; heights up \
+                     to {:e} µm): not a usable height map",
+                    v.unwrap_or(f64::NAN),
+                    self.valid_points,
+                    self.nx * self.ny,
+                    self.height_min_um.abs().max(self.height_max_um.abs())
+                ),
+            )),
+        }
+    }
+}
+
 /// Statistics of a height map over its valid points.
 pub fn summarise(file: &str, map: &HeightMap) -> TopographySummary {
     summarise_heights(

@@ -17,6 +17,7 @@ pub fn read_text(
     height_unit_m: Option<f64>,
 ) -> Result<Topography> {
     let convert = to_metres(unitless_scale(height_unit_m)?);
+    crate::io::staging::note_input(path);
     let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
         std::io::ErrorKind::InvalidData => bad(path, "not a text file (invalid UTF-8)"),
         _ => Error::io(path, e),
@@ -100,7 +101,7 @@ mod tests {
             ("# nothing\n", "no numbers"),
         ] {
             let (_dir, path) = file(text);
-            let err = read_text(&path, Some((1.0, 1.0)), None)
+            let err = read_text(&path, Some((1e-6, 1e-6)), None)
                 .unwrap_err()
                 .to_string();
             assert!(err.contains(needle) && err.contains("m.txt"), "{err}");

@@ -10,7 +10,8 @@ use ndarray::Array2;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::io::binary::{bad, checked_bytes, unsupported, FileSource};
+use crate::io::binary::{bad, unsupported, FileSource};
+use crate::io::ranges::Quantity;
 use crate::surface::Topography;
 
 /// Largest height-map file read whole into memory (bytes).
@@ -118,6 +119,10 @@ impl HeightMap {
             ));
         }
         let (dx, dy) = pixel_size_m.unwrap_or((self.dx_m, self.dy_m));
+        let at = crate::error::Location::file(path);
+        Quantity::PixelSize.check_at(dx, &at)?;
+        Quantity::PixelSize.check_at(dy, &at)?;
+        super::plausible_heights(path, &self.heights)?;
         Topography::new(self.heights, dx, dy).map_err(|e| match e {
             Error::InvalidArgument(reason) => bad(path, reason),
             other => other,
@@ -361,7 +366,9 @@ pub(crate) fn height_map(
 
 /// `nx·ny` samples of `width` bytes: checks the size limit first.
 pub(crate) fn grid_bytes(path: &Path, nx: usize, ny: usize, width: usize) -> Result<usize> {
-    checked_bytes(path, "height map", &[nx, ny], width)
+    crate::limits::Limits::DEFAULT
+        .plane_bytes(nx, ny, width)
+        .map_err(|reason| unsupported(path, format!("height map: {reason} (header corrupt?)")))
 }
 
 /// Positive finite size or an error naming it.

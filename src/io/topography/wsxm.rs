@@ -15,6 +15,7 @@ use std::path::Path;
 use crate::error::Result;
 use crate::surface::Topography;
 
+use super::vendor::grid_bytes;
 use super::{bad, latin1, length_unit, read_bytes, refuse_height_unit, slice, topography};
 
 /// Header fields keyed by (section, key).
@@ -107,7 +108,7 @@ pub fn read_wsxm(
             ))
         }
     };
-    let data = slice(path, &bytes, data_offset, nx * ny * size)?;
+    let data = slice(path, &bytes, data_offset, grid_bytes(path, nx, ny, size)?)?;
     let heights = data
         .chunks_exact(size)
         .map(|c| raw_value(c) * scale)

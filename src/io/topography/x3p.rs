@@ -20,6 +20,7 @@ use crate::io::binary::{bad, decode_values, unsupported, MAX_PLANE_BYTES};
 
 /// Read an X3P file.
 pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
+    crate::io::staging::note_input(path);
     let file = std::fs::File::open(path).map_err(|e| crate::Error::io(path, e))?;
     let mut zip = zip::ZipArchive::new(file)
         .map_err(|e| bad(path, format!("not a readable zip archive: {e}")))?;

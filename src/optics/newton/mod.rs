@@ -22,6 +22,7 @@ pub use gap::{fit_hertz_gap, hertz_gap, ring_gap, GapFit, Phase};
 
 use crate::error::{Error, Location, Result};
 use crate::image::Image;
+use crate::limits::Limits;
 use profile::{
     edge_crossing, find_contact, half_level_edge, noise_sd, peaks, smooth, Contact, HalfLine,
 };
@@ -199,6 +200,26 @@ pub fn analyse(
                 reflection.path.display(),
                 reflection.width,
                 reflection.height
+            ),
+        ));
+    }
+    // Every profile samples at most the image diagonal in steps of the smaller pixel: bound the
+    // whole measurement before starting (a pixel of 200 nm × 1e-6 nm once sampled for ever).
+    let diagonal_m =
+        (reflection.width as f64 * pixel_m.0).hypot(reflection.height as f64 * pixel_m.1);
+    let per_line = diagonal_m / (STEP_PX * pixel_m.0.min(pixel_m.1)) + 2.0;
+    let total = per_line * 2.0 * (options.profiles * options.line_width_px.max(1)) as f64;
+    if total > Limits::DEFAULT.max_profile_samples as f64 {
+        return Err(Error::bad_input(
+            Location::file(&reflection.path),
+            format!(
+                "pixel size {:.4e} × {:.4e} m: {} profiles of {:.3e} samples each exceed the limit \
+                 of {} samples (pixels far from square?)",
+                pixel_m.0,
+                pixel_m.1,
+                2 * options.profiles,
+                per_line,
+                Limits::DEFAULT.max_profile_samples
             ),
         ));
     }

@@ -193,8 +193,13 @@ impl HalfLine {
         let (c, s) = (self.angle_rad.cos(), self.angle_rad.sin());
         let across = self.pixel_m.0.min(self.pixel_m.1);
         let half = (self.width_samples.max(1) - 1) as f64 / 2.0;
+        // The band leaves the image within its diagonal; the bound makes the loop finite for any
+        // pixel size (NaN included).
+        let diagonal_m =
+            (image.width as f64 * self.pixel_m.0).hypot(image.height as f64 * self.pixel_m.1);
+        let max_k = (diagonal_m / self.step_m).min(1e9) as usize + 2;
         let mut out = Vec::new();
-        for k in 0.. {
+        for k in 0..max_k {
             let along = k as f64 * self.step_m;
             let mut sum = 0.0;
             for j in 0..self.width_samples.max(1) {

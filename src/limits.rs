@@ -1,0 +1,112 @@
+//! Limits on the sizes of work: planes and maps decoded from files or asked for on the command
+//! line, blur kernels, resampled grids and sampled profiles. Every reader and every algorithm
+//! whose work size comes from a number it was given checks that number against [`Limits`] first,
+//! with checked arithmetic, and refuses with a message naming the value instead of allocating
+//! terabytes, looping for ever or wrapping a product to zero (issue 12, classes 1–3). The idea is
+//! image-tiff's `Limits` (a decoding budget); these limits are far above any real image or
+//! simulation and far below what would exhaust a workstation.
+
+/// The limits in force. [`Limits::DEFAULT`] is what the command line and Python use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limits {
+    /// Largest decoded plane, height map or simulation grid, bytes (1 GiB).
+    pub max_plane_bytes: usize,
+    /// Longest side of a plane or grid, pixels (65 536).
+    pub max_side: usize,
+    /// Largest half-width of a blur kernel, pixels (1 024: ⌈4σ⌉ for a PSF about 600 pixels wide).
+    pub max_kernel_radius: usize,
+    /// Most samples along all line profiles of one measurement (2^24).
+    pub max_profile_samples: usize,
+}
+
+impl Limits {
+    /// The default limits.
+    pub const DEFAULT: Limits = Limits {
+        max_plane_bytes: 1 << 30,
+        max_side: 1 << 16,
+        max_kernel_radius: 1024,
+        max_profile_samples: 1 << 24,
+    };
+
+    /// Bytes of an `nx × ny` plane of `bytes_per_value`, checked against overflow, the side
+    /// limit and the byte limit. The error text names the size and the limit.
+    pub fn plane_bytes(
+        &self,
+        nx: usize,
+        ny: usize,
+        bytes_per_value: usize,
+    ) -> Result<usize, String> {
+        if nx == 0 || ny == 0 {
+            return Err(format!("a {nx}×{ny} plane has no pixels"));
+        }
+        if nx > self.max_side || ny > self.max_side {
+            return Err(format!(
+                "a {nx}×{ny} plane exceeds the limit of {} pixels per side",
+                self.max_side
+            ));
+        }
+        nx.checked_mul(ny)
+            .and_then(|n| n.checked_mul(bytes_per_value))
+            .filter(|&b| b <= self.max_plane_bytes)
+            .ok_or_else(|| {
+                format!(
+                    "a {nx}×{ny} plane of {bytes_per_value}-byte values exceeds the {} MiB limit",
+                    self.max_plane_bytes >> 20
+                )
+            })
+    }
+
+    /// The radius ⌈4σ⌉ of a Gaussian kernel of `sigma_px` pixels, if within the limit.
+    pub fn kernel_radius(&self, sigma_px: f64) -> Result<usize, String> {
+        let radius = (4.0 * sigma_px).ceil();
+        if sigma_px.is_finite() && sigma_px >= 0.0 && radius <= self.max_kernel_radius as f64 {
+            Ok(radius as usize)
+        } else {
+            Err(format!(
+                "a Gaussian of σ = {sigma_px:.4e} pixels needs a kernel of ±{radius:e} pixels \
+                 (limit ±{})",
+                self.max_kernel_radius
+            ))
+        }
+    }
+
+    /// Pixels along an axis of `extent_m` cut into pixels of `pixel_m`, if within the side limit.
+    pub fn samples(&self, extent_m: f64, pixel_m: f64) -> Result<usize, String> {
+        // The tolerance keeps an exact multiple (10 µm / 200 nm) from gaining a sliver pixel.
+        let n = ((extent_m / pixel_m) * (1.0 - 1e-12)).ceil();
+        if n.is_finite() && n >= 0.0 && n <= self.max_side as f64 {
+            Ok(n as usize)
+        } else {
+            Err(format!(
+                "{extent_m:.4e} m in pixels of {pixel_m:.4e} m is {n:e} pixels (limit {})",
+                self.max_side
+            ))
+        }
+    }
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits::DEFAULT
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn products_that_wrap_are_refused() {
+        let l = Limits::DEFAULT;
+        assert_eq!(l.plane_bytes(512, 256, 2), Ok(262_144));
+        // 2^58 × 2^58 × 2 wraps to 0 in unchecked arithmetic.
+        assert!(l.plane_bytes(1 << 58, 1 << 58, 2).is_err());
+        assert!(l.plane_bytes(1 << 16, 1 << 16, 8).is_err());
+        assert!(l.plane_bytes(0, 5, 2).is_err());
+        assert!(l.kernel_radius(2.0).is_ok());
+        assert!(l.kernel_radius(1e13).is_err());
+        assert!(l.kernel_radius(f64::NAN).is_err());
+        assert!(l.samples(1e-3, 1e-300).is_err());
+        assert_eq!(l.samples(10e-6, 200e-9), Ok(50));
+    }
+}
