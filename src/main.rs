@@ -5,7 +5,7 @@ mod cli;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(
@@ -16,6 +16,9 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// On failure, print every cause of the error on its own line (default: one line)
+    #[arg(long, global = true)]
+    verbose: bool,
 }
 
 #[derive(Subcommand)]
@@ -52,8 +55,39 @@ enum Command {
     Hertz(cli::hertz::Args),
 }
 
+/// The command line's grammar, with option values allowed to start with `-` (`--radius -1um` is
+/// then refused by the range check with its reason, not by clap as an unknown flag `-1`).
+fn grammar() -> clap::Command {
+    fn hyphen_values(arg: clap::Arg) -> clap::Arg {
+        let one_value = arg
+            .get_num_args()
+            .is_none_or(|r| r.min_values() == 1 && r.max_values() == 1);
+        if arg.get_long().is_some() && arg.get_action().takes_values() && one_value {
+            arg.allow_hyphen_values(true)
+        } else {
+            arg
+        }
+    }
+    Cli::command().mut_subcommands(|sub| sub.mut_args(hyphen_values))
+}
+
 fn main() -> ExitCode {
-    let command = Cli::parse().command;
+    let parsed = grammar()
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m));
+    let cli = match parsed {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help and --version
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("{}", cli::errors::usage_line(&e));
+            return ExitCode::from(2);
+        }
+    };
+    let (command, verbose) = (cli.command, cli.verbose);
     cli::signals::discard_on_interrupt();
     let result = match command {
         Command::Analyze(args) => cli::analyze::run(args),
@@ -79,7 +113,7 @@ fn main() -> ExitCode {
             std::thread::park();
         },
         Err(e) => {
-            eprintln!("contactscope: error: {e:#}");
+            eprintln!("{}", cli::errors::report(&e, verbose));
             ExitCode::FAILURE
         }
     }

@@ -79,10 +79,14 @@ pub fn run(args: Args) -> Result<()> {
     let series = build_series(&args)?;
     let hertz = match (&args.radius, &args.modulus) {
         (Some(r), Some(e)) => Some(HertzParams {
-            radius_m: contactscope::io::ranges::Quantity::Radius
-                .check(units::parse_positive(r, Dimension::Length)?, "--radius")?,
-            modulus_pa: contactscope::io::ranges::Quantity::Modulus
-                .check(units::parse_positive(e, Dimension::Pressure)?, "--modulus")?,
+            radius_m: contactscope::io::ranges::Quantity::Radius.check(
+                units::parse_positive(r, Dimension::Length).context("--radius")?,
+                "--radius",
+            )?,
+            modulus_pa: contactscope::io::ranges::Quantity::Modulus.check(
+                units::parse_positive(e, Dimension::Pressure).context("--modulus")?,
+                "--modulus",
+            )?,
         }),
         _ => None,
     };

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 
+use contactscope::io::ranges::Quantity;
 use contactscope::io::topography::TopographySource;
 use contactscope::io::units::{self, Dimension};
 use contactscope::solver::cg::SolverOptions;
@@ -129,7 +130,7 @@ impl HeightMapOptions {
         Ok(TopographySource {
             path,
             pixel_size_m: optional_pixel_size(&self.pixel_size, "--pixel-size")?,
-            height_unit_m: optional_length(&self.height_unit, "--height-unit")?,
+            height_unit_m: optional_quantity(&self.height_unit, "--height-unit", Quantity::Height)?,
             detrend: self.detrend.detrend(),
         })
     }
@@ -171,10 +172,8 @@ impl BodyArgs {
     pub fn body(&self) -> Result<Body> {
         Ok(Body {
             topography: self.input.options.source(self.input.path.clone())?,
-            radius_m: optional_length(&self.radius, "--radius")?
-                .map(|r| contactscope::io::ranges::Quantity::Radius.check(r, "--radius"))
-                .transpose()?,
-            e_star_pa: contactscope::io::ranges::Quantity::Modulus.check(
+            radius_m: optional_quantity(&self.radius, "--radius", Quantity::Radius)?,
+            e_star_pa: Quantity::Modulus.check(
                 units::parse_positive(&self.modulus, Dimension::Pressure).context("--modulus")?,
                 "--modulus",
             )?,
@@ -192,8 +191,21 @@ pub fn optional_pixel_size(text: &Option<String>, flag: &str) -> Result<Option<(
 
 /// An optional positive length in metres.
 pub fn optional_length(text: &Option<String>, flag: &str) -> Result<Option<f64>> {
+    optional_quantity(text, flag, Quantity::Length)
+}
+
+/// A length-valued option checked against the plausible range of `quantity`.
+pub fn optional_quantity(
+    text: &Option<String>,
+    flag: &str,
+    quantity: Quantity,
+) -> Result<Option<f64>> {
     text.as_deref()
-        .map(|t| units::parse_positive(t, Dimension::Length).with_context(|| flag.to_string()))
+        .map(|t| {
+            let v =
+                units::parse_positive(t, Dimension::Length).with_context(|| flag.to_string())?;
+            Ok(quantity.check(v, flag)?)
+        })
         .transpose()
 }
 

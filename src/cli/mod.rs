@@ -8,6 +8,7 @@ pub mod analyze;
 pub mod autocorr;
 pub mod compare;
 pub mod demo;
+pub mod errors;
 pub mod fit_hardening;
 pub mod friction;
 pub mod hertz;

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 
+use contactscope::io::ranges::Quantity;
 use contactscope::io::units::{self, Dimension};
 use contactscope::jobs::surface::{run_surface, SurfaceRequest};
 use contactscope::surface::generate::{RmsTarget, SelfAffineParams};
@@ -46,7 +47,8 @@ pub fn run(args: Args) -> Result<()> {
     let target = match (&args.rms_slope, &args.rms_height) {
         (Some(slope), None) => RmsTarget::Slope(*slope),
         (None, Some(h)) => {
-            RmsTarget::Height(units::parse_positive(h, Dimension::Length).context("--rms-height")?)
+            let h = units::parse_positive(h, Dimension::Length).context("--rms-height")?;
+            RmsTarget::Height(Quantity::Height.check(h, "--rms-height")?)
         }
         _ => bail!("give --rms-slope or --rms-height"),
     };
