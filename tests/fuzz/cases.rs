@@ -1,0 +1,488 @@
+//! Command templates: one valid command line per command and input kind, over the seed corpus.
+//! A case copies the template's inputs into its own folder, mutates one of them (or none), and
+//! sometimes the numbers of its option values.
+
+/// One command line over seed inputs. `OUT` (or `OUT.npy`) is the output the command must not
+/// leave behind when it fails.
+pub struct Template {
+    /// Short name for the report.
+    pub name: &'static str,
+    /// Seed files or folders copied into the case folder.
+    pub copies: &'static [&'static str],
+    /// Which copied files a case may mutate.
+    pub mutable: &'static [&'static str],
+    /// The arguments, paths relative to the case folder.
+    pub args: &'static [&'static str],
+}
+
+macro_rules! t {
+    ($name:expr, [$($c:expr),*], [$($m:expr),*], [$($a:expr),* $(,)?]) => {
+        Template { name: $name, copies: &[$($c),*], mutable: &[$($m),*], args: &[$($a),*] }
+    };
+}
+
+/// Every template.
+pub const TEMPLATES: &[Template] = &[
+    t!(
+        "analyze",
+        ["series"],
+        ["series/series.tif"],
+        [
+            "analyze",
+            "series/series.tif",
+            "--forces",
+            "1,2,4mN",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "analyze-manifest",
+        ["series"],
+        ["series/manifest.csv", "series/series.tif"],
+        [
+            "analyze",
+            "--manifest",
+            "series/manifest.csv",
+            "--radius",
+            "290um",
+            "--modulus",
+            "3.7GPa",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "analyze-options",
+        ["series"],
+        ["series/series.tif"],
+        [
+            "analyze",
+            "series/series.tif",
+            "--forces",
+            "1,2,4mN",
+            "--pixel-size",
+            "200x210nm",
+            "--threshold",
+            "1100",
+            "--overlays",
+            "--save-masks",
+            "--memory-mib",
+            "16",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "threshold",
+        ["series"],
+        ["series/series.tif"],
+        ["threshold", "series/series.tif", "--json"]
+    ),
+    t!(
+        "info",
+        ["series"],
+        ["series/series.tif"],
+        ["info", "series/series.tif", "--json", "--stats"]
+    ),
+    t!(
+        "topography-npy",
+        ["t.npy"],
+        ["t.npy"],
+        ["topography", "t.npy", "--pixel-size", "200nm", "--json"]
+    ),
+    t!(
+        "topography-gsf",
+        ["t.gsf"],
+        ["t.gsf"],
+        ["topography", "t.gsf", "--json"]
+    ),
+    t!(
+        "topography-txt",
+        ["t.txt"],
+        ["t.txt"],
+        [
+            "topography",
+            "t.txt",
+            "--pixel-size",
+            "100nm",
+            "--height-unit",
+            "1nm",
+            "--json"
+        ]
+    ),
+    t!(
+        "topography-top",
+        ["t.top"],
+        ["t.top"],
+        ["topography", "t.top", "--json"]
+    ),
+    t!(
+        "topography-di",
+        ["t.di"],
+        ["t.di"],
+        ["topography", "t.di", "--json"]
+    ),
+    t!(
+        "simulate-npy",
+        ["t.npy"],
+        ["t.npy"],
+        [
+            "simulate",
+            "--topography",
+            "t.npy",
+            "--pixel-size",
+            "200nm",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--model",
+            "elastic",
+            "--loads",
+            "0.05,0.1mN",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "simulate-gsf",
+        ["t.gsf"],
+        ["t.gsf"],
+        [
+            "simulate",
+            "--topography",
+            "t.gsf",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--model",
+            "hardness",
+            "--hardness",
+            "1GPa",
+            "--loads",
+            "0.05,0.1mN",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "simulate-txt",
+        ["t.txt"],
+        ["t.txt"],
+        [
+            "simulate",
+            "--topography",
+            "t.txt",
+            "--pixel-size",
+            "150nm",
+            "--height-unit",
+            "1nm",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--model",
+            "hardening",
+            "--hardening",
+            "4MPa/nm",
+            "--loads",
+            "0.05,0.1mN",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "simulate-top",
+        ["t.top"],
+        ["t.top"],
+        [
+            "simulate",
+            "--topography",
+            "t.top",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--model",
+            "gt",
+            "--loads",
+            "0.05,0.1mN",
+            "--detrend",
+            "plane",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "simulate-di",
+        ["t.di"],
+        ["t.di"],
+        [
+            "simulate",
+            "--topography",
+            "t.di",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--model",
+            "hardening",
+            "--hardening",
+            "4MPa/nm",
+            "--volume-conserving",
+            "--loads",
+            "0.05,0.1mN",
+            "--tolerance",
+            "1e-6",
+            "--max-iterations",
+            "500",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "compare",
+        ["exp", "sim"],
+        [
+            "exp/series.tif",
+            "sim/summary.json",
+            "sim/load_001_contact.tif",
+            "sim/areas.csv"
+        ],
+        [
+            "compare",
+            "--experiment",
+            "exp/series.tif",
+            "--forces",
+            "0.05,0.1mN",
+            "--simulation",
+            "sim",
+            "--psf-fwhm",
+            "450nm",
+            "--out",
+            "OUT"
+        ]
+    ),
+    t!(
+        "compare-psf",
+        ["exp", "sim", "psf"],
+        ["psf/psf.json", "sim/load_002_contact.tif"],
+        [
+            "compare",
+            "--experiment",
+            "exp/series.tif",
+            "--forces",
+            "0.05,0.1mN",
+            "--simulation",
+            "sim",
+            "--psf",
+            "psf/psf.json",
+            "--upsample",
+            "2",
+            "--dihedral",
+            "--pixel-size",
+            "200nm",
+            "--out",
+            "OUT"
+        ]
+    ),
+    t!(
+        "fit-hardening",
+        ["an", "t.npy"],
+        ["an/areas.csv", "t.npy"],
+        [
+            "fit-hardening",
+            "--experiment",
+            "an/areas.csv",
+            "--topography",
+            "t.npy",
+            "--pixel-size",
+            "200nm",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--models",
+            "elastic,hardening",
+            "--k-range",
+            "0.1..10MPa/nm",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "fit-hardening-sweep",
+        ["an", "t.gsf", "series"],
+        ["series/manifest.csv", "t.gsf"],
+        [
+            "fit-hardening",
+            "--experiment",
+            "an/areas.csv",
+            "--topography",
+            "t.gsf",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--models",
+            "hardness",
+            "--hardness-range",
+            "0.1..5GPa",
+            "--sweep",
+            "k=1,4MPa/nm",
+            "--micrographs",
+            "series/manifest.csv",
+            "--psf-fwhm",
+            "450nm",
+            "--imaged-areas",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "newton",
+        ["reflection.tif", "fluorescence.tif"],
+        ["reflection.tif", "fluorescence.tif"],
+        [
+            "newton",
+            "reflection.tif",
+            "--contact",
+            "fluorescence.tif",
+            "--wavelength",
+            "488nm",
+            "--medium-index",
+            "1.447",
+            "--profiles",
+            "20",
+            "--out",
+            "OUT"
+        ]
+    ),
+    t!(
+        "psf",
+        ["beads.tif"],
+        ["beads.tif"],
+        [
+            "psf",
+            "beads.tif",
+            "--bead-diameter",
+            "100nm",
+            "--out",
+            "OUT"
+        ]
+    ),
+    t!(
+        "friction",
+        ["trace.csv", "an"],
+        ["trace.csv", "an/areas.csv"],
+        [
+            "friction",
+            "trace.csv",
+            "--areas",
+            "an/areas.csv",
+            "--force-tolerance",
+            "60%",
+            "--rotation-radius",
+            "5mm",
+            "--out",
+            "OUT"
+        ]
+    ),
+    t!(
+        "hertz",
+        ["squeeze.csv"],
+        ["squeeze.csv"],
+        [
+            "hertz",
+            "squeeze.csv",
+            "--radius",
+            "290um",
+            "--loads",
+            "1,2mN",
+            "--out",
+            "OUT"
+        ]
+    ),
+    t!(
+        "autocorr",
+        ["series"],
+        ["series/series.tif"],
+        [
+            "autocorr",
+            "series/series.tif",
+            "--max-lag",
+            "5um",
+            "--out",
+            "OUT"
+        ]
+    ),
+    t!(
+        "surface",
+        [],
+        [],
+        [
+            "surface",
+            "--size",
+            "32",
+            "--pixel-size",
+            "100nm",
+            "--hurst",
+            "0.8",
+            "--rms-height",
+            "10nm",
+            "--rolloff",
+            "2um",
+            "--cutoff",
+            "300nm",
+            "--seed",
+            "3",
+            "--out",
+            "OUT.npy"
+        ]
+    ),
+    t!(
+        "synth-series",
+        [],
+        [],
+        [
+            "synth-series",
+            "--size",
+            "64",
+            "--loads",
+            "0.05,0.1mN",
+            "--pixel-size",
+            "200nm",
+            "--seed",
+            "5",
+            "--out",
+            "OUT"
+        ]
+    ),
+];
+
+#[test]
+fn templates_name_their_mutable_files_among_the_copies() {
+    for t in TEMPLATES {
+        for m in t.mutable {
+            assert!(
+                t.copies
+                    .iter()
+                    .any(|c| m == c || m.starts_with(&format!("{c}/"))),
+                "{}: {m}",
+                t.name
+            );
+        }
+    }
+}

@@ -1,0 +1,254 @@
+//! The seed corpus: small valid inputs of every kind a command reads, made fresh for each campaign
+//! by the binary itself (series, surfaces, simulations, PSF JSON) and by the library's seeded
+//! generators (beads, Newton rings, friction traces). Nothing is copied from elsewhere, so the
+//! harness runs on a clean checkout without `../shared`.
+
+use std::fs;
+use std::path::Path;
+use std::process::Command;
+
+use contactscope::io::tiff::encode_u16_stack;
+use contactscope::mechanics::friction::XAxis;
+use contactscope::synth::beads::{synth_beads, BeadParams};
+use contactscope::synth::rings::{synth_newton, NewtonSynthParams};
+use contactscope::synth::traces::{synthetic_trace, trace_csv, CsvLayout, TraceParams};
+
+/// Run the binary in `dir` and insist on success.
+fn cli(dir: &Path, args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_contactscope"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("binary runs");
+    assert!(
+        out.status.success(),
+        "seed {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// A 32×32 map as a whitespace-separated text matrix (heights in nm, one row per line).
+fn text_matrix(dir: &Path) {
+    let mut text = String::from("# heights in nm\n");
+    for y in 0..32 {
+        let row: Vec<String> = (0..32)
+            .map(|x| {
+                format!(
+                    "{:.3}",
+                    20.0 * ((x as f64) * 0.4).sin() * ((y as f64) * 0.3).cos()
+                )
+            })
+            .collect();
+        text.push_str(&row.join(" "));
+        text.push('\n');
+    }
+    fs::write(dir.join("t.txt"), text).unwrap();
+}
+
+/// A small WSxM `.top` file as `io::topography::wsxm` documents the format: three text lines,
+/// an INI-like header, `[Header end]`, then int16 little-endian heights.
+fn wsxm(dir: &Path) {
+    let (nx, ny) = (24usize, 20usize);
+    let body = "[Control]\r\n\
+                X Amplitude: 4.8 \u{b5}m\r\n\
+                Y Amplitude: 4 \u{b5}m\r\n\
+                [General Info]\r\n\
+                Number of columns: 24\r\n\
+                Number of rows: 20\r\n\
+                Z Amplitude: 30 nm\r\n\
+                [Head Settings]\r\n\
+                Z Calibration: 1 nm\r\n\
+                [Miscellaneous]\r\n\
+                Maximum: 1000\r\n\
+                Minimum: -1000\r\n\
+                [Header end]\r\n";
+    // The header size line counts itself; iterate until the number is stable.
+    let mut size = 0;
+    let mut header = String::new();
+    for _ in 0..4 {
+        header = format!(
+            "WSxM file copyright UAM\r\nSxM Image file\r\nImage header size: {size}\r\n\r\n{body}"
+        );
+        size = header.len();
+    }
+    let mut bytes: Vec<u8> = header.chars().map(|c| c as u8).collect();
+    for k in 0..nx * ny {
+        let v = ((k as f64 * 0.37).sin() * 900.0) as i16;
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    fs::write(dir.join("t.top"), bytes).unwrap();
+}
+
+/// A small Bruker Nanoscope file (`io::topography::nanoscope`): a `\*File list` text header with a
+/// scan list and one height image of int16 data at its data offset.
+fn nanoscope(dir: &Path) {
+    let n = 16usize;
+    let offset = 2048usize;
+    let mut header = format!(
+        "\\*File list\r\n\\Data length: {offset}\r\n\\*Ciao scan list\r\n\
+         \\Scan Size: 2 2 um\r\n\\@Sens. Zsens: V 20 nm/V\r\n\
+         \\*Ciao image list\r\n\\Data offset: {offset}\r\n\\Data length: {}\r\n\
+         \\Bytes/pixel: 2\r\n\\Samps/line: {n}\r\n\\Number of lines: {n}\r\n\
+         \\Scan Size: 2 2 um\r\n\
+         \\@2:Z scale: V [Sens. Zsens] (0.006713867 V/LSB) 440 V\r\n\
+         \\@2:Image Data: S [Height] \"Height\"\r\n\
+         \\*File list end\r\n",
+        2 * n * n
+    );
+    assert!(header.len() < offset);
+    header.push_str(&"\0".repeat(offset - header.len()));
+    let mut bytes = header.into_bytes();
+    for k in 0..n * n {
+        let v = ((k as f64 * 0.21).cos() * 8000.0) as i16;
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    fs::write(dir.join("t.di"), bytes).unwrap();
+}
+
+/// A Hertzian squeeze test: 2δ from F for R = 290 µm, E* = 3.7 MPa (soft sphere).
+fn squeeze(dir: &Path) {
+    let (r, e) = (290e-6f64, 3.7e6f64);
+    let mut text = String::from("force_mN,displacement_um\n");
+    for i in 1..=12 {
+        let f = 0.5e-3 * i as f64;
+        let delta = (9.0 * f * f / (16.0 * r * e * e)).cbrt();
+        text.push_str(&format!("{},{}\n", f * 1e3, 2.0 * delta * 1e6));
+    }
+    fs::write(dir.join("squeeze.csv"), text).unwrap();
+}
+
+/// Every seed file, in `dir`. Takes about a second.
+pub fn build(dir: &Path) {
+    // Confocal load series (12-bit in 16-bit TIFF, 200 nm pixels) with its manifest.
+    cli(
+        dir,
+        &[
+            "synth-series",
+            "--size",
+            "96",
+            "--loads",
+            "1,2,4mN",
+            "--out",
+            "series",
+        ],
+    );
+    // Micrographs matching the simulation's loads, for compare.
+    cli(
+        dir,
+        &[
+            "synth-series",
+            "--size",
+            "128",
+            "--loads",
+            "0.05,0.1mN",
+            "--out",
+            "exp",
+        ],
+    );
+    // Topographies: npy, gsf (surface), text, WSxM, Nanoscope (writers above).
+    for name in ["t.npy", "t.gsf"] {
+        cli(
+            dir,
+            &[
+                "surface",
+                "--size",
+                "32",
+                "--pixel-size",
+                "200nm",
+                "--rms-height",
+                "20nm",
+                "--out",
+                name,
+            ],
+        );
+    }
+    text_matrix(dir);
+    wsxm(dir);
+    nanoscope(dir);
+    // A simulation folder and an analysis of the series (areas.csv for fits and friction).
+    cli(
+        dir,
+        &[
+            "simulate",
+            "--topography",
+            "t.npy",
+            "--pixel-size",
+            "200nm",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--model",
+            "elastic",
+            "--loads",
+            "0.05,0.1mN",
+            "--out",
+            "sim",
+            "-q",
+        ],
+    );
+    cli(
+        dir,
+        &[
+            "analyze",
+            "series/series.tif",
+            "--forces",
+            "1,2,4mN",
+            "--out",
+            "an",
+            "-q",
+        ],
+    );
+    // Beads at 100 nm pixels, and the PSF JSON measured on them.
+    let beads = synth_beads(&BeadParams::default()).unwrap();
+    let pages: Vec<&[u16]> = beads.planes.iter().map(Vec::as_slice).collect();
+    let tiff = encode_u16_stack(
+        &pages,
+        beads.width,
+        beads.height,
+        Some((100e-9, 100e-9)),
+        "",
+    )
+    .unwrap();
+    fs::write(dir.join("beads.tif"), tiff).unwrap();
+    cli(dir, &["psf", "beads.tif", "--out", "psf"]);
+    // Newton rings: reflection and fluorescence at 200 nm, smaller than the default.
+    let p = NewtonSynthParams {
+        width: 160,
+        height: 160,
+        centre_px: (80.3, 79.6),
+        contact_radius_m: 8e-6,
+        ..NewtonSynthParams::default()
+    };
+    let rings = synth_newton(&p).unwrap();
+    for (name, codes) in [
+        ("reflection.tif", &rings.reflection),
+        ("fluorescence.tif", &rings.fluorescence),
+    ] {
+        let bytes = encode_u16_stack(
+            &[codes.as_slice()],
+            p.width,
+            p.height,
+            Some((p.pixel_size_m, p.pixel_size_m)),
+            "",
+        )
+        .unwrap();
+        fs::write(dir.join(name), bytes).unwrap();
+    }
+    // A friction trace at 2 mN (normal force in a column), and a squeeze test.
+    let trace = synthetic_trace(&TraceParams {
+        static_friction_n: 2e-3,
+        kinetic_friction_n: 1.6e-3,
+        stiffness_n_per_m: 100.0,
+        seed: 3,
+        ..TraceParams::default()
+    });
+    let layout = CsvLayout {
+        x_axis: XAxis::Displacement,
+        torque: false,
+        rotation_radius_m: 5e-3,
+        normal_force_n: Some(2e-3),
+    };
+    fs::write(dir.join("trace.csv"), trace_csv(&trace, &layout)).unwrap();
+    squeeze(dir);
+}
