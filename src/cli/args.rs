@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 
+use contactscope::io::microscopy::select::{LoadAxis, Selection};
 use contactscope::io::topography::TopographySource;
 use contactscope::io::units::{self, Dimension};
 use contactscope::solver::cg::SolverOptions;
@@ -206,5 +207,57 @@ pub fn fraction(text: &str, flag: &str) -> Result<f64> {
     match value {
         Ok(v) if (0.0..1.0).contains(&v) => Ok(v),
         _ => bail!("{flag}: {text:?} is not a fraction in [0, 1) such as 1% or 0.01"),
+    }
+}
+
+/// `--series`, `--channel`, `--z`, `--t`: which plane(s) of a confocal file, shared by every
+/// command that reads micrographs (rules in `io::microscopy::select`).
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct SelectionArgs {
+    /// Series of a CZI (scene) or LIF (image) file; needed when the file has several.
+    #[arg(long)]
+    pub series: Option<usize>,
+    /// Channel; needed when the file has several (TIFF: samples or ImageJ channels).
+    #[arg(long)]
+    pub channel: Option<usize>,
+    /// Focal plane of a CZI, ND2 or LIF file; needed when it has several.
+    #[arg(long)]
+    pub z: Option<usize>,
+    /// Time point of a CZI, ND2 or LIF file; needed when it has several.
+    #[arg(long)]
+    pub t: Option<usize>,
+}
+
+impl SelectionArgs {
+    /// The library's selection.
+    pub fn selection(&self) -> Selection {
+        Selection {
+            series: self.series,
+            channel: self.channel,
+            z: self.z,
+            t: self.t,
+        }
+    }
+}
+
+/// `--load-axis`: the axis of one CZI, ND2 or LIF file whose planes are the loads.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum LoadAxisArg {
+    /// Time points.
+    T,
+    /// Focal planes.
+    Z,
+    /// Series (CZI scenes, LIF images).
+    Series,
+}
+
+impl LoadAxisArg {
+    /// The library's load axis.
+    pub fn axis(self) -> LoadAxis {
+        match self {
+            LoadAxisArg::T => LoadAxis::T,
+            LoadAxisArg::Z => LoadAxis::Z,
+            LoadAxisArg::Series => LoadAxis::Series,
+        }
     }
 }

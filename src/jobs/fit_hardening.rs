@@ -185,8 +185,13 @@ pub fn run_fit(request: &FitRequest) -> Result<FitOutcome> {
         .micrographs
         .as_ref()
         .map(|m| {
-            load_micrographs(&m.experiment, m.channel, m.pixel_size_m)
-                .map(|(_, micrographs)| micrographs)
+            load_micrographs(
+                &m.experiment,
+                &crate::io::microscopy::select::Selection::channel(m.channel),
+                None,
+                m.pixel_size_m,
+            )
+            .map(|(_, micrographs)| micrographs)
         })
         .transpose()?;
     let mut warnings = Vec::new();

@@ -8,9 +8,9 @@ use serde_json::{json, Value};
 use crate::error::{Error, Result};
 use crate::image::Image;
 use crate::image::SampleType;
+use crate::io::microscopy::select::{read_images, LoadAxis, Selection};
 use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::io::staging::Staging;
-use crate::io::tiff::read_pages;
 use crate::io::tiff::TiffReader;
 
 use crate::numerics::stats::MeanSd;
@@ -22,10 +22,10 @@ const MAX_PLOTTED_BEADS: usize = 8;
 /// What the command line asks for.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PsfRequest {
-    /// Bead image or stack (TIFF).
+    /// Bead image or stack (TIFF, CZI, ND2, LIF).
     pub input: PathBuf,
-    /// Channel of multi-channel files.
-    pub channel: Option<usize>,
+    /// Which planes: a confocal file's z planes unless `--z` picks one.
+    pub selection: Selection,
     /// `--pixel-size` override (x, y) in metres.
     pub pixel_size_m: Option<(f64, f64)>,
     /// `--bead-diameter` in metres (turns the finite-bead correction on).
@@ -47,7 +47,13 @@ pub struct PsfOutcome {
 
 /// Run `psf`: every page of the chosen channel, saturation level from the sample type.
 pub fn run_psf(request: &PsfRequest) -> Result<PsfOutcome> {
-    let images = read_pages(&request.input, request.channel, request.pixel_size_m)?;
+    let along = request.selection.z.is_none().then_some(LoadAxis::Z);
+    let images = read_images(
+        &request.input,
+        &request.selection,
+        along,
+        request.pixel_size_m,
+    )?;
     let options = PsfOptions {
         bead_diameter_m: request.bead_diameter_m,
         saturation_level: saturation_level(&request.input, &images)?,

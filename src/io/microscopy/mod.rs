@@ -19,6 +19,7 @@ mod clx;
 pub mod czi;
 pub mod lif;
 pub mod nd2;
+pub mod select;
 pub mod summary;
 mod tiff;
 

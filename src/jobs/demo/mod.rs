@@ -439,7 +439,7 @@ fn psf(work: &Path, data: &Path, p: &DemoParams) -> Result<Recovered> {
     write_atomic(&path, &tiff)?;
     let outcome = run_psf(&PsfRequest {
         input: path,
-        channel: None,
+        selection: crate::io::microscopy::select::Selection::default(),
         pixel_size_m: None,
         bead_diameter_m: None,
         out_dir: work.join("psf"),
@@ -483,6 +483,7 @@ fn newton(work: &Path, data: &Path, p: &DemoParams) -> Result<Vec<Recovered>> {
         reflection,
         fluorescence,
         pixel_size_m: None,
+        selection: crate::io::microscopy::select::Selection::default(),
         options: NewtonOptions::default(),
         out_dir: work.join("newton"),
         command_line: vec!["contactscope demo".into()],
@@ -666,6 +667,7 @@ fn compare_models(
 ) -> Result<Vec<(String, Comparison)>> {
     let (_, micrographs) = load_micrographs(
         &ExperimentInput::Manifest(manifest.to_path_buf()),
+        &crate::io::microscopy::select::Selection::default(),
         None,
         None,
     )?;
