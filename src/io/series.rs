@@ -394,8 +394,11 @@ pub fn from_files_selected(
 /// Give each image its force (newtons); the counts must agree.
 pub fn assign_forces(series: &mut Series, forces_n: &[f64]) -> Result<()> {
     if forces_n.len() != series.images.len() {
+        let along = series.load_axis.map_or(String::new(), |a| {
+            format!(" (the planes along --load-axis {})", a.name())
+        });
         return Err(Error::InvalidArgument(format!(
-            "{} force(s) given for {} image(s); give one force per image",
+            "{} force(s) given for {} image(s){along}; give one force per image",
             forces_n.len(),
             series.images.len()
         )));
