@@ -9,7 +9,7 @@ use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 
 use contactscope::io::microscopy::select::{LoadAxis, Selection};
-use contactscope::io::topography::TopographySource;
+use contactscope::io::topography::{FillInvalid, TopographySource};
 use contactscope::io::units::{self, Dimension};
 use contactscope::solver::cg::SolverOptions;
 use contactscope::surface::Detrend;
@@ -132,18 +132,52 @@ impl HeightMapOptions {
             pixel_size_m: optional_pixel_size(&self.pixel_size, "--pixel-size")?,
             height_unit_m: optional_length(&self.height_unit, "--height-unit")?,
             detrend: self.detrend.detrend(),
+            channel: None,
+            fill_invalid: None,
         })
     }
+}
+
+/// `--fill-invalid`: how to fill a vendor height map's invalid points.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum FillInvalidArg {
+    /// The mean of the valid heights.
+    Mean,
+    /// The height of the nearest valid point (city-block distance).
+    Nearest,
 }
 
 /// `--topography FILE` with its reading options.
 #[derive(clap::Args, Clone, Debug)]
 pub struct TopographyInput {
-    /// Height map: .npy, float TIFF, .gsf, text matrix (.txt/.csv/.dat), WSxM .top, Nanoscope .di.
+    /// Height map: .npy, float TIFF, .gsf, text matrix (.txt/.csv/.dat), WSxM .top, Nanoscope
+    /// .di, or a vendor AFM/profilometer file recognised by content (docs/formats.md).
     #[arg(long = "topography")]
     pub path: PathBuf,
     #[command(flatten)]
     pub options: HeightMapOptions,
+    /// Channel of a multi-channel vendor height map, by name (e.g. Height); default: the
+    /// file's height channel.
+    #[arg(long)]
+    pub channel: Option<String>,
+    /// Fill a vendor map's invalid (unmeasured, masked) points instead of refusing the map:
+    /// mean (of the valid heights) or nearest (valid point, city-block distance).
+    #[arg(long, value_enum)]
+    pub fill_invalid: Option<FillInvalidArg>,
+}
+
+impl TopographyInput {
+    /// The height map to read, with channel and filling.
+    pub fn source(&self) -> Result<TopographySource> {
+        Ok(TopographySource {
+            channel: self.channel.clone(),
+            fill_invalid: self.fill_invalid.map(|f| match f {
+                FillInvalidArg::Mean => FillInvalid::Mean,
+                FillInvalidArg::Nearest => FillInvalid::Nearest,
+            }),
+            ..self.options.source(self.path.clone())?
+        })
+    }
 }
 
 /// The rough sphere and its material, as `simulate` and `fit-hardening` take them.
@@ -171,7 +205,7 @@ impl BodyArgs {
     /// Parsed into library units.
     pub fn body(&self) -> Result<Body> {
         Ok(Body {
-            topography: self.input.options.source(self.input.path.clone())?,
+            topography: self.input.source()?,
             radius_m: optional_length(&self.radius, "--radius")?
                 .map(|r| contactscope::io::ranges::Quantity::Radius.check(r, "--radius"))
                 .transpose()?,

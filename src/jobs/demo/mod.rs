@@ -613,6 +613,8 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
             pixel_size_m: Some((p.sim_pixel_m, p.sim_pixel_m)),
             height_unit_m: None,
             detrend: crate::surface::Detrend::None,
+            channel: None,
+            fill_invalid: None,
         },
         radius_m: Some(p.radius_m),
         e_star_pa: p.e_star_pa,
