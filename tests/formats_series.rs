@@ -519,3 +519,34 @@ fn autocorr_reads_the_selected_plane_as_its_tiff_export() {
         assert!((x - y).abs() < 1e-9, "{x} vs {y}");
     }
 }
+
+#[test]
+fn psf_and_newton_readers_take_the_selected_planes() {
+    use contactscope::io::microscopy::select::{read_images, read_one_image, LoadAxis, Selection};
+    let Some(dir) = shared_data("real-formats") else {
+        return;
+    };
+    let file = dir.join("nd2/cluster.nd2");
+    let mut f = MicroscopyFile::open(&file).unwrap();
+    // psf: a z stack of the selected channel and time point, in z order, with the ND2 pixel size.
+    let sel = Selection {
+        channel: Some(1),
+        t: Some(2),
+        ..Selection::default()
+    };
+    let stack = read_images(&file, &sel, Some(LoadAxis::Z), None).unwrap();
+    assert_eq!(stack.len(), 10);
+    for (z, image) in stack.iter().enumerate() {
+        let plane = f.read_plane(0, &PlaneIndex::tzc(2, z, 1)).unwrap();
+        assert_eq!(image.values, plane.to_f64(), "z = {z}");
+        assert_eq!(image.page, z);
+        let px = image.pixel_size.unwrap();
+        assert_eq!(px.source.describe(), "ND2 SLxPictureMetadata/dCalibration");
+    }
+    // newton: one plane; an unselected axis is named.
+    let one = read_one_image(&file, &Selection { z: Some(7), ..sel }, Some((1e-7, 1e-7))).unwrap();
+    assert_eq!(one.values, stack[7].values);
+    assert!((one.pixel_size.unwrap().x_m - 1e-7).abs() < 1e-20);
+    let e = read_one_image(&file, &sel, None).unwrap_err().to_string();
+    assert!(e.contains("10 z planes; choose one with --z 0..9"), "{e}");
+}
