@@ -18,10 +18,10 @@ default_out!(Out, "contactscope-out/compare");
 #[command(group(clap::ArgGroup::new("psf_source").required(true).args(["psf", "psf_fwhm"])))]
 pub struct Args {
     /// The micrographs: a manifest CSV (file, page, force_mN), a folder holding manifest.csv,
-    /// or TIFF files/folders together with --forces.
+    /// or TIFF/CZI/ND2/LIF files or folders together with --forces.
     #[arg(long, required = true, num_args = 1..)]
     experiment: Vec<PathBuf>,
-    /// Normal force per micrograph when --experiment names TIFFs (e.g. 4mN,8mN or 4mN..40mN:8).
+    /// Normal force per micrograph when --experiment names image files (e.g. 4mN,8mN or 4mN..40mN:8).
     #[arg(long)]
     forces: Option<String>,
     /// Output folder of `contactscope simulate`.

@@ -23,7 +23,7 @@ use crate::io::staging::Staging;
 pub enum ExperimentInput {
     /// A manifest CSV (`file, page, force_mN`), or a folder holding `manifest.csv`.
     Manifest(PathBuf),
-    /// TIFF files or folders with one force per image, N.
+    /// TIFF, CZI, ND2 or LIF files or folders with one force per image, N.
     Files {
         /// Files or folders, in natural order.
         inputs: Vec<PathBuf>,
