@@ -544,9 +544,95 @@ fn psf_and_newton_readers_take_the_selected_planes() {
         assert_eq!(px.source.describe(), "ND2 SLxPictureMetadata/dCalibration");
     }
     // newton: one plane; an unselected axis is named.
-    let one = read_one_image(&file, &Selection { z: Some(7), ..sel }, Some((1e-7, 1e-7))).unwrap();
+    let seven = Selection {
+        z: Some(7),
+        ..sel.clone()
+    };
+    let one = read_one_image(&file, &seven, Some((1e-7, 1e-7))).unwrap();
     assert_eq!(one.values, stack[7].values);
     assert!((one.pixel_size.unwrap().x_m - 1e-7).abs() < 1e-20);
     let e = read_one_image(&file, &sel, None).unwrap_err().to_string();
     assert!(e.contains("10 z planes; choose one with --z 0..9"), "{e}");
+}
+
+#[test]
+fn extra_axes_are_chosen_by_name() {
+    let Some(dir) = shared_data("real-formats") else {
+        return;
+    };
+    // Bgr24 pixels: S = 0 blue, 1 green, 2 red, each its own plane.
+    let file = dir.join("czi/RGB-multichannel.czi");
+    let tmp = tempfile::tempdir().unwrap();
+    let e = stderr(&run(&["threshold", s(&file), "--channel", "0"]));
+    assert!(
+        e.contains("3 planes along axis S") && e.contains("--axis S=0..2"),
+        "{e}"
+    );
+    let green = analyze(
+        &tmp.path().join("g"),
+        &[
+            s(&file),
+            "--channel",
+            "2",
+            "--axis",
+            "S=1",
+            "--forces",
+            "1mN",
+        ],
+    );
+    let mut index = PlaneIndex::tzc(0, 0, 2);
+    index.extra.insert("S".into(), 1);
+    let tiff = tmp.path().join("green.tif");
+    export_tiff(&file, &[(0, index)], None, &tiff);
+    let exported = analyze(
+        &tmp.path().join("t"),
+        &[
+            s(&tiff),
+            "--forces",
+            "1mN",
+            "--pixel-size",
+            "2.95848999467571um",
+        ],
+    );
+    assert_eq!(green.0 .0.len(), exported.0 .0.len());
+    for name in [
+        "threshold",
+        "contact_pixels",
+        "patches",
+        "integrated_intensity",
+    ] {
+        assert_eq!(
+            column(&green.0 .0, &green.0 .1, name),
+            column(&exported.0 .0, &exported.0 .1, name),
+            "{name}"
+        );
+    }
+    // The blue plane is another image.
+    let blue = analyze(
+        &tmp.path().join("b"),
+        &[
+            s(&file),
+            "--channel",
+            "2",
+            "--axis",
+            "S=0",
+            "--forces",
+            "1mN",
+        ],
+    );
+    assert_ne!(
+        column(&green.0 .0, &green.0 .1, "integrated_intensity"),
+        column(&blue.0 .0, &blue.0 .1, "integrated_intensity")
+    );
+    let e = stderr(&run(&[
+        "threshold",
+        s(&file),
+        "--channel",
+        "0",
+        "--axis",
+        "S=3",
+    ]));
+    assert!(e.contains("--axis S=3") && e.contains("(0..2)"), "{e}");
+    let e = stderr(&run(&["threshold", s(&file), "--axis", "Z=1"]));
+    assert!(e.contains("use --t, --z or --channel"), "{e}");
 }

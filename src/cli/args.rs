@@ -246,7 +246,7 @@ pub fn fraction(text: &str, flag: &str) -> Result<f64> {
 
 /// `--series`, `--channel`, `--z`, `--t`: which plane(s) of a confocal file, shared by every
 /// command that reads micrographs (rules in `io::microscopy::select`).
-#[derive(clap::Args, Clone, Copy, Debug, Default)]
+#[derive(clap::Args, Clone, Debug, Default)]
 pub struct SelectionArgs {
     /// Series of a CZI (scene) or LIF (image) file; needed when the file has several.
     #[arg(long)]
@@ -260,6 +260,28 @@ pub struct SelectionArgs {
     /// Time point of a CZI, ND2 or LIF file; needed when it has several.
     #[arg(long)]
     pub t: Option<usize>,
+    /// Index along another axis of a CZI, ND2 or LIF file, by the name `info` shows: H=0
+    /// (Airyscan phase), S=1 (green of an RGB pixel), lambda_emission=3, … Repeatable.
+    #[arg(long = "axis", value_name = "NAME=INDEX", value_parser = parse_axis)]
+    pub axis: Vec<(String, usize)>,
+}
+
+/// `NAME=INDEX` of `--axis`.
+fn parse_axis(text: &str) -> std::result::Result<(String, usize), String> {
+    let (name, index) = text
+        .split_once('=')
+        .ok_or_else(|| format!("{text:?} is not NAME=INDEX (e.g. H=0)"))?;
+    let index = index
+        .trim()
+        .parse::<usize>()
+        .map_err(|_| format!("{text:?}: the index must be a non-negative integer"))?;
+    match name.trim() {
+        "" => Err(format!("{text:?}: the axis name is empty")),
+        n if ["T", "Z", "C", "X", "Y"].contains(&n) => Err(format!(
+            "{text:?}: use --t, --z or --channel for T, Z and C (X and Y are the plane)"
+        )),
+        n => Ok((n.to_string(), index)),
+    }
 }
 
 impl SelectionArgs {
@@ -270,6 +292,7 @@ impl SelectionArgs {
             channel: self.channel,
             z: self.z,
             t: self.t,
+            extra: self.axis.iter().cloned().collect(),
         }
     }
 }

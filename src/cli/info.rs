@@ -100,8 +100,13 @@ fn print_summary(summary: &InfoSummary) {
         } else {
             format!(" '{}'", s.name)
         };
+        let extra: String = a
+            .extra
+            .iter()
+            .map(|(axis, n)| format!(" × {axis} {n}"))
+            .collect();
         println!(
-            "series {}{name}: T {} × Z {} × C {} × Y {} × X {}, {}",
+            "series {}{name}: T {} × Z {} × C {}{extra} × Y {} × X {}, {}",
             s.index, a.t, a.z, a.c, a.y, a.x, s.dtype
         );
         let p = &s.pixel_size_um;

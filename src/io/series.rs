@@ -375,7 +375,7 @@ pub fn from_files_selected(
     selection: &Selection,
     load_axis: Option<LoadAxis>,
 ) -> Result<Series> {
-    let mut table = FileTable::new(*selection, load_axis);
+    let mut table = FileTable::new(selection.clone(), load_axis);
     let mut images = Vec::new();
     for path in collect_files(inputs)? {
         let channel = table.channel();
@@ -472,7 +472,7 @@ pub fn from_manifest_selected(
     };
     let (page_col, friction_col) = (column("page"), column("friction_mN"));
     let base = manifest.parent().unwrap_or(Path::new("."));
-    let mut table = FileTable::new(*selection, load_axis);
+    let mut table = FileTable::new(selection.clone(), load_axis);
     let mut images = Vec::new();
     for (i, row) in reader.records().enumerate() {
         let line = i + 2;

@@ -5,13 +5,15 @@
 //! Rules ([`Selection::planes`]): an axis of length 1 defaults to 0; an axis longer than 1 must
 //! be selected unless it is the load axis, otherwise the error names the axis, its length and
 //! the flag ("FILE: 3 channels; choose one with --channel 0..2"). Extra axes (Airyscan phases
-//! `H`, colour samples `S`, spectral sweeps, …) cannot be selected from the command line: a
-//! series with such an axis longer than 1 is refused naming it (`info` lists them).
+//! `H`, colour samples `S`, spectral sweeps, …) are chosen by name (`--axis H=0`,
+//! [`Selection::extra`]); one longer than 1 and not chosen is refused the same way, naming it
+//! (`info` lists them).
 //!
 //! TIFF files keep their own model (every page of the chosen channel is one image, see
 //! [`crate::io::series`]): on a TIFF only `--channel` applies, and a non-zero `--series`, `--z`
 //! or `--t` is refused.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -21,7 +23,7 @@ use crate::error::{Error, Location, Result};
 use crate::image::{pixel_size_or, Image, PixelSize, PixelSizeSource};
 
 /// The selection flags: each `None` when not given.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
 pub struct Selection {
     /// `--series`: CZI scene, LIF image (ND2 and TIFF have one series).
     pub series: Option<usize>,
@@ -31,6 +33,8 @@ pub struct Selection {
     pub z: Option<usize>,
     /// `--t`: time point.
     pub t: Option<usize>,
+    /// `--axis NAME=INDEX`: indices along extra axes (`H`, `S`, `lambda_emission`, …).
+    pub extra: BTreeMap<String, usize>,
 }
 
 /// The axis along which one file holds the loads of a series, in order.
@@ -132,7 +136,7 @@ impl Selection {
         let mut out = Vec::new();
         for (k, &s) in series.iter().enumerate() {
             let info = &file.series[s];
-            check_extra(path, info)?;
+            let extra = self.extra_index(path, info)?;
             let a = &info.axes;
             let what = |axis: &'static str| match n_series {
                 1 => axis.to_string(),
@@ -165,9 +169,11 @@ impl Selection {
                         Some(LoadAxis::Series) => k,
                         None => 0,
                     };
+                    let mut index = PlaneIndex::tzc(t, z, c);
+                    index.extra = extra.clone();
                     out.push(SelectedPlane {
                         series: s,
-                        index: PlaneIndex::tzc(t, z, c),
+                        index,
                         load_index,
                     });
                 }
@@ -216,24 +222,52 @@ fn along_or_pick(
     Ok(vec![pick(path, what, flag, requested, n)?])
 }
 
-/// Refuse a series with an extra axis longer than 1 (not selectable from the command line).
-fn check_extra(path: &Path, info: &SeriesInfo) -> Result<()> {
-    if let Some((axis, n)) = info.axes.extra.iter().find(|(_, n)| **n > 1) {
-        let meaning = match axis.as_str() {
-            "H" => " (Airyscan detector phases)",
-            "S" => " (colour samples of an RGB pixel)",
-            "P" => " (stage positions)",
-            _ => "",
-        };
-        return Err(Error::Unsupported {
-            at: Location::file(path),
-            reason: format!(
-                "series {} has {n} planes along axis {axis}{meaning}, which the command line cannot select; export the plane you need as TIFF",
+impl Selection {
+    /// The indices along the series' extra axes: each axis longer than 1 must be chosen; a
+    /// chosen axis the series does not have is an error (length-1 axes accept index 0).
+    fn extra_index(&self, path: &Path, info: &SeriesInfo) -> Result<BTreeMap<String, usize>> {
+        let bad = |reason: String| Error::bad_input(Location::file(path), reason);
+        let mut out = BTreeMap::new();
+        for (axis, &n) in &info.axes.extra {
+            let meaning = match axis.as_str() {
+                "H" => " (Airyscan detector phases)",
+                "S" => " (colour samples of an RGB pixel: 0 blue, 1 green, 2 red)",
+                "P" => " (stage positions)",
+                _ => "",
+            };
+            match self.extra.get(axis) {
+                Some(&i) if i < n => {
+                    out.insert(axis.clone(), i);
+                }
+                Some(&i) => {
+                    return Err(bad(format!(
+                        "--axis {axis}={i} requested; series {} has {n} planes along {axis} (0..{})",
+                        info.index,
+                        n - 1
+                    )))
+                }
+                None if n > 1 => {
+                    return Err(bad(format!(
+                        "series {} has {n} planes along axis {axis}{meaning}; choose one with --axis {axis}=0..{}",
+                        info.index,
+                        n - 1
+                    )))
+                }
+                None => {}
+            }
+        }
+        if let Some((axis, &i)) = self
+            .extra
+            .iter()
+            .find(|(a, &i)| !info.axes.extra.contains_key(*a) && i > 0)
+        {
+            return Err(bad(format!(
+                "--axis {axis}={i} requested; series {} has no axis {axis} longer than 1",
                 info.index
-            ),
-        });
+            )));
+        }
+        Ok(out)
     }
-    Ok(())
 }
 
 /// The lateral pixel size of a series from its metadata (both x and y needed), with the

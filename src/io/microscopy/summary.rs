@@ -160,6 +160,7 @@ pub fn info_summary_selected(
             selection.channel.is_none_or(|c| c == i.c)
                 && selection.z.is_none_or(|z| z == i.z)
                 && selection.t.is_none_or(|t| t == i.t)
+                && selection.extra.iter().all(|(a, &k)| i.get(a) == k)
         };
         let um = |m: Option<f64>| m.map(|v| v * 1e6);
         let planes = if stats {
