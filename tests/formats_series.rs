@@ -366,6 +366,7 @@ fn disc_tile(t: i32, s: i32, values: Vec<u16>, size: usize) -> Tile {
     Tile {
         s,
         t,
+        z: 0,
         c: 0,
         m: 0,
         x: 0,
@@ -635,4 +636,130 @@ fn extra_axes_are_chosen_by_name() {
     assert!(e.contains("--axis S=3") && e.contains("(0..2)"), "{e}");
     let e = stderr(&run(&["threshold", s(&file), "--axis", "Z=1"]));
     assert!(e.contains("use --t, --z or --channel"), "{e}");
+}
+
+#[test]
+fn psf_of_a_czi_z_stack_equals_psf_of_its_tiff_export() {
+    use contactscope::synth::beads::{synth_beads, BeadParams};
+    let beads = synth_beads(&BeadParams {
+        planes: 7,
+        sigma_px: 2.0,
+        seed: 3,
+        ..BeadParams::default()
+    })
+    .unwrap();
+    let (w, h) = (beads.width, beads.height);
+    let tmp = tempfile::tempdir().unwrap();
+    let tiles: Vec<Tile> = beads
+        .planes
+        .iter()
+        .enumerate()
+        .map(|(z, plane)| Tile {
+            s: 0,
+            t: 0,
+            z: z as i32,
+            c: 0,
+            m: 0,
+            x: 0,
+            y: 0,
+            w: w as i32,
+            h: h as i32,
+            values: plane.clone(),
+        })
+        .collect();
+    let stack = tmp.path().join("beads.czi");
+    std::fs::write(&stack, czi(&tiles)).unwrap();
+    let tiff = tmp.path().join("beads.tif");
+    let pages: Vec<&[u16]> = beads.planes.iter().map(Vec::as_slice).collect();
+    std::fs::write(&tiff, encode_u16_stack(&pages, w, h, None, "").unwrap()).unwrap();
+    let psf = |input: &Path, out: &str| -> Value {
+        let out = tmp.path().join(out);
+        run_ok(&["psf", s(input), "--pixel-size", "100nm", "--out", s(&out)]);
+        serde_json::from_str(&std::fs::read_to_string(out.join("psf.json")).unwrap()).unwrap()
+    };
+    let (a, b) = (psf(&stack, "czi"), psf(&tiff, "tif"));
+    assert!(a["fwhm_nm_mean"].as_f64().unwrap() > 0.0, "{a}");
+    assert_eq!(a["fwhm_nm_mean"], b["fwhm_nm_mean"]);
+    assert_eq!(a["planes"], 7);
+    assert_eq!(
+        std::fs::read(tmp.path().join("czi/beads.csv")).unwrap(),
+        std::fs::read(tmp.path().join("tif/beads.csv")).unwrap()
+    );
+}
+
+#[test]
+fn newton_on_two_channels_of_one_czi_equals_newton_on_two_tiffs() {
+    use contactscope::synth::rings::{synth_newton, NewtonSynthParams};
+    let n = 128;
+    let synth = synth_newton(&NewtonSynthParams {
+        width: n,
+        height: n,
+        centre_px: (63.4, 64.7),
+        contact_radius_m: 6e-6,
+        seed: 5,
+        ..NewtonSynthParams::default()
+    })
+    .unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let tile = |c: i32, values: &[u16]| Tile {
+        s: 0,
+        t: 0,
+        z: 0,
+        c,
+        m: 0,
+        x: 0,
+        y: 0,
+        w: n as i32,
+        h: n as i32,
+        values: values.to_vec(),
+    };
+    let both = tmp.path().join("rings.czi");
+    let tiles = [tile(0, &synth.reflection), tile(1, &synth.fluorescence)];
+    std::fs::write(&both, czi(&tiles)).unwrap();
+    let write = |name: &str, codes: &[u16]| {
+        let p = tmp.path().join(name);
+        std::fs::write(&p, encode_u16_stack(&[codes], n, n, None, "").unwrap()).unwrap();
+        p
+    };
+    let (r, f) = (
+        write("r.tif", &synth.reflection),
+        write("f.tif", &synth.fluorescence),
+    );
+    let newton = |args: &[&str], out: &str| -> Value {
+        let out = tmp.path().join(out);
+        let mut all = vec!["newton", "--pixel-size", "200nm", "--out", s(&out)];
+        all.extend_from_slice(args);
+        run_ok(&all);
+        serde_json::from_str(&std::fs::read_to_string(out.join("newton.json")).unwrap()).unwrap()
+    };
+    let a = newton(
+        &[
+            s(&both),
+            "--contact",
+            s(&both),
+            "--channel",
+            "0",
+            "--contact-channel",
+            "1",
+        ],
+        "czi",
+    );
+    let b = newton(&[s(&r), "--contact", s(&f)], "tif");
+    let gap = a["detection_gap_nm_mean"].as_f64().unwrap();
+    assert!(gap > 0.0, "{a}");
+    assert_eq!(a["detection_gap_nm_mean"], b["detection_gap_nm_mean"]);
+    // Without --channel the two-channel file is refused naming the axis.
+    let o = run(&[
+        "newton",
+        s(&both),
+        "--contact",
+        s(&both),
+        "--out",
+        s(tmp.path()),
+    ]);
+    assert!(
+        stderr(&o).contains("2 channels; choose one with --channel 0..1"),
+        "{}",
+        stderr(&o)
+    );
 }

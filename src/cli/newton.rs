@@ -33,6 +33,10 @@ pub struct Args {
     pixel_size: PixelSizeArg,
     #[command(flatten)]
     select: SelectionArgs,
+    /// Channel of the contact image when it differs from --channel (e.g. reflection and
+    /// fluorescence as two channels of one CZI, ND2 or LIF file).
+    #[arg(long)]
+    contact_channel: Option<usize>,
     /// Illumination wavelength.
     #[arg(long, default_value = "488nm")]
     wavelength: String,
@@ -55,6 +59,7 @@ pub fn run(args: Args) -> Result<()> {
         fluorescence: args.contact,
         pixel_size_m: args.pixel_size.metres()?,
         selection: args.select.selection(),
+        contact_channel: args.contact_channel,
         options: NewtonOptions {
             wavelength_m: contactscope::io::ranges::Quantity::Wavelength.check(
                 units::parse_positive(&args.wavelength, Dimension::Length)

@@ -21,8 +21,11 @@ pub struct NewtonRequest {
     pub fluorescence: PathBuf,
     /// `--pixel-size` override (x, y), m.
     pub pixel_size_m: Option<(f64, f64)>,
-    /// The plane of each file (the same selection for both).
+    /// The plane of each file (the same selection for both, except the channel below).
     pub selection: Selection,
+    /// Channel of the fluorescence image when it differs from the reflection's (both images
+    /// as two channels of one file).
+    pub contact_channel: Option<usize>,
     /// Analysis choices.
     pub options: NewtonOptions,
     /// Output folder.
@@ -44,7 +47,11 @@ pub struct NewtonOutcome {
 pub fn run_newton(request: &NewtonRequest) -> Result<NewtonOutcome> {
     let (sel, px) = (&request.selection, request.pixel_size_m);
     let reflection = read_one_image(&request.reflection, sel, px)?;
-    let fluorescence = read_one_image(&request.fluorescence, sel, px)?;
+    let contact = Selection {
+        channel: request.contact_channel.or(sel.channel),
+        ..sel.clone()
+    };
+    let fluorescence = read_one_image(&request.fluorescence, &contact, px)?;
     let analysis = analyse(&reflection, &fluorescence, &request.options)?;
     let inputs = [request.reflection.clone(), request.fluorescence.clone()];
     let staging = Staging::new(&request.out_dir, &inputs)?;

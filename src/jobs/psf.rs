@@ -8,7 +8,8 @@ use serde_json::{json, Value};
 use crate::error::{Error, Result};
 use crate::image::Image;
 use crate::image::SampleType;
-use crate::io::microscopy::select::{read_images, LoadAxis, Selection};
+use crate::io::microscopy::select::{is_tiff, read_images, LoadAxis, Selection};
+use crate::io::microscopy::MicroscopyFile;
 use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::io::staging::Staging;
 use crate::io::tiff::TiffReader;
@@ -56,7 +57,7 @@ pub fn run_psf(request: &PsfRequest) -> Result<PsfOutcome> {
     )?;
     let options = PsfOptions {
         bead_diameter_m: request.bead_diameter_m,
-        saturation_level: saturation_level(&request.input, &images)?,
+        saturation_level: saturation_level(&request.input, &request.selection, &images)?,
         ..PsfOptions::default()
     };
     let report = measure_psf(&images, &options)?;
@@ -73,17 +74,32 @@ pub fn run_psf(request: &PsfRequest) -> Result<PsfOutcome> {
 /// The detector's full-scale value: the sample type's maximum code, except that 16-bit data
 /// whose maximum does not exceed 4095 is taken as 12-bit data in a 16-bit container (as the
 /// paper's 4096-grey-level confocal images are), saturating at 4095. Floats: no check.
-fn saturation_level(path: &Path, images: &[Image]) -> Result<Option<f64>> {
-    let info = TiffReader::open(path)?.info().clone();
+/// CZI, ND2 and LIF files: the selected series' sample type, all its bits significant.
+fn saturation_level(path: &Path, selection: &Selection, images: &[Image]) -> Result<Option<f64>> {
+    let (sample_type, bits_per_sample) = if is_tiff(path) {
+        let info = TiffReader::open(path)?.info().clone();
+        (info.sample_type, info.bits_per_sample)
+    } else {
+        let file = MicroscopyFile::open(path)?;
+        let series = file
+            .series
+            .get(selection.series.unwrap_or(0))
+            .ok_or_else(|| Error::InvalidArgument("no such series".into()))?;
+        let bits = match series.dtype {
+            SampleType::U8 => 8,
+            _ => 16,
+        };
+        (series.dtype, bits)
+    };
     let data_max = images
         .iter()
         .flat_map(|im| im.values.iter().copied())
         .fold(f64::NEG_INFINITY, f64::max);
     let full = |bits: u8| f64::from((1u32 << bits.min(16)) - 1);
-    Ok(match info.sample_type {
-        SampleType::U8 => Some(full(info.bits_per_sample.min(8))),
+    Ok(match sample_type {
+        SampleType::U8 => Some(full(bits_per_sample.min(8))),
         SampleType::U16 if data_max <= 4095.0 => Some(4095.0),
-        SampleType::U16 => Some(full(info.bits_per_sample)),
+        SampleType::U16 => Some(full(bits_per_sample)),
         SampleType::I16 => Some(32767.0),
         SampleType::F32 | SampleType::F64 => None,
     })

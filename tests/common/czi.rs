@@ -1,5 +1,5 @@
 //! A small CZI writer for tests (documented in `docs/formats.md`): uncompressed Gray16
-//! subblocks with X, Y, C, S (scene), M (mosaic) and T coordinates, a
+//! subblocks with X, Y, C, S (scene), M (mosaic), T and Z coordinates, a
 //! subblock directory and no metadata segment (so no pixel size). Written from the ZISRAW
 //! layout our reader (`src/io/microscopy/czi.rs`) implements; used by `formats_synthetic.rs`
 //! and `formats_series.rs`. Never a copy of a real sample (the real CZI samples are GPL-3.0).
@@ -13,10 +13,11 @@ pub fn segment(id: &str, used: usize) -> Vec<u8> {
     v
 }
 
-/// One subblock: scene, channel, time point, mosaic index, x, y, 16-bit samples (w × h).
+/// One subblock: scene, channel, time point, focal plane, mosaic index, x, y, 16-bit samples (w × h).
 pub struct Tile {
     pub s: i32,
     pub t: i32,
+    pub z: i32,
     pub c: i32,
     pub m: i32,
     pub x: i32,
@@ -41,6 +42,7 @@ pub fn entry(t: &Tile, position: usize) -> Vec<u8> {
         ("S", t.s, 1),
         ("M", t.m, 1),
         ("T", t.t, 1),
+        ("Z", t.z, 1),
     ];
     e.extend((dims.len() as i32).to_le_bytes());
     for (name, start, size) in dims {
@@ -92,6 +94,7 @@ pub fn tile(s: i32, c: i32, m: i32, (x, y): (i32, i32), value: u16) -> Tile {
     Tile {
         s,
         t: 0,
+        z: 0,
         c,
         m,
         x,

@@ -484,6 +484,7 @@ fn newton(work: &Path, data: &Path, p: &DemoParams) -> Result<Vec<Recovered>> {
         fluorescence,
         pixel_size_m: None,
         selection: crate::io::microscopy::select::Selection::default(),
+        contact_channel: None,
         options: NewtonOptions::default(),
         out_dir: work.join("newton"),
         command_line: vec!["contactscope demo".into()],
