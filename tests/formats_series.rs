@@ -763,3 +763,48 @@ fn newton_on_two_channels_of_one_czi_equals_newton_on_two_tiffs() {
         stderr(&o)
     );
 }
+
+#[test]
+fn lif_load_series_along_z_at_one_emission_wavelength_matches_its_tiff_export() {
+    let Some(dir) = shared_data("real-formats") else {
+        return;
+    };
+    // Series 2: T 2 × Z 11 × 10 emission wavelengths, uint8 64×64.
+    let file = dir.join("lif/LeicaLASX_wavelength-sweep_example.lif");
+    let tmp = tempfile::tempdir().unwrap();
+    let forces = "1,2,3,4,5,6,7,8,9,10,11mN";
+    let vendor = analyze(
+        &tmp.path().join("lif"),
+        &[
+            s(&file),
+            "--series",
+            "2",
+            "--t",
+            "1",
+            "--axis",
+            "lambda_emission=4",
+            "--load-axis",
+            "z",
+            "--forces",
+            forces,
+        ],
+    );
+    let used = &vendor.1["inputs"]["pixel_size_used"];
+    assert!(
+        used["source"].as_str().unwrap().starts_with("LIF"),
+        "{used}"
+    );
+    let px = used["x_um"].as_f64().unwrap() * 1e-6;
+    assert_areas_from_pixel_size(&vendor, px);
+    let planes: Vec<_> = (0..11)
+        .map(|z| {
+            let mut index = PlaneIndex::tzc(1, z, 0);
+            index.extra.insert("lambda_emission".into(), 4);
+            (2, index)
+        })
+        .collect();
+    let tiff = tmp.path().join("export.tif");
+    export_tiff(&file, &planes, Some((px, px)), &tiff);
+    let exported = analyze(&tmp.path().join("tif"), &[s(&tiff), "--forces", forces]);
+    assert_same_analysis(&vendor, &exported);
+}
