@@ -125,6 +125,7 @@ fn czi_load_series_along_t_matches_its_tiff_export() {
     assert_areas_from_pixel_size(&vendor, px);
     assert_eq!(vendor.1["inputs"]["load_axis"], "t");
     assert_eq!(vendor.1["inputs"]["files"][0]["format"], "czi");
+    assert_eq!(vendor.1["inputs"]["files"][0]["compression"], "none");
     // The same three planes (t = 0, 1, 2 at z = 2, c = 1), in order, as one TIFF.
     let tiff = tmp.path().join("export.tif");
     let planes: Vec<_> = (0..3).map(|t| (0, PlaneIndex::tzc(t, 2, 1))).collect();
@@ -331,6 +332,7 @@ fn a_file_without_pixel_size_is_analysed_in_pixels_as_a_tiff_is() {
     let tmp = tempfile::tempdir().unwrap();
     let vendor = analyze(&tmp.path().join("a"), &[s(&file), "--forces", "1mN"]);
     assert_eq!(vendor.1["area_unit"], "px");
+    assert_eq!(vendor.1["inputs"]["files"][0]["compression"], "compressed");
     let warnings = vendor.1["warnings"].to_string();
     assert!(warnings.contains("--pixel-size"), "{warnings}");
     let tiff = tmp.path().join("export.tif");

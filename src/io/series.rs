@@ -84,7 +84,8 @@ pub struct SeriesFile {
     pub height: usize,
     /// Sample type of a plane.
     pub sample_type: SampleType,
-    /// Compression of the first page (TIFF), or "per plane" for CZI, ND2 and LIF.
+    /// Compression of the first page (TIFF); for CZI, ND2 and LIF "compressed" when any
+    /// plane is (CZI zstd, ND2 lossless), else "none".
     pub compression: String,
     /// Channels (of the selected series for CZI, ND2 and LIF).
     pub channels: usize,
@@ -152,7 +153,11 @@ impl SeriesFile {
             width: first.axes.x,
             height: first.axes.y,
             sample_type: first.dtype,
-            compression: "per plane".into(),
+            compression: if file.compressed() {
+                "compressed".into()
+            } else {
+                "none".into()
+            },
             channels: first.axes.c,
             pixel_size,
             notes: Vec::new(),
@@ -642,8 +647,6 @@ pub struct SeriesPlanes<'a> {
 impl<'a> SeriesPlanes<'a> {
     /// The planes of `series`, keeping up to `budget` bytes of decoded compressed planes.
     pub fn new(series: &'a Series, budget: usize) -> Self {
-        // Vendor planes count as compressed: CZI and ND2 planes may be (zstd, zlib), and a
-        // CZI plane may be composed from several tiles.
         let compressed = |path: &Path| {
             series
                 .info_of(path)

@@ -303,6 +303,16 @@ impl MicroscopyFile {
         })
     }
 
+    /// Whether decoding a plane costs more than reading its bytes (CZI zstd subblocks, ND2
+    /// lossless frames); LIF and TIFF planes count as uncompressed here.
+    pub fn compressed(&self) -> bool {
+        match &self.backend {
+            Backend::Czi(r) => r.compressed(),
+            Backend::Nd2(r) => r.compressed(),
+            Backend::Lif(_) | Backend::Tiff(_) => false,
+        }
+    }
+
     /// Decode one plane of series `series`.
     pub fn read_plane(&mut self, series: usize, index: &PlaneIndex) -> Result<Plane> {
         let info = self.series.get(series).ok_or_else(|| {
