@@ -810,3 +810,107 @@ fn lif_load_series_along_z_at_one_emission_wavelength_matches_its_tiff_export() 
     let exported = analyze(&tmp.path().join("tif"), &[s(&tiff), "--forces", forces]);
     assert_same_analysis(&vendor, &exported);
 }
+
+#[test]
+fn compare_reads_a_czi_load_series_as_its_tiff_export() {
+    use contactscope::io::tiff::read_image;
+    use contactscope::optics::blur::Grid;
+    use contactscope::synth::{render_micrograph, MicrographParams};
+    let tmp = tempfile::tempdir().unwrap();
+    // A small rough sphere simulated at two loads, rendered as 48² micrographs at 200 nm.
+    let topo = tmp.path().join("rough.npy");
+    common::rough_surface(&topo, 128, "50nm", 4, &["--rolloff", "2um"]);
+    let sim = tmp.path().join("sim");
+    run_ok(&[
+        "simulate",
+        "--topography",
+        s(&topo),
+        "--pixel-size",
+        "50nm",
+        "--radius",
+        "290um",
+        "--modulus",
+        "3.7GPa",
+        "--loads",
+        "0.5mN,1mN",
+        "--model",
+        "elastic",
+        "--quiet",
+        "--out",
+        s(&sim),
+    ]);
+    let n = 48;
+    let pages: Vec<Vec<u16>> = (0..2)
+        .map(|i| {
+            let map = read_image(
+                &sim.join(format!("load_{:03}_contact.tif", i + 1)),
+                None,
+                None,
+            )
+            .unwrap();
+            let px = map.pixel_size.unwrap();
+            let grid = Grid::new(map.values, map.width, map.height, px.x_m, px.y_m).unwrap();
+            let params = MicrographParams {
+                fwhm_m: 450e-9,
+                pixel_m: 200e-9,
+                width: n,
+                height: n,
+                corner_px: (10, 9),
+                background: 300.0,
+                contact_level: 2500.0,
+                counts_per_photon: 4.0,
+                seed: i as u64,
+            };
+            render_micrograph(&grid, &params).unwrap()
+        })
+        .collect();
+    let tiff = tmp.path().join("series.tif");
+    let refs: Vec<&[u16]> = pages.iter().map(Vec::as_slice).collect();
+    std::fs::write(&tiff, encode_u16_stack(&refs, n, n, None, "").unwrap()).unwrap();
+    let along_t = tmp.path().join("series.czi");
+    let tiles: Vec<Tile> = pages
+        .iter()
+        .enumerate()
+        .map(|(t, p)| Tile {
+            t: t as i32,
+            ..disc_tile(0, 0, p.clone(), n)
+        })
+        .collect();
+    std::fs::write(&along_t, czi(&tiles)).unwrap();
+    let compare = |experiment: &Path, out: &str, extra: &[&str]| {
+        let out = tmp.path().join(out);
+        let mut args = vec![
+            "compare",
+            "--experiment",
+            s(experiment),
+            "--forces",
+            "0.5,1mN",
+            "--simulation",
+            s(&sim),
+            "--psf-fwhm",
+            "450nm",
+            "--pixel-size",
+            "200nm",
+            "--out",
+            s(&out),
+        ];
+        args.extend_from_slice(extra);
+        run_ok(&args);
+        read_csv(&out.join("compare.csv"))
+    };
+    let (ha, ra) = compare(&along_t, "czi", &["--load-axis", "t"]);
+    let (hb, rb) = compare(&tiff, "tif", &[]);
+    assert_eq!(ha, hb);
+    assert_eq!(ra.len(), 2);
+    for name in [
+        "force_mN",
+        "dice",
+        "jaccard",
+        "shift_x_px",
+        "shift_y_px",
+        "area_ratio",
+    ] {
+        assert_eq!(column(&ha, &ra, name), column(&hb, &rb, name), "{name}");
+    }
+    assert!(column(&ha, &ra, "dice").iter().all(|d| *d > 0.5), "{ra:?}");
+}
