@@ -118,3 +118,33 @@ fn main() -> ExitCode {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// Flattened argument groups (selection flags, height-map options) must not clash with a
+    /// command's own flags. clap checks this only with debug assertions, which the release
+    /// profile the tests run in turns off, so the long names are compared here.
+    #[test]
+    fn no_command_has_two_flags_of_one_name() {
+        for command in super::Cli::command().get_subcommands() {
+            let mut names: Vec<&str> = command
+                .get_arguments()
+                .filter_map(|a| a.get_long())
+                .collect();
+            let n = names.len();
+            names.sort_unstable();
+            names.dedup();
+            assert_eq!(names.len(), n, "{}: {names:?}", command.get_name());
+        }
+        let analyze = super::Cli::command();
+        let analyze = analyze.find_subcommand("analyze").unwrap();
+        for flag in ["series", "channel", "z", "t", "axis", "load-axis"] {
+            assert!(
+                analyze.get_arguments().any(|a| a.get_long() == Some(flag)),
+                "analyze --{flag}"
+            );
+        }
+    }
+}

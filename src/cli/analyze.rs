@@ -13,14 +13,15 @@ use contactscope::jobs::analyze::{
 };
 use contactscope::threshold::Method;
 
-use super::args::{default_out, OutputFolder, PixelSizeArg, Quiet};
+use super::args::{default_out, LoadAxisArg, OutputFolder, PixelSizeArg, Quiet, SelectionArgs};
 use super::{command_line, progress_bar};
 
 default_out!(Out, "contactscope-out");
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// TIFF files or directories of TIFFs (natural sort order). Not with --manifest.
+    /// TIFF, CZI, ND2 or LIF files, or directories of them (natural sort order). Not with
+    /// --manifest.
     inputs: Vec<PathBuf>,
     /// CSV with columns file, [page], force_mN, [friction_mN]; paths relative to the CSV.
     #[arg(long, conflicts_with_all = ["inputs", "forces"])]
@@ -28,9 +29,11 @@ pub struct Args {
     /// Normal forces, one per image, with a unit: 4,10,20,40mN.
     #[arg(long)]
     forces: Option<String>,
-    /// Channel of multi-channel files (samples per pixel or ImageJ hyperstack channels).
-    #[arg(long)]
-    channel: Option<usize>,
+    #[command(flatten)]
+    select: SelectionArgs,
+    /// Axis of a CZI, ND2 or LIF file whose planes are the loads, in order.
+    #[arg(long, value_enum)]
+    load_axis: Option<LoadAxisArg>,
     /// otsu (one threshold for the series), per-image, or a number (contact is value > t).
     #[arg(long, default_value = "otsu")]
     threshold: String,
@@ -58,13 +61,15 @@ pub struct Args {
 }
 
 fn build_series(args: &Args) -> Result<Series> {
+    let selection = args.select.selection();
+    let load_axis = args.load_axis.map(LoadAxisArg::axis);
     let mut series = match &args.manifest {
-        Some(manifest) => series::from_manifest(manifest, args.channel)?,
+        Some(manifest) => series::from_manifest_selected(manifest, &selection, load_axis)?,
         None => {
             if args.inputs.is_empty() {
-                bail!("give TIFF files or directories, or --manifest");
+                bail!("give image files or directories, or --manifest");
             }
-            series::from_files(&args.inputs, args.channel)?
+            series::from_files_selected(&args.inputs, &selection, load_axis)?
         }
     };
     if let Some(text) = &args.forces {

@@ -8,8 +8,9 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 
+use contactscope::io::microscopy::select::{LoadAxis, Selection};
 use contactscope::io::ranges::Quantity;
-use contactscope::io::topography::TopographySource;
+use contactscope::io::topography::{FillInvalid, TopographySource};
 use contactscope::io::units::{self, Dimension};
 use contactscope::solver::cg::SolverOptions;
 use contactscope::surface::Detrend;
@@ -132,18 +133,52 @@ impl HeightMapOptions {
             pixel_size_m: optional_pixel_size(&self.pixel_size, "--pixel-size")?,
             height_unit_m: optional_quantity(&self.height_unit, "--height-unit", Quantity::Height)?,
             detrend: self.detrend.detrend(),
+            channel: None,
+            fill_invalid: None,
         })
     }
+}
+
+/// `--fill-invalid`: how to fill a vendor height map's invalid points.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum FillInvalidArg {
+    /// The mean of the valid heights.
+    Mean,
+    /// The height of the nearest valid point (city-block distance).
+    Nearest,
 }
 
 /// `--topography FILE` with its reading options.
 #[derive(clap::Args, Clone, Debug)]
 pub struct TopographyInput {
-    /// Height map: .npy, float TIFF, .gsf, text matrix (.txt/.csv/.dat), WSxM .top, Nanoscope .di.
+    /// Height map: .npy, float TIFF, .gsf, text matrix (.txt/.csv/.dat), WSxM .top, Nanoscope
+    /// .di, or a vendor AFM/profilometer file recognised by content (docs/formats.md).
     #[arg(long = "topography")]
     pub path: PathBuf,
     #[command(flatten)]
     pub options: HeightMapOptions,
+    /// Channel of a multi-channel vendor height map, by name (e.g. Height); default: the
+    /// file's height channel.
+    #[arg(long)]
+    pub channel: Option<String>,
+    /// Fill a vendor map's invalid (unmeasured, masked) points instead of refusing the map:
+    /// mean (of the valid heights) or nearest (valid point, city-block distance).
+    #[arg(long, value_enum)]
+    pub fill_invalid: Option<FillInvalidArg>,
+}
+
+impl TopographyInput {
+    /// The height map to read, with channel and filling.
+    pub fn source(&self) -> Result<TopographySource> {
+        Ok(TopographySource {
+            channel: self.channel.clone(),
+            fill_invalid: self.fill_invalid.map(|f| match f {
+                FillInvalidArg::Mean => FillInvalid::Mean,
+                FillInvalidArg::Nearest => FillInvalid::Nearest,
+            }),
+            ..self.options.source(self.path.clone())?
+        })
+    }
 }
 
 /// The rough sphere and its material, as `simulate` and `fit-hardening` take them.
@@ -171,7 +206,7 @@ impl BodyArgs {
     /// Parsed into library units.
     pub fn body(&self) -> Result<Body> {
         Ok(Body {
-            topography: self.input.options.source(self.input.path.clone())?,
+            topography: self.input.source()?,
             radius_m: optional_quantity(&self.radius, "--radius", Quantity::Radius)?,
             e_star_pa: Quantity::Modulus.check(
                 units::parse_positive(&self.modulus, Dimension::Pressure).context("--modulus")?,
@@ -218,5 +253,80 @@ pub fn fraction(text: &str, flag: &str) -> Result<f64> {
     match value {
         Ok(v) if (0.0..1.0).contains(&v) => Ok(v),
         _ => bail!("{flag}: {text:?} is not a fraction in [0, 1) such as 1% or 0.01"),
+    }
+}
+
+/// `--series`, `--channel`, `--z`, `--t`: which plane(s) of a confocal file, shared by every
+/// command that reads micrographs (rules in `io::microscopy::select`).
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct SelectionArgs {
+    /// Series of a CZI (scene) or LIF (image) file; needed when the file has several.
+    #[arg(long)]
+    pub series: Option<usize>,
+    /// Channel; needed when the file has several (TIFF: samples or ImageJ channels).
+    #[arg(long)]
+    pub channel: Option<usize>,
+    /// Focal plane of a CZI, ND2 or LIF file; needed when it has several.
+    #[arg(long)]
+    pub z: Option<usize>,
+    /// Time point of a CZI, ND2 or LIF file; needed when it has several.
+    #[arg(long)]
+    pub t: Option<usize>,
+    /// Index along another axis of a CZI, ND2 or LIF file, by the name `info` shows: H=0
+    /// (Airyscan phase), S=1 (green of an RGB pixel), lambda_emission=3, … Repeatable.
+    #[arg(long = "axis", value_name = "NAME=INDEX", value_parser = parse_axis)]
+    pub axis: Vec<(String, usize)>,
+}
+
+/// `NAME=INDEX` of `--axis`.
+fn parse_axis(text: &str) -> std::result::Result<(String, usize), String> {
+    let (name, index) = text
+        .split_once('=')
+        .ok_or_else(|| format!("{text:?} is not NAME=INDEX (e.g. H=0)"))?;
+    let index = index
+        .trim()
+        .parse::<usize>()
+        .map_err(|_| format!("{text:?}: the index must be a non-negative integer"))?;
+    match name.trim() {
+        "" => Err(format!("{text:?}: the axis name is empty")),
+        n if ["T", "Z", "C", "X", "Y"].contains(&n) => Err(format!(
+            "{text:?}: use --t, --z or --channel for T, Z and C (X and Y are the plane)"
+        )),
+        n => Ok((n.to_string(), index)),
+    }
+}
+
+impl SelectionArgs {
+    /// The library's selection.
+    pub fn selection(&self) -> Selection {
+        Selection {
+            series: self.series,
+            channel: self.channel,
+            z: self.z,
+            t: self.t,
+            extra: self.axis.iter().cloned().collect(),
+        }
+    }
+}
+
+/// `--load-axis`: the axis of one CZI, ND2 or LIF file whose planes are the loads.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum LoadAxisArg {
+    /// Time points.
+    T,
+    /// Focal planes.
+    Z,
+    /// Series (CZI scenes, LIF images).
+    Series,
+}
+
+impl LoadAxisArg {
+    /// The library's load axis.
+    pub fn axis(self) -> LoadAxis {
+        match self {
+            LoadAxisArg::T => LoadAxis::T,
+            LoadAxisArg::Z => LoadAxis::Z,
+            LoadAxisArg::Series => LoadAxis::Series,
+        }
     }
 }

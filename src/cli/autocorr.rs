@@ -6,14 +6,15 @@ use anyhow::Result;
 
 use contactscope::jobs::autocorr::{run_autocorr, AutocorrRequest};
 
-use super::args::{default_out, optional_length, OutputFolder, PixelSizeArg};
+use super::args::{default_out, optional_length, OutputFolder, PixelSizeArg, SelectionArgs};
 use super::{command_line, print_warnings, print_written};
 
 default_out!(Out, "contactscope-out/autocorr");
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// TIFF images (every page of a multi-page file counts as one image).
+    /// TIFF images (every page of a multi-page file counts as one image), or CZI, ND2, LIF
+    /// files (the one plane the selection flags name).
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
     #[command(flatten)]
@@ -21,9 +22,8 @@ pub struct Args {
     /// Largest lag (e.g. 20um); default half the smaller image side.
     #[arg(long)]
     max_lag: Option<String>,
-    /// Channel of multi-channel files.
-    #[arg(long)]
-    channel: Option<usize>,
+    #[command(flatten)]
+    select: SelectionArgs,
     #[command(flatten)]
     out: OutputFolder<Out>,
 }
@@ -31,7 +31,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let request = AutocorrRequest {
         inputs: args.inputs.clone(),
-        channel: args.channel,
+        selection: args.select.selection(),
         pixel_size_m: args.pixel_size.metres()?,
         max_lag_m: optional_length(&args.max_lag, "--max-lag")?,
         out_dir: args.out.out.clone(),

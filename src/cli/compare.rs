@@ -9,7 +9,7 @@ use contactscope::io::results::fwhm_from_psf_json;
 use contactscope::io::units::{self, Dimension};
 use contactscope::jobs::compare::{run_compare, CompareRequest, ExperimentInput};
 
-use super::args::{default_out, fraction, OutputFolder, PixelSizeArg};
+use super::args::{default_out, fraction, LoadAxisArg, OutputFolder, PixelSizeArg, SelectionArgs};
 use super::{command_line, print_warnings, print_written};
 
 default_out!(Out, "contactscope-out/compare");
@@ -18,10 +18,10 @@ default_out!(Out, "contactscope-out/compare");
 #[command(group(clap::ArgGroup::new("psf_source").required(true).args(["psf", "psf_fwhm"])))]
 pub struct Args {
     /// The micrographs: a manifest CSV (file, page, force_mN), a folder holding manifest.csv,
-    /// or TIFF files/folders together with --forces.
+    /// or TIFF/CZI/ND2/LIF files or folders together with --forces.
     #[arg(long, required = true, num_args = 1..)]
     experiment: Vec<PathBuf>,
-    /// Normal force per micrograph when --experiment names TIFFs (e.g. 4mN,8mN or 4mN..40mN:8).
+    /// Normal force per micrograph when --experiment names image files (e.g. 4mN,8mN or 4mN..40mN:8).
     #[arg(long)]
     forces: Option<String>,
     /// Output folder of `contactscope simulate`.
@@ -35,9 +35,11 @@ pub struct Args {
     psf_fwhm: Option<String>,
     #[command(flatten)]
     pixel_size: PixelSizeArg,
-    /// Channel of multi-channel micrographs.
-    #[arg(long)]
-    channel: Option<usize>,
+    #[command(flatten)]
+    select: SelectionArgs,
+    /// Axis of a CZI, ND2 or LIF micrograph file whose planes are the loads, in order.
+    #[arg(long, value_enum)]
+    load_axis: Option<LoadAxisArg>,
     /// Also try mirror images and 90° rotations when registering.
     #[arg(long)]
     dihedral: bool,
@@ -81,7 +83,8 @@ pub fn run(args: Args) -> Result<()> {
     }
     let request = CompareRequest {
         experiment,
-        channel: args.channel,
+        selection: args.select.selection(),
+        load_axis: args.load_axis.map(LoadAxisArg::axis),
         pixel_size_m: args.pixel_size.metres()?,
         simulation: args.simulation.clone(),
         settings: CompareSettings {

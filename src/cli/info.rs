@@ -6,9 +6,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use contactscope::io::microscopy::summary::{info_summary, InfoSummary};
+use contactscope::io::microscopy::summary::{info_summary_selected, InfoSummary};
 use contactscope::io::units;
 use contactscope::jobs::info::{run_info, InfoRequest};
+
+use super::args::SelectionArgs;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -21,11 +23,16 @@ pub struct Args {
     /// Decode every plane and add its min, max, mean and sum ("planes").
     #[arg(long)]
     stats: bool,
+    /// Restrict the listing: --series keeps one series, --channel/--z/--t the planes of --stats.
+    #[command(flatten)]
+    select: SelectionArgs,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if args.json || args.stats || !is_tiff(&args.file) {
-        let summary = info_summary(&args.file, args.stats)?;
+    let selection = args.select.selection();
+    let selected = selection != Default::default();
+    if args.json || args.stats || selected || !is_tiff(&args.file) {
+        let summary = info_summary_selected(&args.file, args.stats, &selection)?;
         if args.json {
             println!("{}", serde_json::to_string_pretty(&summary)?);
         } else {
@@ -93,8 +100,13 @@ fn print_summary(summary: &InfoSummary) {
         } else {
             format!(" '{}'", s.name)
         };
+        let extra: String = a
+            .extra
+            .iter()
+            .map(|(axis, n)| format!(" × {axis} {n}"))
+            .collect();
         println!(
-            "series {}{name}: T {} × Z {} × C {} × Y {} × X {}, {}",
+            "series {}{name}: T {} × Z {} × C {}{extra} × Y {} × X {}, {}",
             s.index, a.t, a.z, a.c, a.y, a.x, s.dtype
         );
         let p = &s.pixel_size_um;

@@ -9,7 +9,7 @@ use contactscope::io::units::{self, Dimension};
 use contactscope::jobs::newton::{run_newton, NewtonRequest};
 use contactscope::optics::newton::{NewtonOptions, Phase};
 
-use super::args::{default_out, OutputFolder, PixelSizeArg};
+use super::args::{default_out, OutputFolder, PixelSizeArg, SelectionArgs};
 use super::command_line;
 
 default_out!(Out, "contactscope-out/newton");
@@ -24,13 +24,19 @@ enum PhaseArg {
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Reflection image with Newton rings (single-page TIFF).
+    /// Reflection image with Newton rings (single-page TIFF, or one plane of a CZI, ND2, LIF).
     reflection: PathBuf,
     /// Fluorescence image of the contact, same field and size.
     #[arg(long = "contact")]
     contact: PathBuf,
     #[command(flatten)]
     pixel_size: PixelSizeArg,
+    #[command(flatten)]
+    select: SelectionArgs,
+    /// Channel of the contact image when it differs from --channel (e.g. reflection and
+    /// fluorescence as two channels of one CZI, ND2 or LIF file).
+    #[arg(long)]
+    contact_channel: Option<usize>,
     /// Illumination wavelength.
     #[arg(long, default_value = "488nm")]
     wavelength: String,
@@ -52,6 +58,8 @@ pub fn run(args: Args) -> Result<()> {
         reflection: args.reflection,
         fluorescence: args.contact,
         pixel_size_m: args.pixel_size.metres()?,
+        selection: args.select.selection(),
+        contact_channel: args.contact_channel,
         options: NewtonOptions {
             wavelength_m: contactscope::io::ranges::Quantity::Wavelength.check(
                 units::parse_positive(&args.wavelength, Dimension::Length)

@@ -7,23 +7,23 @@ use anyhow::Result;
 use contactscope::jobs::psf::{run_psf, PsfRequest};
 use contactscope::optics::psf::FWHM_PER_SIGMA;
 
-use super::args::{default_out, optional_length, OutputFolder, PixelSizeArg};
+use super::args::{default_out, optional_length, OutputFolder, PixelSizeArg, SelectionArgs};
 use super::command_line;
 
 default_out!(Out, "contactscope-out/psf");
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Bead image or z stack (TIFF; every page of the chosen channel).
+    /// Bead image or z stack: TIFF (every page of the chosen channel), or CZI, ND2, LIF (every
+    /// z plane of the selected series, channel and time point, or the one plane of --z).
     input: PathBuf,
     #[command(flatten)]
     pixel_size: PixelSizeArg,
     /// Bead diameter, e.g. 100nm: turns on the finite-bead correction σ² − a²/5.
     #[arg(long)]
     bead_diameter: Option<String>,
-    /// Channel of multi-channel files.
-    #[arg(long)]
-    channel: Option<usize>,
+    #[command(flatten)]
+    select: SelectionArgs,
     #[command(flatten)]
     out: OutputFolder<Out>,
 }
@@ -31,7 +31,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let request = PsfRequest {
         input: args.input.clone(),
-        channel: args.channel,
+        selection: args.select.selection(),
         pixel_size_m: args.pixel_size.metres()?,
         bead_diameter_m: optional_length(&args.bead_diameter, "--bead-diameter")?,
         out_dir: args.out.out.clone(),

@@ -6,14 +6,18 @@ use anyhow::Result;
 
 use contactscope::jobs::threshold::{run_threshold, ThresholdRequest};
 
+use super::args::{LoadAxisArg, SelectionArgs};
+
 #[derive(clap::Args)]
 pub struct Args {
-    /// TIFF files or directories.
+    /// TIFF, CZI, ND2 or LIF files, or directories of them.
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
-    /// Channel of multi-channel files.
-    #[arg(long)]
-    channel: Option<usize>,
+    #[command(flatten)]
+    select: SelectionArgs,
+    /// Axis of a CZI, ND2 or LIF file whose planes are the loads, in order.
+    #[arg(long, value_enum)]
+    load_axis: Option<LoadAxisArg>,
     /// Print a JSON object.
     #[arg(long)]
     json: bool,
@@ -22,7 +26,8 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let outcome = run_threshold(&ThresholdRequest {
         inputs: args.inputs,
-        channel: args.channel,
+        selection: args.select.selection(),
+        load_axis: args.load_axis.map(LoadAxisArg::axis),
     })?;
     super::print_warnings(&outcome.warnings);
     if args.json {

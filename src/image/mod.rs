@@ -129,6 +129,12 @@ pub enum PixelSizeSource {
     ImageJ,
     /// TIFF ResolutionUnit (centimetre or inch) with X/YResolution.
     ResolutionTags,
+    /// Zeiss CZI `Metadata/Scaling/Items/Distance[@Id=X|Y]/Value`.
+    CziScaling,
+    /// Nikon ND2 `SLxPictureMetadata/dCalibration`.
+    Nd2Calibration,
+    /// Leica LIF `DimensionDescription` (DimID 1, 2) `Length/(NumberOfElements − 1)`.
+    LifDimensions,
 }
 
 impl PixelSizeSource {
@@ -139,6 +145,11 @@ impl PixelSizeSource {
             PixelSizeSource::OmeXml => "OME-XML PhysicalSizeX/Y",
             PixelSizeSource::ImageJ => "ImageJ unit + X/YResolution",
             PixelSizeSource::ResolutionTags => "TIFF ResolutionUnit + X/YResolution",
+            PixelSizeSource::CziScaling => "CZI Metadata/Scaling/Items/Distance X/Y",
+            PixelSizeSource::Nd2Calibration => "ND2 SLxPictureMetadata/dCalibration",
+            PixelSizeSource::LifDimensions => {
+                "LIF DimensionDescription DimID 1/2 Length/(NumberOfElements-1)"
+            }
         }
     }
 }

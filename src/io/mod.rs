@@ -11,7 +11,7 @@
 //! | [`staging`] | output folders written to a staging folder and renamed into place atomically |
 //! | [`table`] | small CSV tables whose column names carry the unit (`force_mN`), `areas.csv` |
 //! | [`tiff`] | TIFF reading (pages, channels, pixel-size metadata) and writing |
-//! | [`series`] | files, folders and manifests → which page is which load; the file-backed plane source of the series analysis |
+//! | [`series`] | files, folders and manifests (TIFF, CZI, ND2, LIF) → which page or plane is which load; the file-backed plane source of the series analysis |
 //! | [`topography`] | height maps: `.npy`, float TIFF, `.gsf`, text, WSxM, Nanoscope, and vendor AFM/profilometer formats (`.ibw`, `.nid`, `.mi`, Park TIFF, `.gwy`, `.x3p`, `.sdf`, `.opd`, `.plu`, `.sur`, `.frt`) |
 //! | [`microscopy`] | confocal files: Zeiss CZI, Nikon ND2, Leica LIF, and TIFF described the same way |
 //! | [`plot`] | charts (PNG/SVG) and micrograph panels (PNG) |

@@ -9,9 +9,9 @@ use serde_json::{json, Value};
 
 use crate::error::{Error, Location, Result};
 use crate::image::Image;
+use crate::io::microscopy::select::{read_images, Selection};
 use crate::io::plot::{Axes, Chart, Curve, Legend};
 use crate::io::staging::Staging;
-use crate::io::tiff::read_pages;
 
 use crate::spectral::autocorrelation::AcfCurve;
 
@@ -20,8 +20,8 @@ use crate::spectral::autocorrelation::AcfCurve;
 pub struct AutocorrRequest {
     /// Image files; every page of a multi-page file is one image.
     pub inputs: Vec<PathBuf>,
-    /// Channel of multi-channel files.
-    pub channel: Option<usize>,
+    /// Which plane of confocal files (and the channel of TIFFs).
+    pub selection: Selection,
     /// Pixel size override (x, y), m.
     pub pixel_size_m: Option<(f64, f64)>,
     /// Largest lag, m; by default half the smaller side of each image.
@@ -51,7 +51,7 @@ pub fn run_autocorr(request: &AutocorrRequest) -> Result<AutocorrOutcome> {
     }
     let mut images = Vec::new();
     for path in &request.inputs {
-        let pages = read_pages(path, request.channel, request.pixel_size_m)?;
+        let pages = read_images(path, &request.selection, None, request.pixel_size_m)?;
         let multi = pages.len() > 1;
         images.extend(pages.into_iter().map(|im| (label_of(&im, multi), im)));
     }

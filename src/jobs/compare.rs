@@ -12,6 +12,7 @@ use crate::compare::{
 };
 use crate::error::{Error, Location, Result};
 use crate::image::{pixel_size_or, Plane};
+use crate::io::microscopy::select::{LoadAxis, Selection};
 use crate::io::plot::edge_panels_png;
 use crate::io::results::simulated_maps;
 use crate::io::series::{self, Series};
@@ -22,7 +23,7 @@ use crate::io::staging::Staging;
 pub enum ExperimentInput {
     /// A manifest CSV (`file, page, force_mN`), or a folder holding `manifest.csv`.
     Manifest(PathBuf),
-    /// TIFF files or folders with one force per image, N.
+    /// TIFF, CZI, ND2 or LIF files or folders with one force per image, N.
     Files {
         /// Files or folders, in natural order.
         inputs: Vec<PathBuf>,
@@ -36,8 +37,10 @@ pub enum ExperimentInput {
 pub struct CompareRequest {
     /// The experiment series.
     pub experiment: ExperimentInput,
-    /// Channel of multi-channel micrographs.
-    pub channel: Option<usize>,
+    /// Which planes of confocal micrograph files (and the channel of TIFFs).
+    pub selection: Selection,
+    /// Axis of a CZI, ND2 or LIF micrograph file whose planes are the loads.
+    pub load_axis: Option<LoadAxis>,
     /// Micrograph pixel size override (x, y), m.
     pub pixel_size_m: Option<(f64, f64)>,
     /// Output folder of `contactscope simulate` (areas.csv + load_NNN_contact.tif).
@@ -66,8 +69,12 @@ pub struct CompareOutcome {
 /// Run `compare`: match loads, render, register, threshold, score, and write `compare.csv`,
 /// `compare.json` and one `panel_NNN.png` per matched load (all or nothing).
 pub fn run_compare(request: &CompareRequest) -> Result<CompareOutcome> {
-    let (series, micrographs) =
-        load_micrographs(&request.experiment, request.channel, request.pixel_size_m)?;
+    let (series, micrographs) = load_micrographs(
+        &request.experiment,
+        &request.selection,
+        request.load_axis,
+        request.pixel_size_m,
+    )?;
     let simulated = simulated_maps(&request.simulation)?;
     let Comparison {
         loads,
@@ -102,10 +109,11 @@ pub fn run_compare(request: &CompareRequest) -> Result<CompareOutcome> {
 /// them (one exact Otsu threshold over the series, as `analyze`).
 pub fn load_micrographs(
     experiment: &ExperimentInput,
-    channel: Option<usize>,
+    selection: &Selection,
+    load_axis: Option<LoadAxis>,
     pixel_size_m: Option<(f64, f64)>,
 ) -> Result<(Series, Micrographs)> {
-    let series = experiment_series(experiment, channel)?;
+    let series = experiment_series(experiment, selection, load_axis)?;
     let planes: Vec<Plane> = series.planes(0).scan(|_, plane| Ok(plane.clone()))?;
     let (threshold, _, warnings) = global_threshold(planes.as_slice(), &|_, _, _| {})?;
     let pixel_m = experiment_pixel(&series, pixel_size_m)?;
@@ -129,7 +137,11 @@ pub fn load_micrographs(
     Ok((series, micrographs))
 }
 
-fn experiment_series(experiment: &ExperimentInput, channel: Option<usize>) -> Result<Series> {
+fn experiment_series(
+    experiment: &ExperimentInput,
+    selection: &Selection,
+    load_axis: Option<LoadAxis>,
+) -> Result<Series> {
     match experiment {
         ExperimentInput::Manifest(path) => {
             let manifest = if path.is_dir() {
@@ -143,10 +155,10 @@ fn experiment_series(experiment: &ExperimentInput, channel: Option<usize>) -> Re
                     "no manifest: give a manifest CSV (file, page, force_mN) or a folder holding manifest.csv, or TIFF files with --forces",
                 ));
             }
-            series::from_manifest(&manifest, channel)
+            series::from_manifest_selected(&manifest, selection, load_axis)
         }
         ExperimentInput::Files { inputs, forces_n } => {
-            let mut s = series::from_files(inputs, channel)?;
+            let mut s = series::from_files_selected(inputs, selection, load_axis)?;
             series::assign_forces(&mut s, forces_n)?;
             Ok(s)
         }

@@ -180,16 +180,21 @@ impl FitOutcome {
 /// Run `fit-hardening`.
 pub fn run_fit(request: &FitRequest) -> Result<FitOutcome> {
     let measured = read_measured(&request.experiment)?;
-    let body = model_body(request)?;
+    let (body, notes) = model_body(request)?;
     let micrographs = request
         .micrographs
         .as_ref()
         .map(|m| {
-            load_micrographs(&m.experiment, m.channel, m.pixel_size_m)
-                .map(|(_, micrographs)| micrographs)
+            load_micrographs(
+                &m.experiment,
+                &crate::io::microscopy::select::Selection::channel(m.channel),
+                None,
+                m.pixel_size_m,
+            )
+            .map(|(_, micrographs)| micrographs)
         })
         .transpose()?;
-    let mut warnings = Vec::new();
+    let mut warnings = notes;
     let mut fits = Vec::new();
     for &family in &request.families {
         let fit = fit_family(request, &body, family, &measured)?;
@@ -247,9 +252,10 @@ pub fn read_measured(path: &Path) -> Result<Measured> {
         .map_err(|e| Error::bad_input(Location::file(path), e.to_string()))
 }
 
-fn model_body(request: &FitRequest) -> Result<ModelBody> {
+fn model_body(request: &FitRequest) -> Result<(ModelBody, Vec<String>)> {
+    let (topography, notes) = request.topography.read_with_notes()?;
     let mut body = ModelBody::new(
-        request.topography.read()?,
+        topography,
         request.radius_m,
         request.e_star_pa,
         request.options,
@@ -257,7 +263,7 @@ fn model_body(request: &FitRequest) -> Result<ModelBody> {
     body.periodic = request.periodic;
     body.imaging = request.imaging;
     body.progress = request.progress.clone();
-    Ok(body)
+    Ok((body, notes))
 }
 
 fn fit_family(
@@ -590,6 +596,8 @@ fn summary_json(
         "command_line": request.command_line,
         "experiment": request.experiment.display().to_string(),
         "topography": request.topography.path.display().to_string(),
+        "topography_channel": request.topography.channel,
+        "fill_invalid": request.topography.fill_invalid,
         "radius_um": request.radius_m.map(|r| r * 1e6),
         "contact_modulus_GPa": request.e_star_pa * 1e-9,
         "roughness": {

@@ -6,9 +6,9 @@ use std::path::PathBuf;
 use serde_json::{json, Value};
 
 use crate::error::{Error, Result};
+use crate::io::microscopy::select::{read_one_image, Selection};
 use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::io::staging::Staging;
-use crate::io::tiff::read_image;
 use crate::numerics::stats::MeanSd;
 use crate::optics::newton::{analyse, hertz_gap, ring_gap, NewtonAnalysis, NewtonOptions};
 
@@ -21,6 +21,11 @@ pub struct NewtonRequest {
     pub fluorescence: PathBuf,
     /// `--pixel-size` override (x, y), m.
     pub pixel_size_m: Option<(f64, f64)>,
+    /// The plane of each file (the same selection for both, except the channel below).
+    pub selection: Selection,
+    /// Channel of the fluorescence image when it differs from the reflection's (both images
+    /// as two channels of one file).
+    pub contact_channel: Option<usize>,
     /// Analysis choices.
     pub options: NewtonOptions,
     /// Output folder.
@@ -40,8 +45,13 @@ pub struct NewtonOutcome {
 
 /// Read, analyse and write the outputs.
 pub fn run_newton(request: &NewtonRequest) -> Result<NewtonOutcome> {
-    let reflection = read_image(&request.reflection, None, request.pixel_size_m)?;
-    let fluorescence = read_image(&request.fluorescence, None, request.pixel_size_m)?;
+    let (sel, px) = (&request.selection, request.pixel_size_m);
+    let reflection = read_one_image(&request.reflection, sel, px)?;
+    let contact = Selection {
+        channel: request.contact_channel.or(sel.channel),
+        ..sel.clone()
+    };
+    let fluorescence = read_one_image(&request.fluorescence, &contact, px)?;
     let analysis = analyse(&reflection, &fluorescence, &request.options)?;
     let inputs = [request.reflection.clone(), request.fluorescence.clone()];
     let staging = Staging::new(&request.out_dir, &inputs)?;

@@ -8,9 +8,10 @@ use serde_json::{json, Value};
 use crate::error::{Error, Result};
 use crate::image::Image;
 use crate::image::SampleType;
+use crate::io::microscopy::select::{is_tiff, read_images, LoadAxis, Selection};
+use crate::io::microscopy::MicroscopyFile;
 use crate::io::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::io::staging::Staging;
-use crate::io::tiff::read_pages;
 use crate::io::tiff::TiffReader;
 
 use crate::numerics::stats::MeanSd;
@@ -22,10 +23,10 @@ const MAX_PLOTTED_BEADS: usize = 8;
 /// What the command line asks for.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PsfRequest {
-    /// Bead image or stack (TIFF).
+    /// Bead image or stack (TIFF, CZI, ND2, LIF).
     pub input: PathBuf,
-    /// Channel of multi-channel files.
-    pub channel: Option<usize>,
+    /// Which planes: a confocal file's z planes unless `--z` picks one.
+    pub selection: Selection,
     /// `--pixel-size` override (x, y) in metres.
     pub pixel_size_m: Option<(f64, f64)>,
     /// `--bead-diameter` in metres (turns the finite-bead correction on).
@@ -47,10 +48,16 @@ pub struct PsfOutcome {
 
 /// Run `psf`: every page of the chosen channel, saturation level from the sample type.
 pub fn run_psf(request: &PsfRequest) -> Result<PsfOutcome> {
-    let images = read_pages(&request.input, request.channel, request.pixel_size_m)?;
+    let along = request.selection.z.is_none().then_some(LoadAxis::Z);
+    let images = read_images(
+        &request.input,
+        &request.selection,
+        along,
+        request.pixel_size_m,
+    )?;
     let options = PsfOptions {
         bead_diameter_m: request.bead_diameter_m,
-        saturation_level: saturation_level(&request.input, &images)?,
+        saturation_level: saturation_level(&request.input, &request.selection, &images)?,
         ..PsfOptions::default()
     };
     let report = measure_psf(&images, &options)?;
@@ -67,17 +74,32 @@ pub fn run_psf(request: &PsfRequest) -> Result<PsfOutcome> {
 /// The detector's full-scale value: the sample type's maximum code, except that 16-bit data
 /// whose maximum does not exceed 4095 is taken as 12-bit data in a 16-bit container (as the
 /// paper's 4096-grey-level confocal images are), saturating at 4095. Floats: no check.
-fn saturation_level(path: &Path, images: &[Image]) -> Result<Option<f64>> {
-    let info = TiffReader::open(path)?.info().clone();
+/// CZI, ND2 and LIF files: the selected series' sample type, all its bits significant.
+fn saturation_level(path: &Path, selection: &Selection, images: &[Image]) -> Result<Option<f64>> {
+    let (sample_type, bits_per_sample) = if is_tiff(path) {
+        let info = TiffReader::open(path)?.info().clone();
+        (info.sample_type, info.bits_per_sample)
+    } else {
+        let file = MicroscopyFile::open(path)?;
+        let series = file
+            .series
+            .get(selection.series.unwrap_or(0))
+            .ok_or_else(|| Error::InvalidArgument("no such series".into()))?;
+        let bits = match series.dtype {
+            SampleType::U8 => 8,
+            _ => 16,
+        };
+        (series.dtype, bits)
+    };
     let data_max = images
         .iter()
         .flat_map(|im| im.values.iter().copied())
         .fold(f64::NEG_INFINITY, f64::max);
     let full = |bits: u8| f64::from((1u32 << bits.min(16)) - 1);
-    Ok(match info.sample_type {
-        SampleType::U8 => Some(full(info.bits_per_sample.min(8))),
+    Ok(match sample_type {
+        SampleType::U8 => Some(full(bits_per_sample.min(8))),
         SampleType::U16 if data_max <= 4095.0 => Some(4095.0),
-        SampleType::U16 => Some(full(info.bits_per_sample)),
+        SampleType::U16 => Some(full(bits_per_sample)),
         SampleType::I16 => Some(32767.0),
         SampleType::F32 | SampleType::F64 => None,
     })

@@ -112,13 +112,13 @@ pub fn run_simulate(
     progress: SimulateProgress,
     monitor: Option<Monitor>,
 ) -> Result<SimulateOutcome> {
-    let roughness = request.topography.read()?;
+    let (roughness, notes) = request.topography.read_with_notes()?;
     let stats = SurfaceStats::finite_differences(&roughness)?;
     let staging = Staging::new(
         &request.out_dir,
         std::slice::from_ref(&request.topography.path),
     )?;
-    let (loads, warnings) = match request.model {
+    let (loads, mut warnings) = match request.model {
         ModelChoice::GreenwoodTripp => run_gt(request, &roughness, &stats, &staging, progress)?,
         ModelChoice::HalfSpace(model) => {
             let mut body = roughness.clone();
@@ -134,6 +134,7 @@ pub fn run_simulate(
             run_halfspace(request, model, &body, options, &staging, progress)?
         }
     };
+    warnings.splice(0..0, notes);
     staging.write("areas.csv", &areas_csv(&loads)?)?;
     staging.write("area_vs_load.png", &area_plot(request, &loads).to_png()?)?;
     let summary = summary_json(request, &roughness, &stats, &loads, &warnings);
@@ -434,6 +435,8 @@ fn summary_json(
             "pixel_size_x_nm": roughness.dx_m * 1e9,
             "pixel_size_y_nm": roughness.dy_m * 1e9,
             "detrend": request.topography.detrend.name(),
+            "channel": request.topography.channel,
+            "fill_invalid": request.topography.fill_invalid,
             "h_rms_nm": stats.h_rms_m * 1e9,
             "h_prime_rms": stats.h_prime_rms,
             "h_double_prime_rms_per_um": stats.h_double_prime_rms_per_m * 1e-6,

@@ -4,16 +4,19 @@ use std::path::PathBuf;
 
 use crate::analysis::global_threshold;
 use crate::error::Result;
+use crate::io::microscopy::select::{LoadAxis, Selection};
 use crate::io::series;
 use crate::threshold::Threshold;
 
 /// Which files, already validated.
 #[derive(Debug, Clone)]
 pub struct ThresholdRequest {
-    /// TIFF files or directories.
+    /// TIFF, CZI, ND2 or LIF files, or directories of them.
     pub inputs: Vec<PathBuf>,
-    /// Channel of multi-channel files.
-    pub channel: Option<usize>,
+    /// Which planes of confocal files (and the channel of TIFFs).
+    pub selection: Selection,
+    /// Axis of a CZI, ND2 or LIF file whose planes are the series' images.
+    pub load_axis: Option<LoadAxis>,
 }
 
 /// The threshold and what it was computed from.
@@ -33,7 +36,8 @@ pub struct ThresholdOutcome {
 
 /// Read every page (every image counts once) and pick the series threshold; nothing is written.
 pub fn run_threshold(request: &ThresholdRequest) -> Result<ThresholdOutcome> {
-    let series = series::from_files(&request.inputs, request.channel)?;
+    let series =
+        series::from_files_selected(&request.inputs, &request.selection, request.load_axis)?;
     let (threshold, pixels, warnings) = global_threshold(&series.planes(0), &|_, _, _| {})?;
     Ok(ThresholdOutcome {
         threshold,

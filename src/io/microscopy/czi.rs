@@ -150,6 +150,12 @@ pub struct CziReader {
 }
 
 impl CziReader {
+    /// Whether any subblock is compressed (zstd), so that decoding a plane costs more than
+    /// reading it.
+    pub(crate) fn compressed(&self) -> bool {
+        self.entries.iter().any(|e| e.compression != 0)
+    }
+
     /// Read the file header, the subblock directory and the metadata.
     pub(crate) fn open(mut source: FileSource) -> Result<Self> {
         let path = source.path.clone();

@@ -19,6 +19,7 @@ mod clx;
 pub mod czi;
 pub mod lif;
 pub mod nd2;
+pub mod select;
 pub mod summary;
 mod tiff;
 
@@ -300,6 +301,16 @@ impl MicroscopyFile {
             series,
             backend,
         })
+    }
+
+    /// Whether decoding a plane costs more than reading its bytes (CZI zstd subblocks, ND2
+    /// lossless frames); LIF and TIFF planes count as uncompressed here.
+    pub fn compressed(&self) -> bool {
+        match &self.backend {
+            Backend::Czi(r) => r.compressed(),
+            Backend::Nd2(r) => r.compressed(),
+            Backend::Lif(_) | Backend::Tiff(_) => false,
+        }
     }
 
     /// Decode one plane of series `series`.

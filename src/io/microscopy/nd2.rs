@@ -58,6 +58,11 @@ pub struct Nd2Reader {
 }
 
 impl Nd2Reader {
+    /// Whether the frames are zlib streams (lossless compression).
+    pub(crate) fn compressed(&self) -> bool {
+        self.lossless
+    }
+
     /// Read the chunk map and the metadata chunks.
     pub(crate) fn open(mut source: FileSource) -> Result<Self> {
         let path = source.path.clone();

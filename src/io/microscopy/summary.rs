@@ -16,9 +16,11 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use super::select::Selection;
 use super::{Axes, MicroscopyFile, PlaneIndex};
 use crate::error::Result;
 use crate::image::{Plane, Samples};
+use crate::io::binary::bad;
 
 /// `info --json` for one file.
 #[derive(Debug, Clone, Serialize)]
@@ -113,13 +115,57 @@ pub fn plane_statistics(plane: &Plane) -> (f64, f64, f64, f64) {
 /// The summary of a file; with `stats`, every plane of every series is decoded (one at a time)
 /// and summarised.
 pub fn info_summary(path: &Path, stats: bool) -> Result<InfoSummary> {
+    info_summary_selected(path, stats, &Selection::default())
+}
+
+/// The summary restricted by the selection flags: `--series` keeps one series, `--channel`,
+/// `--z` and `--t` keep the planes (of `planes`) with that index. An index beyond an axis of a
+/// listed series is an error naming the axis and its length.
+pub fn info_summary_selected(
+    path: &Path,
+    stats: bool,
+    selection: &Selection,
+) -> Result<InfoSummary> {
     let mut file = MicroscopyFile::open(path)?;
     let mut series = Vec::with_capacity(file.series.len());
+    let n_series = file.series.len();
+    if let Some(s) = selection.series.filter(|s| *s >= n_series) {
+        return Err(bad(
+            path,
+            format!("--series {s} requested; the file has {n_series} series"),
+        ));
+    }
     for info in file.series.clone() {
+        if selection.series.is_some_and(|s| s != info.index) {
+            continue;
+        }
+        let a = &info.axes;
+        for (flag, value, n) in [
+            ("--channel", selection.channel, a.c),
+            ("--z", selection.z, a.z),
+            ("--t", selection.t, a.t),
+        ] {
+            if let Some(v) = value.filter(|v| *v >= n) {
+                return Err(bad(
+                    path,
+                    format!(
+                        "{flag} {v} requested; series {} has {n} (0..{})",
+                        info.index,
+                        n - 1
+                    ),
+                ));
+            }
+        }
+        let wanted = |i: &PlaneIndex| {
+            selection.channel.is_none_or(|c| c == i.c)
+                && selection.z.is_none_or(|z| z == i.z)
+                && selection.t.is_none_or(|t| t == i.t)
+                && selection.extra.iter().all(|(a, &k)| i.get(a) == k)
+        };
         let um = |m: Option<f64>| m.map(|v| v * 1e6);
         let planes = if stats {
             let mut out = Vec::new();
-            for index in PlaneIndex::all(&info.axes) {
+            for index in PlaneIndex::all(&info.axes).into_iter().filter(wanted) {
                 let plane = file.read_plane(info.index, &index)?;
                 let (min, max, mean, sum) = plane_statistics(&plane);
                 out.push(PlaneStats {

@@ -47,6 +47,7 @@
 //! values are heights (a length unit, or a name with "height", "topograph" or "z-axis"). When no
 //! channel matches, the error lists them all.
 
+pub mod fill;
 pub mod frt;
 pub mod gwy;
 pub mod ibw;
@@ -79,6 +80,7 @@ use crate::io::tiff::TiffReader;
 
 use crate::surface::{Detrend, Topography};
 
+pub use fill::FillInvalid;
 pub use gsf::{read_gsf, write_gsf};
 pub use nanoscope::read_nanoscope;
 pub use npy::{read_npy, write_npy};
@@ -88,7 +90,9 @@ pub(crate) use vendor::{
     choose, count, grid_bytes, height_like, height_map, length_factor, length_scale, positive,
     ChannelEntry,
 };
-pub use vendor::{detect, detect_file, read, read_for_surface, HeightMap, TopographyFormat};
+pub use vendor::{
+    detect, detect_file, read, read_for_surface, read_for_surface_with, HeightMap, TopographyFormat,
+};
 pub use wsxm::read_wsxm;
 
 /// Extensions [`read_topography`] knows (Nanoscope files also use three-digit extensions).
@@ -107,14 +111,65 @@ pub struct TopographySource {
     pub height_unit_m: Option<f64>,
     /// Detrending applied after reading.
     pub detrend: Detrend,
+    /// Channel of a multi-channel vendor file, by name (default: its height channel).
+    pub channel: Option<String>,
+    /// Fill a vendor map's invalid points this way (default: refuse such a map).
+    pub fill_invalid: Option<FillInvalid>,
 }
 
 impl TopographySource {
+    /// A file with the default channel, no filling and no detrending.
+    pub fn new(path: PathBuf) -> Self {
+        TopographySource {
+            path,
+            pixel_size_m: None,
+            height_unit_m: None,
+            detrend: Detrend::None,
+            channel: None,
+            fill_invalid: None,
+        }
+    }
+
     /// Read the file ([`read_topography`]) and detrend it.
     pub fn read(&self) -> Result<Topography> {
-        let mut topography = read_topography(&self.path, self.pixel_size_m, self.height_unit_m)?;
+        Ok(self.read_with_notes()?.0)
+    }
+
+    /// [`Self::read`], with notes for the user (how many invalid points were filled).
+    pub fn read_with_notes(&self) -> Result<(Topography, Vec<String>)> {
+        let vendor = read_for_surface_with(
+            &self.path,
+            self.pixel_size_m,
+            self.height_unit_m,
+            self.channel.as_deref(),
+            self.fill_invalid,
+        )?;
+        let mut notes = Vec::new();
+        let mut topography = match vendor {
+            Some((t, filled)) => {
+                if let (Some(how), true) = (self.fill_invalid, filled > 0) {
+                    notes.push(format!(
+                        "{}: {filled} invalid point(s) filled with the {} valid height",
+                        self.path.display(),
+                        how.name()
+                    ));
+                }
+                t
+            }
+            None => {
+                if let Some(channel) = &self.channel {
+                    return Err(Error::bad_input(
+                        Location::file(&self.path),
+                        format!(
+                            "channel '{channel}' asked for, but this format holds one height map"
+                        ),
+                    ));
+                }
+                read_topography(&self.path, self.pixel_size_m, self.height_unit_m)?
+            }
+        };
         topography.detrend(self.detrend);
-        Ok(topography)
+        Ok((topography, notes))
     }
 }
 

@@ -2,6 +2,7 @@
 //! [`HeightMap`] they read into, format detection, channel choice and the checks their readers
 //! share. The table of formats is in the [parent module](super).
 
+use super::fill::FillInvalid;
 use std::path::Path;
 
 use super::{frt, gwy, ibw, mi, nid, opd, park, plu, sdf, sur, x3p};
@@ -215,10 +216,39 @@ pub fn read_for_surface(
     pixel_size_m: Option<(f64, f64)>,
     height_unit_m: Option<f64>,
 ) -> Result<Option<Topography>> {
+    Ok(read_for_surface_with(path, pixel_size_m, height_unit_m, None, None)?.map(|(t, _)| t))
+}
+
+/// [`read_for_surface`] with a channel (by name, as [`read`] chooses it) and, on request, the
+/// invalid points filled ([`FillInvalid`]); also returns how many points were filled. Without
+/// `fill`, a map with invalid points is refused naming their count and `--fill-invalid`.
+pub fn read_for_surface_with(
+    path: &Path,
+    pixel_size_m: Option<(f64, f64)>,
+    height_unit_m: Option<f64>,
+    channel: Option<&str>,
+    fill: Option<FillInvalid>,
+) -> Result<Option<(Topography, usize)>> {
     if !matches!(detect_file(path), Ok(Some(_))) {
         return Ok(None);
     }
-    let map = read(path, None)?;
+    let mut map = read(path, channel)?;
+    let filled = match fill {
+        Some(how) => map.fill_invalid(how),
+        None if map.invalid_points > 0 && map.valid_points() > 0 => {
+            return Err(bad(
+                path,
+                format!(
+                    "{} of {} points of channel '{}' are invalid (not measured); a contact \
+                     calculation needs every height: give --fill-invalid mean|nearest to fill them",
+                    map.invalid_points,
+                    map.heights.len(),
+                    map.channel
+                ),
+            ));
+        }
+        None => 0,
+    };
     if height_unit_m.is_some() {
         return Err(bad(
             path,
@@ -228,7 +258,8 @@ pub fn read_for_surface(
             ),
         ));
     }
-    map.into_topography(path, pixel_size_m).map(Some)
+    map.into_topography(path, pixel_size_m)
+        .map(|t| Some((t, filled)))
 }
 
 /// The whole file, refused above [`MAX_FILE_BYTES`].

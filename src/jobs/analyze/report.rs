@@ -343,9 +343,16 @@ pub fn inputs_json(series: &Series, analysis: &Analysis) -> Value {
         "images": series.images.len(),
         "manifest": series.manifest.as_ref().map(|m| m.display().to_string()),
         "channel": series.channel,
+        "selection": series.selection,
+        "load_axis": series.load_axis,
         "files": series.files.iter().map(|f| json!({
             "path": f.path.display().to_string(),
+            "format": f.format.name(),
             "pages_used": series.images.iter().filter(|i| i.path == f.path).count(),
+            "planes_used": (f.tiff.is_none()).then(|| series.images.iter()
+                .filter(|i| i.path == f.path)
+                .filter_map(|i| i.plane.as_ref().map(|p| p.describe()))
+                .collect::<Vec<_>>()),
             "width_px": f.width,
             "height_px": f.height,
             "sample_type": f.sample_type.name(),

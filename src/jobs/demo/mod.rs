@@ -439,7 +439,7 @@ fn psf(work: &Path, data: &Path, p: &DemoParams) -> Result<Recovered> {
     write_atomic(&path, &tiff)?;
     let outcome = run_psf(&PsfRequest {
         input: path,
-        channel: None,
+        selection: crate::io::microscopy::select::Selection::default(),
         pixel_size_m: None,
         bead_diameter_m: None,
         out_dir: work.join("psf"),
@@ -483,6 +483,8 @@ fn newton(work: &Path, data: &Path, p: &DemoParams) -> Result<Vec<Recovered>> {
         reflection,
         fluorescence,
         pixel_size_m: None,
+        selection: crate::io::microscopy::select::Selection::default(),
+        contact_channel: None,
         options: NewtonOptions::default(),
         out_dir: work.join("newton"),
         command_line: vec!["contactscope demo".into()],
@@ -612,6 +614,8 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
             pixel_size_m: Some((p.sim_pixel_m, p.sim_pixel_m)),
             height_unit_m: None,
             detrend: crate::surface::Detrend::None,
+            channel: None,
+            fill_invalid: None,
         },
         radius_m: Some(p.radius_m),
         e_star_pa: p.e_star_pa,
@@ -666,6 +670,7 @@ fn compare_models(
 ) -> Result<Vec<(String, Comparison)>> {
     let (_, micrographs) = load_micrographs(
         &ExperimentInput::Manifest(manifest.to_path_buf()),
+        &crate::io::microscopy::select::Selection::default(),
         None,
         None,
     )?;

@@ -5,6 +5,12 @@
 //! `force_mN` and optional `friction_mN`, paths relative to the manifest's folder.
 //! Pages are zero-based TIFF page (IFD) indices, as tifffile numbers them.
 //!
+//! Zeiss CZI, Nikon ND2 and Leica LIF files ([`crate::io::microscopy`]) are accepted as well,
+//! detected by content: each gives the planes a [`Selection`] names (`--series`, `--channel`,
+//! `--z`, `--t`): one plane per file, or, with a [`LoadAxis`] (`--load-axis t|z|series`), every
+//! plane along that axis in order. For these files the "page" of an image (and a manifest's
+//! `page` column) is its position along the load axis.
+//!
 //! [`SeriesPlanes`] is the file-backed plane source the series analysis
 //! ([`crate::analysis::analyze`]) reads through, and [`pixel_size`] the series' pixel size from
 //! the files' metadata or an override.
@@ -17,6 +23,12 @@ use std::sync::{Arc, Mutex};
 use rayon::prelude::*;
 use serde::Serialize;
 
+mod file;
+
+pub use file::SeriesFile;
+
+use super::microscopy::select::{LoadAxis, SelectedPlane, Selection};
+use super::microscopy::MicroscopyFile;
 use super::tiff::{TiffInfo, TiffReader};
 use crate::analysis::PlaneSource;
 use crate::error::{Error, Location, Result};
@@ -28,8 +40,11 @@ use crate::io::ranges::Quantity;
 pub struct ImageRef {
     /// File holding the image.
     pub path: PathBuf,
-    /// Zero-based page (IFD index) in the file.
+    /// Zero-based page (IFD index) in a TIFF; for CZI, ND2 and LIF files the position along
+    /// the load axis (0 without one).
     pub page: usize,
+    /// The plane of a CZI, ND2 or LIF file (`None` for TIFF pages).
+    pub plane: Option<SelectedPlane>,
     /// Normal force in newtons, when known.
     pub force_n: Option<f64>,
     /// Friction force in newtons, when the manifest gives it.
@@ -42,16 +57,20 @@ pub struct Series {
     /// Images in load order.
     pub images: Vec<ImageRef>,
     /// Header facts per distinct file, in first-use order.
-    pub files: Vec<TiffInfo>,
+    pub files: Vec<SeriesFile>,
     /// Selected channel.
     pub channel: usize,
     /// The manifest the series came from, if any.
     pub manifest: Option<PathBuf>,
+    /// The selection flags the series was built with.
+    pub selection: Selection,
+    /// The axis of CZI, ND2 or LIF files holding the loads, if any.
+    pub load_axis: Option<LoadAxis>,
 }
 
 impl Series {
     /// Header facts of the file holding image `i`.
-    pub fn info_of(&self, path: &Path) -> Option<&TiffInfo> {
+    pub fn info_of(&self, path: &Path) -> Option<&SeriesFile> {
         self.files.iter().find(|f| f.path == path)
     }
 }
@@ -93,14 +112,16 @@ fn split_digits(s: &str) -> (&str, &str) {
     s.split_at(end)
 }
 
-fn is_tiff_name(path: &Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("tif") || e.eq_ignore_ascii_case("tiff"))
+fn is_image_name(path: &Path) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        ["tif", "tiff", "czi", "nd2", "lif"]
+            .iter()
+            .any(|x| e.eq_ignore_ascii_case(x))
+    })
 }
 
-/// Expand inputs into files: directories give their TIFF files in natural order, files are kept
-/// in the order given.
+/// Expand inputs into files: directories give their image files (.tif, .tiff, .czi, .nd2,
+/// .lif) in natural order, files are kept in the order given.
 pub fn collect_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     if inputs.is_empty() {
         return Err(Error::InvalidArgument("no input files given".into()));
@@ -115,12 +136,12 @@ pub fn collect_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
         let mut found: Vec<PathBuf> = std::fs::read_dir(input)
             .map_err(|e| Error::io(input, e))?
             .filter_map(|entry| entry.ok().map(|e| e.path()))
-            .filter(|p| p.is_file() && is_tiff_name(p))
+            .filter(|p| p.is_file() && is_image_name(p))
             .collect();
         if found.is_empty() {
             return Err(Error::bad_input(
                 Location::file(input),
-                "directory holds no .tif or .tiff files",
+                "directory holds no .tif, .tiff, .czi, .nd2 or .lif files",
             ));
         }
         found.sort_by(|a, b| natural_cmp(&a.to_string_lossy(), &b.to_string_lossy()));
@@ -129,28 +150,31 @@ pub fn collect_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-/// Check that a file's header agrees with the series' first file and resolve the channel.
-fn check_file(info: &TiffInfo, first: Option<&TiffInfo>, channel: Option<usize>) -> Result<usize> {
-    if let Some(first) = first {
-        let describe = |i: &TiffInfo| {
-            format!(
-                "{}×{} {} with {} channel(s)",
-                i.width,
-                i.height,
-                i.sample_type.name(),
-                i.channels
-            )
+/// Check that a file's planes agree with the series' first file (size and sample type; the
+/// channel count too between TIFF files).
+fn check_file(file: &SeriesFile, first: Option<&SeriesFile>) -> Result<()> {
+    let Some(first) = first else {
+        return Ok(());
+    };
+    let both_tiff = file.tiff.is_some() && first.tiff.is_some();
+    if (file.width, file.height, file.sample_type) != (first.width, first.height, first.sample_type)
+        || (both_tiff && file.channels != first.channels)
+    {
+        let at = match &file.tiff {
+            Some(info) => Location::page(&file.path, info.pages.first().copied().unwrap_or(0)),
+            None => Location::file(&file.path),
         };
-        if (info.width, info.height, info.sample_type, info.channels)
-            != (first.width, first.height, first.sample_type, first.channels)
-        {
-            return Err(Error::SeriesMismatch {
-                at: Location::page(&info.path, info.pages.first().copied().unwrap_or(0)),
-                reason: format!("image is {}", describe(info)),
-                expected: describe(first),
-            });
-        }
+        return Err(Error::SeriesMismatch {
+            at,
+            reason: format!("image is {}", file.describe()),
+            expected: first.describe(),
+        });
     }
+    Ok(())
+}
+
+/// Resolve the channel of a TIFF file.
+fn tiff_channel(info: &TiffInfo, channel: Option<usize>) -> Result<usize> {
     match channel {
         None if info.channels > 1 => Err(Error::bad_input(
             Location::file(&info.path),
@@ -175,63 +199,92 @@ fn check_file(info: &TiffInfo, first: Option<&TiffInfo>, channel: Option<usize>)
 
 /// Header facts of several files, opened once each, in first-use order.
 struct FileTable {
-    files: Vec<TiffInfo>,
+    files: Vec<SeriesFile>,
     index: HashMap<PathBuf, usize>,
-    channel: Option<usize>,
+    selection: Selection,
+    load_axis: Option<LoadAxis>,
 }
 
 impl FileTable {
-    fn new(channel: Option<usize>) -> Self {
+    fn new(selection: Selection, load_axis: Option<LoadAxis>) -> Self {
         FileTable {
             files: Vec::new(),
             index: HashMap::new(),
-            channel,
+            selection,
+            load_axis,
         }
     }
 
-    fn get(&mut self, path: &Path) -> Result<&TiffInfo> {
+    fn get(&mut self, path: &Path) -> Result<&SeriesFile> {
         if let Some(&i) = self.index.get(path) {
             return Ok(&self.files[i]);
         }
-        let info = TiffReader::open(path)?.info().clone();
-        check_file(&info, self.files.first(), self.channel)?;
+        let file = if super::microscopy::select::is_tiff(path) {
+            self.selection.check_tiff(path)?;
+            let info = TiffReader::open(path)?.info().clone();
+            tiff_channel(&info, self.selection.channel)?;
+            SeriesFile::from_tiff(info)
+        } else {
+            SeriesFile::from_vendor(path, &self.selection, self.load_axis)?
+        };
+        check_file(&file, self.files.first())?;
         self.index.insert(path.to_path_buf(), self.files.len());
-        self.files.push(info);
+        self.files.push(file);
         Ok(self.files.last().expect("just pushed"))
     }
 
     fn channel(&self) -> usize {
-        self.channel.unwrap_or(0)
+        self.selection.channel.unwrap_or(0)
+    }
+
+    fn into_series(self, images: Vec<ImageRef>, manifest: Option<PathBuf>) -> Series {
+        Series {
+            images,
+            channel: self.channel(),
+            files: self.files,
+            manifest,
+            selection: self.selection,
+            load_axis: self.load_axis,
+        }
     }
 }
 
 /// Every page of the selected channel of every file, in order.
 pub fn from_files(inputs: &[PathBuf], channel: Option<usize>) -> Result<Series> {
-    let mut table = FileTable::new(channel);
+    from_files_selected(inputs, &Selection::channel(channel), None)
+}
+
+/// The images of every file in order: every page of the channel of a TIFF; the planes the
+/// selection names in a CZI, ND2 or LIF file (one plane, or every plane along `load_axis`).
+pub fn from_files_selected(
+    inputs: &[PathBuf],
+    selection: &Selection,
+    load_axis: Option<LoadAxis>,
+) -> Result<Series> {
+    let mut table = FileTable::new(selection.clone(), load_axis);
     let mut images = Vec::new();
     for path in collect_files(inputs)? {
         let channel = table.channel();
-        let pages = table.get(&path)?.pages_of_channel(channel);
-        images.extend(pages.into_iter().map(|page| ImageRef {
+        let planes = table.get(&path)?.images(channel);
+        images.extend(planes.into_iter().map(|(page, plane)| ImageRef {
             path: path.clone(),
             page,
+            plane,
             force_n: None,
             friction_n: None,
         }));
     }
-    Ok(Series {
-        images,
-        channel: table.channel(),
-        files: table.files,
-        manifest: None,
-    })
+    Ok(table.into_series(images, None))
 }
 
 /// Give each image its force (newtons); the counts must agree.
 pub fn assign_forces(series: &mut Series, forces_n: &[f64]) -> Result<()> {
     if forces_n.len() != series.images.len() {
+        let along = series.load_axis.map_or(String::new(), |a| {
+            format!(" (the planes along --load-axis {})", a.name())
+        });
         return Err(Error::InvalidArgument(format!(
-            "{} force(s) given for {} image(s); give one force per image",
+            "{} force(s) given for {} image(s){along}; give one force per image",
             forces_n.len(),
             series.images.len()
         )));
@@ -274,6 +327,16 @@ fn manifest_number(
 
 /// Read a manifest CSV (`file`, optional `page`, `force_mN`, optional `friction_mN`).
 pub fn from_manifest(manifest: &Path, channel: Option<usize>) -> Result<Series> {
+    from_manifest_selected(manifest, &Selection::channel(channel), None)
+}
+
+/// A manifest whose files may be CZI, ND2 or LIF files too: their `page` is the position along
+/// `load_axis` (empty when the selection names one plane).
+pub fn from_manifest_selected(
+    manifest: &Path,
+    selection: &Selection,
+    load_axis: Option<LoadAxis>,
+) -> Result<Series> {
     let at_manifest = Location::file(manifest);
     crate::io::staging::note_input(manifest);
     let text = std::fs::read_to_string(manifest).map_err(|e| Error::io(manifest, e))?;
@@ -296,7 +359,7 @@ pub fn from_manifest(manifest: &Path, channel: Option<usize>) -> Result<Series> 
     };
     let (page_col, friction_col) = (column("page"), column("friction_mN"));
     let base = manifest.parent().unwrap_or(Path::new("."));
-    let mut table = FileTable::new(channel);
+    let mut table = FileTable::new(selection.clone(), load_axis);
     let mut images = Vec::new();
     for (i, row) in reader.records().enumerate() {
         let line = i + 2;
@@ -314,10 +377,11 @@ pub fn from_manifest(manifest: &Path, channel: Option<usize>) -> Result<Series> 
         if let Some(f) = friction {
             Quantity::Force.check_at(f * 1e-3, &at)?;
         }
-        let page = resolve_page(&mut table, &path, &row, page_col, &at)?;
+        let (page, plane) = resolve_page(&mut table, &path, &row, page_col, &at)?;
         images.push(ImageRef {
             path,
             page,
+            plane,
             force_n: Some(force * 1e-3),
             friction_n: friction.map(|f| f * 1e-3),
         });
@@ -328,12 +392,7 @@ pub fn from_manifest(manifest: &Path, channel: Option<usize>) -> Result<Series> 
             "manifest lists no images",
         ));
     }
-    Ok(Series {
-        images,
-        channel: table.channel(),
-        files: table.files,
-        manifest: Some(manifest.to_path_buf()),
-    })
+    Ok(table.into_series(images, Some(manifest.to_path_buf())))
 }
 
 fn resolve_page(
@@ -342,13 +401,14 @@ fn resolve_page(
     row: &csv::StringRecord,
     page_col: Option<usize>,
     at: &Location,
-) -> Result<usize> {
+) -> Result<(usize, Option<SelectedPlane>)> {
     let channel = table.channel();
-    let pages = table.get(path)?.pages_of_channel(channel);
+    let images = table.get(path)?.images(channel);
+    let pages: Vec<usize> = images.iter().map(|(p, _)| *p).collect();
     let text = page_col.and_then(|c| row.get(c)).unwrap_or("").trim();
     if text.is_empty() {
-        return match pages.as_slice() {
-            [only] => Ok(*only),
+        return match images.as_slice() {
+            [only] => Ok(only.clone()),
             _ => Err(Error::bad_input(
                 at.clone(),
                 format!(
@@ -365,7 +425,7 @@ fn resolve_page(
             format!("page '{text}' is not a non-negative integer"),
         )
     })?;
-    if !pages.contains(&page) {
+    let Some(found) = images.into_iter().find(|(p, _)| *p == page) else {
         return Err(Error::bad_input(
             at.clone(),
             format!(
@@ -374,8 +434,8 @@ fn resolve_page(
                 page_list(&pages)
             ),
         ));
-    }
-    Ok(page)
+    };
+    Ok(found)
 }
 
 fn page_list(pages: &[usize]) -> String {
@@ -482,7 +542,7 @@ impl<'a> SeriesPlanes<'a> {
         }
     }
 
-    fn plane(&self, reader: &mut Option<TiffReader>, i: usize) -> Result<Arc<Plane>> {
+    fn plane(&self, reader: &mut Option<Reader>, i: usize) -> Result<Arc<Plane>> {
         if let Some(p) = self.cache.lock().expect("lock")[i].clone() {
             return Ok(p);
         }
@@ -495,14 +555,48 @@ impl<'a> SeriesPlanes<'a> {
         Ok(plane)
     }
 
-    fn read(&self, reader: &mut Option<TiffReader>, image: &ImageRef) -> Result<Plane> {
-        if reader.as_ref().is_none_or(|r| r.info().path != image.path) {
-            *reader = Some(TiffReader::open(&image.path)?);
+    fn read(&self, reader: &mut Option<Reader>, image: &ImageRef) -> Result<Plane> {
+        if reader.as_ref().is_none_or(|r| r.path() != image.path) {
+            *reader = Some(match image.plane {
+                None => Reader::Tiff(Box::new(TiffReader::open(&image.path)?)),
+                Some(_) => Reader::Vendor(Box::new(MicroscopyFile::open(&image.path)?)),
+            });
         }
-        let reader = reader.as_mut().expect("just opened");
-        let plane = reader.read_page(image.page, self.series.channel)?;
-        check_plane(&plane, self.series, &image.path, image.page)?;
+        let plane = match (reader.as_mut().expect("just opened"), &image.plane) {
+            (Reader::Tiff(r), None) => r.read_page(image.page, self.series.channel)?,
+            (Reader::Vendor(f), Some(p)) => f.read_plane(p.series, &p.index)?,
+            _ => {
+                return Err(Error::InvalidArgument(format!(
+                    "{}: file changed its format during the analysis",
+                    image.path.display()
+                )))
+            }
+        };
+        check_plane(&plane, self.series, image)?;
         Ok(plane)
+    }
+}
+
+/// An open file of a series.
+enum Reader {
+    Tiff(Box<TiffReader>),
+    Vendor(Box<MicroscopyFile>),
+}
+
+impl Reader {
+    fn path(&self) -> &Path {
+        match self {
+            Reader::Tiff(r) => &r.info().path,
+            Reader::Vendor(f) => &f.path,
+        }
+    }
+}
+
+/// Where an image is, for messages: `file (page 3)` or `file.czi (series 0, t 2, z 0, c 1)`.
+pub fn image_location(image: &ImageRef) -> Location {
+    match &image.plane {
+        None => Location::page(&image.path, image.page),
+        Some(p) => Location::file(format!("{} ({})", image.path.display(), p.describe())),
     }
 }
 
@@ -516,8 +610,7 @@ impl PlaneSource for SeriesPlanes<'_> {
     }
 
     fn label(&self, index: usize) -> String {
-        let image = &self.series.images[index];
-        Location::page(&image.path, image.page).to_string()
+        image_location(&self.series.images[index]).to_string()
     }
 
     /// In parallel over runs of images of one file.
@@ -548,15 +641,15 @@ impl PlaneSource for SeriesPlanes<'_> {
     }
 }
 
-fn check_plane(plane: &Plane, series: &Series, path: &Path, page: usize) -> Result<()> {
+fn check_plane(plane: &Plane, series: &Series, image: &ImageRef) -> Result<()> {
     let first = &series.files[0];
     if (plane.width, plane.height, plane.sample_type)
         != (first.width, first.height, first.sample_type)
     {
         return Err(Error::SeriesMismatch {
-            at: Location::page(path, page),
+            at: image_location(image),
             reason: format!(
-                "page is {}×{} {}",
+                "plane is {}×{} {}",
                 plane.width,
                 plane.height,
                 plane.sample_type.name()
