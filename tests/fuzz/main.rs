@@ -15,9 +15,13 @@
 //! `FUZZ_KEEP` (folder for failing cases, default `target/fuzz-failures`).
 
 mod cases;
+#[allow(dead_code)]
+#[path = "../common/czi.rs"]
+mod czi;
 mod mutate;
 mod run;
 mod seeds;
+mod vendor;
 
 use std::collections::BTreeMap;
 use std::fs;
@@ -30,7 +34,7 @@ use rand::seq::IndexedRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use cases::{Template, TEMPLATES};
+use cases::Template;
 use run::{run_case, Class, Limits};
 
 fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
@@ -47,6 +51,7 @@ fn copy_tree(from: &Path, to: &Path) {
             copy_tree(&e.path(), &to.join(e.file_name()));
         }
     } else {
+        fs::create_dir_all(to.parent().unwrap()).unwrap();
         fs::copy(from, to).unwrap();
     }
 }
@@ -59,10 +64,16 @@ struct Case {
 }
 
 /// Copy the template's inputs into `dir` and mutate them; deterministic in (seed, index).
-fn prepare(seeds: &Path, dir: &Path, seed: u64, index: usize) -> Case {
+fn prepare(
+    templates: &[&'static Template],
+    seeds: &Path,
+    dir: &Path,
+    seed: u64,
+    index: usize,
+) -> Case {
     let mut rng =
         ChaCha8Rng::seed_from_u64(seed.wrapping_mul(1_000_003).wrapping_add(index as u64));
-    let template = TEMPLATES.choose(&mut rng).unwrap();
+    let template = *templates.choose(&mut rng).unwrap();
     fs::create_dir_all(dir).unwrap();
     for c in template.copies {
         copy_tree(&seeds.join(c), &dir.join(c));
@@ -117,6 +128,13 @@ fn campaign(cases: usize, seed: u64) {
     let seeds_dir = base.path().join("seeds");
     fs::create_dir_all(&seeds_dir).unwrap();
     seeds::build(&seeds_dir);
+    vendor::build(&seeds_dir);
+    // Every template whose seeds exist (the real vendor samples may be absent).
+    let templates: Vec<&'static Template> = cases::TEMPLATES
+        .iter()
+        .chain(vendor::TEMPLATES)
+        .filter(|t| t.copies.iter().all(|c| seeds_dir.join(c).exists()))
+        .collect();
 
     let next = AtomicUsize::new(0);
     let counts: Mutex<BTreeMap<(&str, Class), usize>> = Mutex::new(BTreeMap::new());
@@ -130,7 +148,7 @@ fn campaign(cases: usize, seed: u64) {
                     break;
                 }
                 let dir = base.path().join(format!("case-{i}"));
-                let case = prepare(&seeds_dir, &dir, seed, i);
+                let case = prepare(&templates, &seeds_dir, &dir, seed, i);
                 let out = dir.join(
                     case.args
                         .iter()
@@ -179,7 +197,8 @@ fn campaign(cases: usize, seed: u64) {
         }] += n;
     }
     println!(
-        "fuzz: {cases} cases, seed {seed}, {jobs} jobs, {:.0} s",
+        "fuzz: {cases} cases over {} templates, seed {seed}, {jobs} jobs, {:.0} s",
+        templates.len(),
         start.elapsed().as_secs_f64()
     );
     for (t, [ok, err, bad]) in &by_template {
