@@ -19,6 +19,7 @@ use contactscope::error::Error;
 
 mod images;
 mod mechanics;
+mod synth;
 
 create_exception!(
     contactscope,
@@ -168,5 +169,6 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
     images::register(m)?;
     mechanics::register(m)?;
+    synth::register(m)?;
     Ok(())
 }

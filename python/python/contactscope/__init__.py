@@ -327,3 +327,44 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
                                      _f64(heights, 2, "heights"), pixel_size, float(modulus),
                                      radius, family, range, grid, ln_tolerance, tolerance,
                                      max_iterations, imaging_fwhm, imaging_pixel_size))
+
+
+# Seeded generators with known truth, and a TIFF writer (inputs for examples and tests).
+
+def synth_series(width: int = 256, height: int = 256, pixel_size: float = 200e-9,
+                 forces: Optional[Sequence[float]] = None, seed: int = 2018) -> Results:
+    """A synthetic confocal load series (12-bit values in uint16) with known truth: ``images``
+    (loads, rows, columns), ``forces_n`` (N), ``true_area_m2`` (m²) and the true masks
+    ``truth``; pixel size in m. Defaults: the bundled fixture (8 loads, 4–100 mN)."""
+    forces = None if forces is None else [float(f) for f in forces]
+    return Results(_cs.synth_series(width, height, pixel_size, forces, seed))
+
+
+def synth_beads(width: int = 128, height: int = 128, planes: int = 1, beads: int = 6,
+                sigma_px: float = 1.91, seed: int = 7) -> np.ndarray:
+    """A synthetic bead image or z stack (12-bit values in uint16), spots of σ = ``sigma_px``
+    pixels: (planes, rows, columns)."""
+    return _cs.synth_beads(width, height, planes, beads, sigma_px, seed)
+
+
+def synth_newton(width: int = 256, height: int = 256, pixel_size: float = 200e-9,
+                 contact_radius: float = 12e-6, detection_gap: float = 9e-9,
+                 seed: int = 7) -> Results:
+    """A synthetic Newton-ring ``reflection`` image and ``fluorescence`` image of one contact
+    (uint16), with the true ``detection_gap_m``, ``contact_radius_m``, ``sphere_radius_m`` (m)."""
+    return Results(_cs.synth_newton(width, height, pixel_size, contact_radius, detection_gap,
+                                    seed))
+
+
+def write_tiff(path: PathLike, stack: Any, pixel_size: Optional[PixelSize] = None) -> None:
+    """Write an image or stack (uint16 or float32; other types as float32) as a multi-page TIFF
+    with the pixel size (m) in its metadata when given."""
+    a = np.asarray(stack)
+    if a.ndim == 2:
+        a = a[np.newaxis]
+    if a.dtype != np.uint16:
+        a = a.astype(np.float32)
+    _cs.write_tiff(os.fspath(path), np.ascontiguousarray(a), pixel_size)
+
+
+__all__ += ["synth_series", "synth_beads", "synth_newton", "write_tiff"]
