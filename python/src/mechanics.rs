@@ -173,7 +173,7 @@ struct Step {
 /// "gt" (Greenwood–Tripp bearing area; needs `radius`). Per load: the summary and, with
 /// `maps`, pressure (Pa), gap (m), contact (bool) and plastic displacement (m) maps.
 #[pyfunction]
-#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=0.0, alpha=None, radius=None, periodic=false, tolerance=1e-10, max_iterations=2000, maps=true))]
+#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=0.0, alpha=None, radius=None, periodic=false, tolerance=1e-8, max_iterations=5000, maps=true))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -429,7 +429,7 @@ fn model_body(
 /// "hardening" with k in Pa/m) on the rough sphere, as `fit_hardening` counts them (raw p > 0
 /// pixels, or imaged like micrographs with `imaging_fwhm` and `imaging_pixel_size`).
 #[pyfunction]
-#[pyo3(signature = (heights, pixel_size, modulus, family, parameter, loads, radius=None, tolerance=1e-10, max_iterations=2000, imaging_fwhm=None, imaging_pixel_size=None))]
+#[pyo3(signature = (heights, pixel_size, modulus, family, parameter, loads, radius=None, tolerance=1e-8, max_iterations=5000, imaging_fwhm=None, imaging_pixel_size=None))]
 #[allow(clippy::too_many_arguments)]
 fn ramp<'py>(
     py: Python<'py>,
@@ -486,7 +486,7 @@ fn misfit(forces: Vec<f64>, areas: Vec<f64>, simulated: Vec<f64>) -> PyResult<f6
 /// "hardening" (k in Pa/m) or "hardness" (p_Y in Pa) a log grid over `range` then Brent's method
 /// on ln(parameter), with the Gauss–Newton standard error; "elastic" and "gt" are evaluated once.
 #[pyfunction]
-#[pyo3(signature = (forces, areas, heights, pixel_size, modulus, radius=None, family="hardening", range=None, grid=7, ln_tolerance=0.01, tolerance=1e-10, max_iterations=2000, imaging_fwhm=None, imaging_pixel_size=None))]
+#[pyo3(signature = (forces, areas, heights, pixel_size, modulus, radius=None, family="hardening", range=None, grid=7, ln_tolerance=0.01, tolerance=1e-8, max_iterations=5000, imaging_fwhm=None, imaging_pixel_size=None))]
 #[allow(clippy::too_many_arguments)]
 fn fit_hardening<'py>(
     py: Python<'py>,

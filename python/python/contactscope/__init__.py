@@ -258,7 +258,7 @@ def simulate(heights: Any, pixel_size: PixelSize, modulus: float, loads: Iterabl
              model: str = "elastic", *, hardness: Optional[float] = None,
              k: Optional[float] = None, initial_hardness: float = 0.0,
              alpha: Optional[float] = None, radius: Optional[float] = None,
-             periodic: bool = False, tolerance: float = 1e-10, max_iterations: int = 2000,
+             periodic: bool = False, tolerance: float = 1e-8, max_iterations: int = 5000,
              maps: bool = True) -> Results:
     """A load ramp on a rough body (heights in m, rows = y, positive towards the flat; pixel
     size in m; a sphere of ``radius`` m is added when given) pressed on a flat of contact
@@ -282,7 +282,7 @@ def simulate(heights: Any, pixel_size: PixelSize, modulus: float, loads: Iterabl
 
 def ramp(heights: Any, pixel_size: PixelSize, modulus: float, family: str,
          parameter: Optional[float], loads: Sequence[float], radius: Optional[float] = None,
-         tolerance: float = 1e-10, max_iterations: int = 2000,
+         tolerance: float = 1e-8, max_iterations: int = 5000,
          imaging_fwhm: Optional[float] = None,
          imaging_pixel_size: Optional[PixelSize] = None) -> Results:
     """One model evaluation of a fit (the unit of a Dask task): contact areas ``areas_m2`` (m²)
@@ -302,8 +302,8 @@ def misfit(forces: Sequence[float], areas: Sequence[float], simulated: Sequence[
 def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
                   pixel_size: PixelSize, modulus: float, radius: Optional[float] = None,
                   family: str = "hardening", range: Optional["tuple[float, float]"] = None,
-                  grid: int = 7, ln_tolerance: float = 0.01, tolerance: float = 1e-10,
-                  max_iterations: int = 2000, imaging_fwhm: Optional[float] = None,
+                  grid: int = 7, ln_tolerance: float = 0.01, tolerance: float = 1e-8,
+                  max_iterations: int = 5000, imaging_fwhm: Optional[float] = None,
                   imaging_pixel_size: Optional[PixelSize] = None, client: Any = None) -> Results:
     """Fit a contact model to a measured area–load curve (``forces`` in N, ``areas`` in m²) on
     the rough sphere (heights in m, pixel size in m, sphere ``radius`` in m, E* ``modulus`` in

@@ -125,8 +125,8 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
           family: str = "hardening", values: Sequence[Optional[float]] = (None,),
           heights: Any = None, surfaces: Optional[Sequence[Any]] = None,
           surface_spec: Optional[Dict[str, Any]] = None, seeds: Sequence[int] = (),
-          radius: Optional[float] = None, tolerance: float = 1e-10,
-          max_iterations: int = 2000, imaging_fwhm: Optional[float] = None,
+          radius: Optional[float] = None, tolerance: float = 1e-8,
+          max_iterations: int = 5000, imaging_fwhm: Optional[float] = None,
           imaging_pixel_size: Any = None, client: Any = None,
           threads_per_task: int = 1) -> Results:
     """Load ramps over a parameter grid, one Dask task per ramp.
@@ -248,8 +248,8 @@ def brent_minimum(f: Callable[[float], float], lo: float, hi: float, tol: float,
 def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
                   pixel_size: Any, modulus: float, *, radius: Optional[float] = None,
                   family: str = "hardening", range: Optional["tuple[float, float]"] = None,
-                  grid: int = 7, ln_tolerance: float = 0.01, tolerance: float = 1e-10,
-                  max_iterations: int = 2000, imaging_fwhm: Optional[float] = None,
+                  grid: int = 7, ln_tolerance: float = 0.01, tolerance: float = 1e-8,
+                  max_iterations: int = 5000, imaging_fwhm: Optional[float] = None,
                   imaging_pixel_size: Any = None, client: Any = None,
                   threads_per_task: int = 1) -> Results:
     """:func:`contactscope.fit_hardening` with every model evaluation (one load ramp) a Dask task.
