@@ -316,3 +316,15 @@ def test_results_are_plain_data():
     with pytest.raises(AttributeError):
         a.nothing
     assert pathlib.Path  # noqa: B018 (imports used)
+
+
+def test_stubs_name_every_function():
+    import ast
+
+    import contactscope._contactscope as ext
+
+    stub = pathlib.Path(cs.__file__).with_name("_contactscope.pyi")
+    tree = ast.parse(stub.read_text(encoding="utf-8"))
+    named = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    assert named == {n for n in dir(ext) if not n.startswith("_")}
+    assert set(cs.__all__) <= set(dir(cs))
