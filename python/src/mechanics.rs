@@ -210,7 +210,8 @@ fn simulate<'py>(
     })?;
     let d = PyDict::new(py);
     let rows = PyList::empty(py);
-    let mut stacks: [Vec<f64>; 4] = Default::default();
+    let cells = if maps { steps.len() * nx * ny } else { 0 };
+    let mut stacks: [Vec<f64>; 4] = std::array::from_fn(|_| Vec::with_capacity(cells));
     let mut have_maps = maps;
     for s in steps {
         let r = PyDict::new(py);
@@ -306,21 +307,7 @@ fn run_halfspace(
     let mut steps = Vec::with_capacity(loads.len());
     sweep_each(&setup, loads, &mut |_, s| {
         let plastic_volume_m3 = s.plastic_m.iter().sum::<f64>() * cell;
-        let maps = keep_maps.then(|| {
-            let contact = s
-                .solution
-                .pressure
-                .iter()
-                .map(|p| f64::from(u8::from(*p > 0.0)))
-                .collect();
-            [
-                s.solution.pressure.clone(),
-                s.solution.gap.clone(),
-                contact,
-                s.plastic_m.clone(),
-            ]
-        });
-        steps.push(Step {
+        let mut step = Step {
             force_n: s.force_n,
             area_m2: s.area_m2,
             contact_fraction: s.contact_fraction,
@@ -332,8 +319,19 @@ fn run_halfspace(
             residual: s.solution.gap_residual.max(s.solution.pressure_change),
             plastic_volume_m3,
             edge_contact: s.edge_contact,
-            maps,
-        });
+            maps: None,
+        };
+        if keep_maps {
+            // The step is ours: its fields move into the result without a copy.
+            let contact = s
+                .solution
+                .pressure
+                .iter()
+                .map(|p| f64::from(u8::from(*p > 0.0)))
+                .collect();
+            step.maps = Some([s.solution.pressure, s.solution.gap, contact, s.plastic_m]);
+        }
+        steps.push(step);
         Ok(())
     })?;
     Ok(steps)

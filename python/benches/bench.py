@@ -1,0 +1,119 @@
+"""Benchmarks of the Python package (issue 13's performance targets; measured, never asserted).
+
+1. Call overhead: `cs.simulate` on a 512² map against the command line's `simulate` on the
+   same .npy (its wall time, which also writes the maps and the plot; and the library's own
+   compute time, measured here as the Python call with maps=False minus nothing else), target:
+   Python ≤ 5 % over the CLI's compute time.
+2. Dask: a sweep of 8 k values (one load ramp each) on LocalCluster(n_workers=2,
+   threads_per_worker=1) against the serial loop of the same ramps, target ≥ 1.7×.
+
+Run from the repository root after `cargo build --release` and installing the package:
+    python python/benches/bench.py [--repeat 3] [--size 512]
+"""
+
+import argparse
+import json
+import os
+import pathlib
+import subprocess
+import tempfile
+import time
+
+import numpy as np
+
+import contactscope as cs
+from contactscope import distributed
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+BIN = pathlib.Path(os.environ.get("CONTACTSCOPE_BIN", ROOT / "target" / "release" / "contactscope"))
+PIXEL = 100e-9
+MODULUS = 1e9
+RADIUS = 20e-6
+LOADS = [20e-6, 40e-6, 80e-6, 160e-6]
+K_VALUES = [1e15, 1.5e15, 2e15, 3e15, 4e15, 6e15, 8e15, 12e15]
+
+
+def best_of(repeat, fn):
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times), times
+
+
+def bench_overhead(size, repeat, tmp):
+    heights = cs.surface(size, size, PIXEL, rms_height=50e-9, seed=3)
+    npy = tmp / "s.npy"
+    np.save(npy, heights)
+    loads = ",".join(f"{f * 1e6:g}" for f in LOADS) + "uN"
+    cli_args = [str(BIN), "simulate", "--topography", str(npy), "--pixel-size", "100nm",
+                "--detrend", "none", "--radius", "20um", "--modulus", "1GPa",
+                "--model", "hardening", "--hardening", "4MPa/nm", "--loads", loads, "-q"]
+
+    def cli():
+        out = tmp / f"sim-{time.monotonic_ns()}"
+        subprocess.run(cli_args + ["--out", str(out)], check=True, capture_output=True)
+
+    def py(maps):
+        return lambda: cs.simulate(heights, PIXEL, MODULUS, LOADS, "hardening", k=4e15,
+                                   radius=RADIUS, maps=maps)
+
+    cli()  # warm the page cache
+    t_cli, all_cli = best_of(repeat, cli)
+    t_py_maps, all_maps = best_of(repeat, py(True))
+    t_py, all_py = best_of(repeat, py(False))
+    return {
+        "grid": f"{size}x{size}", "loads": len(LOADS),
+        "cli_wall_s": t_cli, "python_maps_s": t_py_maps, "python_no_maps_s": t_py,
+        "overhead_vs_cli_pct": 100 * (t_py_maps / t_cli - 1),
+        "all": {"cli": all_cli, "python_maps": all_maps, "python_no_maps": all_py},
+    }
+
+
+def bench_dask(size, repeat):
+    heights = cs.surface(size, size, PIXEL, rms_height=50e-9, seed=4)
+    kwargs = dict(family="hardening", values=K_VALUES, heights=heights, radius=RADIUS)
+
+    def serial(threads):
+        cs.set_num_threads(threads)
+        try:
+            return distributed.sweep(LOADS, PIXEL, MODULUS, client="serial", **kwargs)
+        finally:
+            cs.set_num_threads(0)
+
+    t_serial_1, _ = best_of(repeat, lambda: serial(1))
+    t_serial_all, _ = best_of(repeat, lambda: serial(0))
+    with distributed.local_client(n_workers=2, threads_per_worker=1) as client:
+        distributed.sweep(LOADS, PIXEL, MODULUS, client=client, **kwargs)  # warm the workers
+        t_dask, all_dask = best_of(
+            repeat, lambda: distributed.sweep(LOADS, PIXEL, MODULUS, client=client, **kwargs))
+        same = [np.array_equal(a["areas_m2"], b["areas_m2"]) for a, b in zip(
+            distributed.sweep(LOADS, PIXEL, MODULUS, client=client, **kwargs).rows,
+            serial(1).rows)]
+    return {
+        "grid": f"{size}x{size}", "ramps": len(K_VALUES), "loads_per_ramp": len(LOADS),
+        "serial_1_thread_s": t_serial_1, "serial_all_cores_s": t_serial_all,
+        "dask_2_workers_s": t_dask,
+        "speedup_vs_serial_1_thread": t_serial_1 / t_dask,
+        "speedup_vs_serial_all_cores": t_serial_all / t_dask,
+        "identical_to_serial": all(same), "all_dask": all_dask,
+    }
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--size", type=int, default=512, help="grid of the overhead benchmark")
+    p.add_argument("--sweep-size", type=int, default=256, help="grid of the Dask sweep")
+    args = p.parse_args()
+    with tempfile.TemporaryDirectory() as d:
+        overhead = bench_overhead(args.size, args.repeat, pathlib.Path(d))
+    print(json.dumps({"overhead": overhead}, indent=1))
+    dask = bench_dask(args.sweep_size, args.repeat)
+    print(json.dumps({"dask": dask}, indent=1))
+    print(f"os.cpu_count() = {os.cpu_count()}, load average {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    main()
