@@ -16,6 +16,7 @@ import json
 import os
 import pathlib
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -84,10 +85,21 @@ def bench_dask(size, repeat):
 
     t_serial_1, _ = best_of(repeat, lambda: serial(1))
     t_serial_all, _ = best_of(repeat, lambda: serial(0))
+    from dask.distributed import get_task_stream
+
     with distributed.local_client(n_workers=2, threads_per_worker=1) as client:
         distributed.sweep(LOADS, PIXEL, MODULUS, client=client, **kwargs)  # warm the workers
         t_dask, all_dask = best_of(
             repeat, lambda: distributed.sweep(LOADS, PIXEL, MODULUS, client=client, **kwargs))
+        # How busy the workers were: compute time of the ramps over 2 × the wall time. On an
+        # idle machine the speed-up over the 1-thread serial loop is about 2 × this.
+        with get_task_stream(client) as stream:
+            t = time.perf_counter()
+            distributed.sweep(LOADS, PIXEL, MODULUS, client=client, **kwargs)
+            wall = time.perf_counter() - t
+        busy = sum(s["stop"] - s["start"] for task in stream.data
+                   for s in task["startstops"] if s["action"] == "compute"
+                   and "_ramp_task" in task["key"])
         same = [np.array_equal(a["areas_m2"], b["areas_m2"]) for a, b in zip(
             distributed.sweep(LOADS, PIXEL, MODULUS, client=client, **kwargs).rows,
             serial(1).rows)]
@@ -98,6 +110,7 @@ def bench_dask(size, repeat):
         "speedup_vs_serial_1_thread": t_serial_1 / t_dask,
         "speedup_vs_serial_all_cores": t_serial_all / t_dask,
         "identical_to_serial": all(same), "all_dask": all_dask,
+        "ramp_compute_s_on_workers": busy, "worker_utilisation": busy / (2 * wall),
     }
 
 
@@ -113,6 +126,19 @@ def main():
     dask = bench_dask(args.sweep_size, args.repeat)
     print(json.dumps({"dask": dask}, indent=1))
     print(f"os.cpu_count() = {os.cpu_count()}, load average {os.getloadavg()}")
+    # The machine's own share of 2 cores: the same ramps in two plain processes at once.
+    one = ("import time, contactscope as cs; cs.set_num_threads(1); "
+           f"h = cs.surface({args.sweep_size}, {args.sweep_size}, {PIXEL}, rms_height=50e-9, "
+           "seed=4); t = time.perf_counter(); "
+           f"[cs.ramp(h, {PIXEL}, {MODULUS}, 'hardening', k, {LOADS}, radius={RADIUS}) "
+           f"for k in {K_VALUES[:4]}]; print(time.perf_counter() - t)")
+    alone = float(subprocess.run([sys.executable, "-c", one], capture_output=True, text=True,
+                                 check=True).stdout)
+    pair = [subprocess.Popen([sys.executable, "-c", one], stdout=subprocess.PIPE, text=True)
+            for _ in range(2)]
+    together = max(float(p.communicate()[0]) for p in pair)
+    print(json.dumps({"two_plain_processes": {"alone_s": alone, "two_at_once_s": together,
+                                               "parallel_speedup": 2 * alone / together}}))
 
 
 if __name__ == "__main__":

@@ -161,8 +161,8 @@ struct Step {
     residual: f64,
     plastic_volume_m3: f64,
     edge_contact: bool,
-    /// pressure (Pa), gap (m), contact (0/1), plastic displacement (m).
-    maps: Option<[Vec<f64>; 4]>,
+    /// pressure (Pa), gap (m), plastic displacement (m); contact is p > 0.
+    maps: Option<[Vec<f64>; 3]>,
 }
 
 /// A load ramp with one contact model on a rough body: heights (m, rows = y; positive towards
@@ -199,21 +199,37 @@ fn simulate<'py>(
         return Err(bad("no loads given (newtons)"));
     }
     let (nx, ny) = (roughness.nx(), roughness.ny());
-    let steps = compute(py, move || {
+    let (steps, stacks) = compute(py, move || {
         let stats = SurfaceStats::finite_differences(&roughness)?;
-        match model {
+        let mut steps = match model {
             Some(model) => run_halfspace(
                 roughness, &stats, radius, modulus, model, periodic, options, &loads, maps,
             ),
             None => run_gt(&roughness, &stats, radius, modulus, &loads, maps),
-        }
+        }?;
+        // The per-load maps into (loads, ny, nx) stacks, still without the GIL.
+        let stacks = maps.then(|| {
+            let cells = steps.len() * nx * ny;
+            let mut stacks: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(cells));
+            let mut contact: Vec<bool> = Vec::with_capacity(cells);
+            for s in &mut steps {
+                if let Some([mut pressure, gap, plastic]) = s.maps.take() {
+                    contact.extend(pressure.iter().map(|p| *p > 0.0));
+                    if model.is_none() {
+                        pressure.fill(f64::NAN);
+                    }
+                    for (stack, map) in stacks.iter_mut().zip([pressure, gap, plastic]) {
+                        stack.extend(map);
+                    }
+                }
+            }
+            (stacks, contact)
+        });
+        Ok((steps, stacks))
     })?;
     let d = PyDict::new(py);
     let rows = PyList::empty(py);
-    let cells = if maps { steps.len() * nx * ny } else { 0 };
-    let mut stacks: [Vec<f64>; 4] = std::array::from_fn(|_| Vec::with_capacity(cells));
-    let mut have_maps = maps;
-    for s in steps {
+    for s in &steps {
         let r = PyDict::new(py);
         r.set_item("force_n", s.force_n)?;
         r.set_item("area_m2", s.area_m2)?;
@@ -227,46 +243,18 @@ fn simulate<'py>(
         r.set_item("plastic_volume_m3", s.plastic_volume_m3)?;
         r.set_item("edge_contact", s.edge_contact)?;
         rows.append(r)?;
-        match s.maps {
-            Some(m) => {
-                for (stack, map) in stacks.iter_mut().zip(m) {
-                    stack.extend(map);
-                }
-            }
-            None => have_maps = false,
-        }
     }
-    let n = rows.len();
     d.set_item("rows", rows)?;
-    if have_maps {
-        let [pressure, gap, contact, plastic] = stacks;
-        let shape = (n, ny, nx);
+    if let Some(([pressure, gap, plastic], contact)) = stacks {
+        // The stacks become numpy arrays without another copy.
+        let shape = (steps.len(), ny, nx);
         let err = |e: ndarray::ShapeError| bad(format!("maps: {e}"));
-        d.set_item(
-            "pressure",
-            Array3::from_shape_vec(shape, pressure)
-                .map_err(err)?
-                .into_pyarray(py),
-        )?;
-        d.set_item(
-            "gap",
-            Array3::from_shape_vec(shape, gap)
-                .map_err(err)?
-                .into_pyarray(py),
-        )?;
-        let contact: Vec<bool> = contact.iter().map(|c| *c > 0.0).collect();
-        d.set_item(
-            "contact",
-            Array3::from_shape_vec(shape, contact)
-                .map_err(err)?
-                .into_pyarray(py),
-        )?;
-        d.set_item(
-            "plastic",
-            Array3::from_shape_vec(shape, plastic)
-                .map_err(err)?
-                .into_pyarray(py),
-        )?;
+        for (name, values) in [("pressure", pressure), ("gap", gap), ("plastic", plastic)] {
+            let a = Array3::from_shape_vec(shape, values).map_err(err)?;
+            d.set_item(name, a.into_pyarray(py))?;
+        }
+        let a = Array3::from_shape_vec(shape, contact).map_err(err)?;
+        d.set_item("contact", a.into_pyarray(py))?;
     }
     Ok(d)
 }
@@ -323,13 +311,7 @@ fn run_halfspace(
         };
         if keep_maps {
             // The step is ours: its fields move into the result without a copy.
-            let contact = s
-                .solution
-                .pressure
-                .iter()
-                .map(|p| f64::from(u8::from(*p > 0.0)))
-                .collect();
-            step.maps = Some([s.solution.pressure, s.solution.gap, contact, s.plastic_m]);
+            step.maps = Some([s.solution.pressure, s.solution.gap, s.plastic_m]);
         }
         steps.push(step);
         Ok(())
@@ -362,6 +344,8 @@ fn run_gt(
             let profile = gt_profile(&params, force)?;
             let map = gt_bearing_area(roughness, &profile, None)?;
             let mask: Vec<u8> = map.mask.iter().map(|m| u8::from(*m)).collect();
+            // No pressure field: the first map carries the bearing-area contact (1) instead, and
+            // `simulate` returns NaN pressures for GT.
             let contact: Vec<f64> = mask.iter().map(|m| f64::from(*m)).collect();
             Ok(Step {
                 force_n: force,
@@ -380,8 +364,7 @@ fn run_gt(
                 plastic_volume_m3: 0.0,
                 edge_contact: false,
                 // GT gives the bearing-area contact map only: no pressure, gap or plastic maps.
-                maps: keep_maps
-                    .then(|| [vec![f64::NAN; n], vec![f64::NAN; n], contact, vec![0.0; n]]),
+                maps: keep_maps.then(|| [contact, vec![f64::NAN; n], vec![0.0; n]]),
             })
         })
         .collect()

@@ -194,6 +194,10 @@ def test_simulate_gt_and_elastic_models(surface_npy):
     gt = cs.simulate(h, 100e-9, 1e9, [20e-6, 40e-6], "gt", radius=20e-6)
     assert gt.rows[1]["area_m2"] > gt.rows[0]["area_m2"] > 0
     assert gt.contact.shape == (2, 128, 128)
+    # The bearing-area map is the contact; GT has no pressure field.
+    np.testing.assert_allclose(gt.contact.sum(axis=(1, 2)) * 1e-14,
+                               [r["area_m2"] for r in gt.rows], rtol=1e-12)
+    assert np.isnan(gt.pressure).all()
 
 
 def test_compare_matches_cli(cli, series_tif, tmp_path):
