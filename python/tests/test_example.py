@@ -31,3 +31,5 @@ def test_paper_workflow_example(tmp_path):
     # The areas grow sublinearly with the load, as the paper's.
     assert 0.6 < summary["power_law_exponent"] < 1.0
     assert "k =" in done.stdout
+    # The map is large enough: the simulated contact never reaches its border.
+    assert not any(summary["edge_contact"])
