@@ -92,55 +92,30 @@ impl StackIn<'_> {
 
 /// Planes as one numpy array in the file's own type (uint8, uint16, int16 or float32).
 fn planes_to_py<'py>(py: Python<'py>, planes: &[Plane]) -> PyResult<Bound<'py, PyAny>> {
-    let (n, h, w) = (planes.len(), planes[0].height, planes[0].width);
-    let shape = (n, h, w);
-    let err = |e: ndarray::ShapeError| bad(format!("planes of different sizes: {e}"));
-    let kind = planes[0].sample_type;
-    let int_values = |offset_to: &dyn Fn(u16, i32) -> i64| -> Vec<i64> {
-        planes
+    let shape = (planes.len(), planes[0].height, planes[0].width);
+    /// Every value of every plane as `T` (the values fit: `T` is the planes' own type).
+    fn stack<'py, T: numpy::Element>(
+        py: Python<'py>,
+        planes: &[Plane],
+        shape: (usize, usize, usize),
+        cast: impl Fn(f64) -> T,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let values: Vec<T> = planes
             .iter()
-            .flat_map(|p| match &p.samples {
-                Samples::Int { codes, offset } => {
-                    codes.iter().map(|&c| offset_to(c, *offset)).collect()
-                }
-                Samples::Float(v) => v.iter().map(|&x| x as i64).collect::<Vec<i64>>(),
-            })
-            .collect()
-    };
-    let value = |c: u16, o: i32| i64::from(i32::from(c) + o);
-    Ok(match kind {
-        SampleType::U8 => {
-            let v: Vec<u8> = int_values(&value).into_iter().map(|x| x as u8).collect();
-            Array3::from_shape_vec(shape, v)
-                .map_err(err)?
-                .into_pyarray(py)
-                .into_any()
-        }
-        SampleType::U16 => {
-            let v: Vec<u16> = int_values(&value).into_iter().map(|x| x as u16).collect();
-            Array3::from_shape_vec(shape, v)
-                .map_err(err)?
-                .into_pyarray(py)
-                .into_any()
-        }
-        SampleType::I16 => {
-            let v: Vec<i16> = int_values(&value).into_iter().map(|x| x as i16).collect();
-            Array3::from_shape_vec(shape, v)
-                .map_err(err)?
-                .into_pyarray(py)
-                .into_any()
-        }
-        SampleType::F32 | SampleType::F64 => {
-            let v: Vec<f32> = planes
-                .iter()
-                .flat_map(|p| (0..p.len()).map(|i| p.value(i) as f32))
-                .collect();
-            Array3::from_shape_vec(shape, v)
-                .map_err(err)?
-                .into_pyarray(py)
-                .into_any()
-        }
-    })
+            .flat_map(|p| (0..p.len()).map(|i| cast(p.value(i))))
+            .collect();
+        Ok(Array3::from_shape_vec(shape, values)
+            .map_err(|e| bad(format!("planes of different sizes: {e}")))?
+            .into_pyarray(py)
+            .into_any())
+    }
+    match planes[0].sample_type {
+        SampleType::U8 => stack(py, planes, shape, |v| v as u8),
+        SampleType::U16 => stack(py, planes, shape, |v| v as u16),
+        SampleType::I16 => stack(py, planes, shape, |v| v as i16),
+        // The library keeps float samples as f32.
+        SampleType::F32 | SampleType::F64 => stack(py, planes, shape, |v| v as f32),
+    }
 }
 
 fn pixel_size_dict<'py>(py: Python<'py>, p: Option<PixelSize>) -> PyResult<Bound<'py, PyAny>> {

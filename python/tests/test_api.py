@@ -332,3 +332,18 @@ def test_stubs_name_every_function():
     named = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
     assert named == {n for n in dir(ext) if not n.startswith("_")}
     assert set(cs.__all__) <= set(dir(cs))
+
+
+def test_float_series_matches_cli(cli, series_tif, tmp_path):
+    # Float data take the library's float histogram path (finite range, then bins).
+    _, s = series_tif
+    stack = (s.images.astype(np.float32) / 4095.0)
+    cs.write_tiff(tmp_path / "f.tif", stack, 2e-7)
+    r = cs.read_series(tmp_path / "f.tif", forces=FORCES)
+    assert r.images.dtype == np.float32
+    a = cs.analyze(r)
+    cli("analyze", tmp_path / "f.tif", "--forces", "2,4,8mN", "--out", tmp_path / "an", "-q")
+    rows = read_csv(tmp_path / "an" / "areas.csv")
+    assert [x["contact_pixels"] for x in a.rows] == [int(x["contact_pixels"]) for x in rows]
+    assert a.threshold == pytest.approx(float(rows[0]["threshold"]), rel=1e-6)
+    assert 0.0 < a.threshold < 1.0
