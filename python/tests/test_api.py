@@ -347,3 +347,16 @@ def test_float_series_matches_cli(cli, series_tif, tmp_path):
     assert [x["contact_pixels"] for x in a.rows] == [int(x["contact_pixels"]) for x in rows]
     assert a.threshold == pytest.approx(float(rows[0]["threshold"]), rel=1e-6)
     assert 0.0 < a.threshold < 1.0
+
+
+def test_read_topography_gsf_carries_its_pixel_size(cli, tmp_path):
+    gsf = tmp_path / "s.gsf"
+    cli("surface", "--size", 64, "--pixel-size", "50nm", "--rms-height", "20nm", "--seed", 9,
+        "--out", gsf)
+    t = cs.read_topography(gsf, detrend="none")
+    assert t.pixel_size_m == pytest.approx((50e-9, 50e-9), rel=1e-9)
+    np.testing.assert_allclose(t.heights, cs.surface(64, 64, 50e-9, rms_height=20e-9, seed=9),
+                               rtol=1e-6, atol=1e-15)
+    with pytest.raises(cs.InputError, match="extension"):
+        (tmp_path / "s.xyz").write_text("1 2 3")
+        cs.read_topography(tmp_path / "s.xyz", pixel_size=1e-7)
