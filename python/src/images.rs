@@ -342,6 +342,19 @@ fn analyze<'py>(
         d.set_item("image", i)?;
         d.set_item("force_n", force)?;
         d.set_item("threshold", r.threshold.value)?;
+        // As the CLI's areas.csv: force / area (Pa) and the radius of a disc of that area (m).
+        let area_m2 = pixel_m2.map(|a| a * r.measurement.contact_pixels as f64);
+        d.set_item(
+            "mean_pressure_pa",
+            match (force, area_m2) {
+                (Some(f), Some(a)) if a > 0.0 => Some(f / a),
+                _ => None,
+            },
+        )?;
+        d.set_item(
+            "equivalent_radius_m",
+            area_m2.map(|a| (a / std::f64::consts::PI).sqrt()),
+        )?;
         if let Some(f) = force {
             fx.push(f);
             fy.push(pixel_m2.unwrap_or(1.0) * r.measurement.contact_pixels as f64);

@@ -76,6 +76,10 @@ def test_analyze_matches_cli(cli, series_tif, tmp_path):
     np.testing.assert_allclose(df["mean_intensity"], [float(r["mean_intensity"]) for r in rows],
                                rtol=1e-12)
     assert list(df["patches"]) == [int(r["patches"]) for r in rows]
+    np.testing.assert_allclose(df["mean_pressure_pa"] * 1e-6,
+                               [float(r["mean_pressure_MPa"]) for r in rows], rtol=1e-12)
+    np.testing.assert_allclose(df["equivalent_radius_m"] * 1e6,
+                               [float(r["equivalent_radius_um"]) for r in rows], rtol=1e-12)
     assert a.threshold == float(rows[0]["threshold"])
     summary = json.loads((tmp_path / "an" / "summary.json").read_text())
     text = json.dumps(summary)

@@ -178,7 +178,8 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
     (default), "per-image" or a fixed threshold.
 
     Returns ``rows`` (per image: ``force_n``, ``threshold``, ``contact_pixels``, ``area_m2``,
-    intensities, patches), the series ``threshold``, the ``power_law`` fit A = c·N^β (m², N)
+    ``mean_pressure_pa``, ``equivalent_radius_m``, intensities, patches), the series
+    ``threshold``, the ``power_law`` fit A = c·N^β (m², N)
     and ``warnings``; ``to_pandas()`` gives the table.
     """
     if isinstance(series, Series):
