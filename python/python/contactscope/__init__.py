@@ -1,0 +1,371 @@
+"""contactscope: real-contact-area microscopy (Weber et al., Nat. Commun. 9, 888 (2018)).
+
+numpy arrays in, numpy arrays out; the work is done by the Rust library with the GIL released.
+
+Units are SI everywhere: lengths and heights in metres (200 nm = 2e-7), forces in newtons
+(4 mN = 4e-3), pressures, moduli and hardness in pascals, the hardening coefficient k in Pa/m
+(4 MPa/nm = 4e15 Pa/m), areas in m². Dictionary keys and column names carry their unit
+(``area_m2``, ``force_n``).
+
+Errors: bad input raises :class:`InputError` (a ``ValueError``), a file that cannot be read raises
+:class:`FileError` (an ``OSError``), a solver at its iteration limit :class:`ConvergenceError`
+(a ``ValueError``); each carries the library's message.
+
+Distributed sweeps and fits on Dask: :mod:`contactscope.distributed`.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Iterable, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _contactscope as _cs
+from ._contactscope import (  # noqa: F401  (re-exported)
+    ConvergenceError,
+    FileError,
+    InputError,
+    InternalError,
+    get_num_threads,
+    set_num_threads,
+)
+
+__version__ = _cs.__version__
+
+PathLike = Union[str, "os.PathLike[str]"]
+PixelSize = Union[float, "tuple[float, float]"]
+
+__all__ = [
+    "ConvergenceError",
+    "FileError",
+    "InputError",
+    "InternalError",
+    "Results",
+    "Series",
+    "analyze",
+    "autocorrelation",
+    "blur_and_resample",
+    "compare",
+    "fit_hardening",
+    "get_num_threads",
+    "measure",
+    "misfit",
+    "newton",
+    "otsu_threshold",
+    "psf",
+    "ramp",
+    "read_image",
+    "read_series",
+    "read_topography",
+    "set_num_threads",
+    "simulate",
+    "surface",
+]
+
+
+class Results(dict):
+    """A result: a dict whose keys are also attributes; ``rows`` (one dict per image or load)
+    become a table with :meth:`to_pandas`."""
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def to_pandas(self):
+        """The per-image or per-load rows as a ``pandas.DataFrame`` (needs pandas)."""
+        try:
+            import pandas as pd
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError("to_pandas() needs pandas: pip install pandas") from e
+        return pd.DataFrame(list(self["rows"]))
+
+
+class Series(Results):
+    """A load series read from files: ``images`` (n, rows, columns) in the files' own sample type,
+    ``forces_n`` (N, ``None`` where unknown), ``paths``, ``pages``, ``pixel_size_m`` ((x, y) in m
+    or ``None``) and ``warnings``."""
+
+    def to_pandas(self):
+        import pandas as pd
+
+        return pd.DataFrame(
+            {"path": self["paths"], "page": self["pages"], "force_n": self["forces_n"]}
+        )
+
+
+_STACK_TYPES = (np.uint8, np.uint16, np.int16, np.float32, np.float64)
+
+
+def _stack(images: Any) -> np.ndarray:
+    """One image (2-D), a stack (3-D) or a list of equal 2-D images as a C-ordered 3-D array of
+    a type the library keeps as is (uint8, uint16, int16, float32, float64)."""
+    if isinstance(images, Series):
+        images = images["images"]
+    if isinstance(images, (list, tuple)):
+        images = np.stack([np.asarray(i) for i in images])
+    a = np.asarray(images)
+    if a.ndim == 2:
+        a = a[np.newaxis]
+    if a.ndim != 3:
+        raise InputError(f"images must be a 2-D image or a 3-D stack; got {a.ndim} dimensions")
+    if a.dtype.type not in _STACK_TYPES:
+        if np.issubdtype(a.dtype, np.integer) and a.size and a.min() >= 0 and a.max() <= 65535:
+            a = a.astype(np.uint16)
+        else:
+            a = a.astype(np.float64)
+    return np.ascontiguousarray(a)
+
+
+def _f64(a: Any, ndim: int, what: str) -> np.ndarray:
+    a = np.asarray(a, dtype=np.float64)
+    if ndim == 3 and a.ndim == 2:
+        a = a[np.newaxis]
+    if a.ndim != ndim:
+        raise InputError(f"{what} must be a {ndim}-D array; got {a.ndim} dimensions")
+    return np.ascontiguousarray(a)
+
+
+def read_image(path: PathLike, channel: Optional[int] = None,
+               pixel_size: Optional[PixelSize] = None) -> Results:
+    """Every page of one channel of a TIFF file.
+
+    Returns ``images`` (pages, rows, columns) as float64 in the file's intensity units,
+    ``pixel_size_m`` ((x, y) in m from the file's metadata or ``pixel_size``, m; ``None`` if
+    unknown) and ``pixel_size_source``.
+    """
+    return Results(_cs.read_image(os.fspath(path), channel, pixel_size))
+
+
+def read_series(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
+                forces: Optional[Sequence[float]] = None, channel: Optional[int] = None,
+                pixel_size: Optional[PixelSize] = None) -> Series:
+    """A load series: TIFF files and folders (natural order) or one manifest CSV (``.csv``:
+    columns ``file``, ``page``, ``force``… as for the command line).
+
+    ``forces`` (N), one per image, when the files do not come with a manifest; ``pixel_size``
+    (m, or (x, y)) overrides the files' metadata. Returns a :class:`Series`.
+    """
+    if isinstance(paths_or_manifest, (str, os.PathLike)):
+        paths = [os.fspath(paths_or_manifest)]
+    else:
+        paths = [os.fspath(p) for p in paths_or_manifest]
+    manifest = len(paths) == 1 and paths[0].lower().endswith(".csv")
+    forces = None if forces is None else [float(f) for f in forces]
+    return Series(_cs.read_series(paths, channel, forces, pixel_size, manifest))
+
+
+def otsu_threshold(images: Any) -> float:
+    """One exact Otsu (1979) threshold over the pooled histogram of all images (the paper's
+    global rule), in the images' intensity units; contact is value > threshold."""
+    return _cs.otsu_threshold(_stack(images))["threshold"]
+
+
+def measure(image: Any, threshold: float, pixel_size: Optional[PixelSize] = None) -> Results:
+    """Contact (value > ``threshold``) of one 2-D image: ``contact_pixels``, ``area_m2`` (with
+    ``pixel_size`` in m), intensities, 8-connected ``patches`` and the boolean ``mask``."""
+    return Results(_cs.measure(_stack(image), float(threshold), pixel_size))
+
+
+def analyze(series: Any, forces: Optional[Sequence[float]] = None,
+            pixel_size: Optional[PixelSize] = None,
+            method: Union[str, float, None] = None) -> Results:
+    """The paper's series analysis: one global Otsu threshold over all images, then each image
+    measured. ``series``: a :class:`Series` (its forces and pixel size are used unless given) or
+    images (2-D, 3-D stack or list). ``forces`` in N, ``pixel_size`` in m; ``method``: "otsu"
+    (default), "per-image" or a fixed threshold.
+
+    Returns ``rows`` (per image: ``force_n``, ``threshold``, ``contact_pixels``, ``area_m2``,
+    ``mean_pressure_pa``, ``equivalent_radius_m``, intensities, patches), the series
+    ``threshold``, the ``power_law`` fit A = c·N^β (m², N)
+    and ``warnings``; ``to_pandas()`` gives the table.
+    """
+    if isinstance(series, Series):
+        if forces is None and all(f is not None for f in series["forces_n"]):
+            forces = series["forces_n"]
+        if pixel_size is None:
+            pixel_size = series["pixel_size_m"]
+    forces = None if forces is None else [float(f) for f in forces]
+    return Results(_cs.analyze(_stack(series), forces, pixel_size, method))
+
+
+def psf(beads: Any, pixel_size: PixelSize, bead_diameter: Optional[float] = None,
+        saturation_level: Optional[float] = None) -> Results:
+    """The point-spread function from sub-resolution beads (one image or a z stack; pixel size
+    in m): ``sigma_m`` and ``fwhm_m`` (m; corrected for ``bead_diameter``, m, when given), the
+    per-bead results in ``beads``."""
+    return Results(_cs.psf(_f64(beads, 3, "beads"), pixel_size, bead_diameter, saturation_level))
+
+
+def autocorrelation(image: Any, pixel_size: PixelSize, max_lag: Optional[float] = None) -> Results:
+    """Radially averaged intensity autocorrelation C(r) of one image: ``lag_m`` (m), ``c``,
+    ``xi_1e_m`` (first lag with C ≤ 1/e, m) and ``first_zero_m`` (m); lags up to ``max_lag`` m
+    (default half the shorter side)."""
+    return Results(_cs.autocorrelation(_f64(image, 2, "image"), pixel_size, max_lag))
+
+
+def newton(reflection: Any, contact: Any, pixel_size: PixelSize, wavelength: float = 488e-9,
+           medium_index: float = 1.447, profiles: int = 20) -> Results:
+    """The detection gap from Newton rings (reflection image) around the fluorescent contact
+    (same field); pixel size and ``wavelength`` in m. Returns ``detection_gap_m``,
+    ``contact_radius_m``, ``sphere_radius_m``, ``edge_radius_m`` (mean and sd, m)."""
+    return Results(_cs.newton(_f64(reflection, 2, "reflection"), _f64(contact, 2, "contact"),
+                              pixel_size, wavelength, medium_index, profiles))
+
+
+def blur_and_resample(map: Any, pixel_size: PixelSize, fwhm: float,
+                      image_pixel_size: PixelSize) -> np.ndarray:
+    """A map (e.g. a simulated contact map, 1 = contact; pixel size in m) as the microscope sees
+    it: Gaussian PSF blur of FWHM ``fwhm`` (m), then integrated over image pixels of
+    ``image_pixel_size`` (m). A binary map's image sums to its area in image pixels."""
+    return _cs.blur_and_resample(_f64(map, 2, "map"), pixel_size, float(fwhm), image_pixel_size)
+
+
+def compare(micrographs: Any, forces: Sequence[float], pixel_size: PixelSize, maps: Any,
+            map_forces: Sequence[float], map_pixel_size: PixelSize, psf_fwhm: float,
+            dihedral: bool = False, upsample: int = 20, force_tolerance: float = 0.01) -> Results:
+    """Simulated contact maps (1 = contact; pixel size in m) against micrographs (pixel size in
+    m) at matching forces (N, within ``force_tolerance``): each map blurred with the PSF
+    (``psf_fwhm``, m), registered and scored. ``rows``: ``dice``, ``jaccard``, areas (m²),
+    ``edge_distance_m`` (m), ``shift_px``, ``correlation_peak``."""
+    rows = _cs.compare(_stack(micrographs), [float(f) for f in forces], pixel_size,
+                       _f64(maps, 3, "maps"), [float(f) for f in map_forces], map_pixel_size,
+                       float(psf_fwhm), dihedral, upsample, force_tolerance)
+    return Results(rows=rows)
+
+
+def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
+                    height_unit: Optional[float] = None, detrend: str = "plane") -> Results:
+    """A height map from any format contactscope reads (npy, TIFF, GSF, text, WSxM, Nanoscope,
+    Gwyddion, SPIP, X3P, Digital Surf, … by extension or content): ``heights`` (rows = y, m) and
+    ``pixel_size_m`` ((x, y), m), after ``detrend`` ("none", "mean", "plane" as the command
+    line's default). ``height_unit``: metres per stored unit for files without one."""
+    return Results(_cs.read_topography(os.fspath(path), pixel_size, height_unit, detrend))
+
+
+def surface(nx: int, ny: int, pixel_size: float, hurst: float = 0.8,
+            rms_height: Optional[float] = None, rms_slope: Optional[float] = None,
+            rolloff: Optional[float] = None, cutoff: Optional[float] = None,
+            seed: int = 0) -> np.ndarray:
+    """A seeded self-affine random surface: heights (ny, nx) in m on ``pixel_size`` m pixels,
+    Hurst exponent ``hurst``, scaled to ``rms_height`` (m) or ``rms_slope``; optional roll-off
+    and short-wavelength cutoff wavelengths (m)."""
+    return _cs.surface(nx, ny, pixel_size, hurst, rms_height, rms_slope, rolloff, cutoff, seed)
+
+
+def simulate(heights: Any, pixel_size: PixelSize, modulus: float, loads: Iterable[float],
+             model: str = "elastic", *, hardness: Optional[float] = None,
+             k: Optional[float] = None, initial_hardness: float = 0.0,
+             alpha: Optional[float] = None, radius: Optional[float] = None,
+             periodic: bool = False, tolerance: float = 1e-8, max_iterations: int = 5000,
+             maps: bool = True) -> Results:
+    """A load ramp on a rough body (heights in m, rows = y, positive towards the flat; pixel
+    size in m; a sphere of ``radius`` m is added when given) pressed on a flat of contact
+    modulus E* ``modulus`` (Pa) at normal forces ``loads`` (N, in order; the plastic state carries
+    from load to load).
+
+    Models: "elastic"; "hardness" (p ≤ ``hardness`` Pa; ``alpha`` for the volume-conserving
+    update); "hardening" (p_Y = ``initial_hardness`` + ``k``·h_pl, k in Pa/m); "gt"
+    (Greenwood–Tripp bearing area, needs ``radius``).
+
+    Returns ``rows`` (per load: ``force_n``, ``area_m2``, ``mean_pressure_pa``,
+    ``approach_m``, ``patches``, ``plastic_volume_m3``, …) and, with ``maps``, the per-load
+    stacks ``pressure`` (Pa), ``gap`` (m), ``contact`` (bool) and ``plastic`` (m), each
+    (loads, ny, nx).
+    """
+    return Results(_cs.simulate(_f64(heights, 2, "heights"), pixel_size, float(modulus),
+                                [float(f) for f in loads], model, hardness, k,
+                                initial_hardness, alpha, radius, periodic, tolerance,
+                                max_iterations, maps))
+
+
+def ramp(heights: Any, pixel_size: PixelSize, modulus: float, family: str,
+         parameter: Optional[float], loads: Sequence[float], radius: Optional[float] = None,
+         tolerance: float = 1e-8, max_iterations: int = 5000,
+         imaging_fwhm: Optional[float] = None,
+         imaging_pixel_size: Optional[PixelSize] = None) -> Results:
+    """One model evaluation of a fit (the unit of a Dask task): contact areas ``areas_m2`` (m²)
+    of one load ramp (``loads`` in N, increasing) for ``family`` ("elastic", "gt", "hardness"
+    with p_Y in Pa, "hardening" with k in Pa/m), counted as :func:`fit_hardening` counts them."""
+    return Results(_cs.ramp(_f64(heights, 2, "heights"), pixel_size, float(modulus), family,
+                            parameter, [float(f) for f in loads], radius, tolerance,
+                            max_iterations, imaging_fwhm, imaging_pixel_size))
+
+
+def misfit(forces: Sequence[float], areas: Sequence[float], simulated: Sequence[float]) -> float:
+    """RMS over the measured loads of ln(A_sim/A_exp) (forces in N, areas in m²)."""
+    return _cs.misfit([float(f) for f in forces], [float(a) for a in areas],
+                      [float(s) for s in simulated])
+
+
+def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
+                  pixel_size: PixelSize, modulus: float, radius: Optional[float] = None,
+                  family: str = "hardening", range: Optional["tuple[float, float]"] = None,
+                  grid: int = 7, ln_tolerance: float = 0.01, tolerance: float = 1e-8,
+                  max_iterations: int = 5000, imaging_fwhm: Optional[float] = None,
+                  imaging_pixel_size: Optional[PixelSize] = None, client: Any = None) -> Results:
+    """Fit a contact model to a measured area–load curve (``forces`` in N, ``areas`` in m²) on
+    the rough sphere (heights in m, pixel size in m, sphere ``radius`` in m, E* ``modulus`` in
+    Pa). "hardening" fits k (Pa/m; default range 1e14–1e17), "hardness" p_Y (Pa); "elastic"
+    and "gt" are evaluated once. Returns ``parameter``, ``parameter_se``, ``misfit``,
+    ``areas_m2`` at the best parameter and the search ``trace``.
+
+    With a ``dask.distributed`` ``client``, the model evaluations run as Dask tasks
+    (:func:`contactscope.distributed.fit_hardening`).
+    """
+    if client is not None:
+        from . import distributed
+
+        return distributed.fit_hardening(forces, areas, heights, pixel_size, modulus,
+                                         radius=radius, family=family, range=range, grid=grid,
+                                         ln_tolerance=ln_tolerance, tolerance=tolerance,
+                                         max_iterations=max_iterations,
+                                         imaging_fwhm=imaging_fwhm,
+                                         imaging_pixel_size=imaging_pixel_size, client=client)
+    return Results(_cs.fit_hardening([float(f) for f in forces], [float(a) for a in areas],
+                                     _f64(heights, 2, "heights"), pixel_size, float(modulus),
+                                     radius, family, range, grid, ln_tolerance, tolerance,
+                                     max_iterations, imaging_fwhm, imaging_pixel_size))
+
+
+# Seeded generators with known truth, and a TIFF writer (inputs for examples and tests).
+
+def synth_series(width: int = 256, height: int = 256, pixel_size: float = 200e-9,
+                 forces: Optional[Sequence[float]] = None, seed: int = 2018) -> Results:
+    """A synthetic confocal load series (12-bit values in uint16) with known truth: ``images``
+    (loads, rows, columns), ``forces_n`` (N), ``true_area_m2`` (m²) and the true masks
+    ``truth``; pixel size in m. Defaults: the bundled fixture (8 loads, 4–100 mN)."""
+    forces = None if forces is None else [float(f) for f in forces]
+    return Results(_cs.synth_series(width, height, pixel_size, forces, seed))
+
+
+def synth_beads(width: int = 128, height: int = 128, planes: int = 1, beads: int = 6,
+                sigma_px: float = 1.91, seed: int = 7) -> np.ndarray:
+    """A synthetic bead image or z stack (12-bit values in uint16), spots of σ = ``sigma_px``
+    pixels: (planes, rows, columns)."""
+    return _cs.synth_beads(width, height, planes, beads, sigma_px, seed)
+
+
+def synth_newton(width: int = 256, height: int = 256, pixel_size: float = 200e-9,
+                 contact_radius: float = 12e-6, detection_gap: float = 9e-9,
+                 seed: int = 7) -> Results:
+    """A synthetic Newton-ring ``reflection`` image and ``fluorescence`` image of one contact
+    (uint16), with the true ``detection_gap_m``, ``contact_radius_m``, ``sphere_radius_m`` (m)."""
+    return Results(_cs.synth_newton(width, height, pixel_size, contact_radius, detection_gap,
+                                    seed))
+
+
+def write_tiff(path: PathLike, stack: Any, pixel_size: Optional[PixelSize] = None) -> None:
+    """Write an image or stack (uint16 or float32; other types as float32) as a multi-page TIFF
+    with the pixel size (m) in its metadata when given."""
+    a = np.asarray(stack)
+    if a.ndim == 2:
+        a = a[np.newaxis]
+    if a.dtype != np.uint16:
+        a = a.astype(np.float32)
+    _cs.write_tiff(os.fspath(path), np.ascontiguousarray(a), pixel_size)
+
+
+__all__ += ["synth_series", "synth_beads", "synth_newton", "write_tiff"]

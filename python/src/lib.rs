@@ -1,0 +1,174 @@
+//! Python bindings of contactscope (issue 13): a thin layer over the library's in-memory
+//! algorithms (layer (a)) and its readers (layer (b)). numpy arrays in and out, SI units
+//! everywhere (metres, pascals, newtons), the GIL released while Rust computes, and library
+//! errors raised as Python exceptions that subclass `ValueError` (bad input) or `OSError`
+//! (files) and carry the library's message. A panic never reaches Python as a panic: it becomes
+//! a [`InternalError`] (a `RuntimeError`).
+//!
+//! The pure-Python package `contactscope` (python/python/contactscope) wraps these functions
+//! with result classes, `to_pandas()` and the Dask helpers (`contactscope.distributed`).
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::{Arc, Mutex};
+
+use pyo3::create_exception;
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+
+use contactscope::error::Error;
+
+mod images;
+mod mechanics;
+mod synth;
+
+create_exception!(
+    contactscope,
+    InputError,
+    PyValueError,
+    "Bad input: a value, an array or a file's content that contactscope refuses (the message says why)."
+);
+create_exception!(
+    contactscope,
+    FileError,
+    PyOSError,
+    "A file could not be opened, read or written."
+);
+create_exception!(
+    contactscope,
+    ConvergenceError,
+    PyValueError,
+    "An iterative solver stopped at its iteration limit without meeting its tolerance."
+);
+create_exception!(
+    contactscope,
+    InternalError,
+    PyRuntimeError,
+    "A bug in contactscope (a Rust panic caught at the boundary); please report it."
+);
+
+/// The library's error as the matching Python exception, with the library's message.
+pub(crate) fn to_py(e: Error) -> PyErr {
+    let message = e.to_string();
+    match e {
+        Error::Io { .. } | Error::Output { .. } => FileError::new_err(message),
+        Error::NotConverged { .. } => ConvergenceError::new_err(message),
+        _ => InputError::new_err(message),
+    }
+}
+
+/// A bad argument found here (before the library sees it).
+pub(crate) fn bad(message: impl Into<String>) -> PyErr {
+    InputError::new_err(message.into())
+}
+
+/// The thread pool Rust's parallel code runs on; `None`: rayon's global pool (all cores).
+static POOL: Mutex<Option<Arc<rayon::ThreadPool>>> = Mutex::new(None);
+
+/// Run `f` with the GIL released, on the configured thread pool, with panics caught.
+pub(crate) fn compute<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce() -> contactscope::error::Result<T> + Send,
+) -> PyResult<T> {
+    let pool = POOL.lock().map(|p| p.clone()).unwrap_or(None);
+    let outcome = py.detach(move || {
+        catch_unwind(AssertUnwindSafe(move || match pool {
+            Some(pool) => pool.install(f),
+            None => f(),
+        }))
+    });
+    match outcome {
+        Ok(result) => result.map_err(to_py),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(InternalError::new_err(format!(
+                "internal error in contactscope: {what}"
+            )))
+        }
+    }
+}
+
+/// Use `n` threads for contactscope's parallel loops in this process (0: all cores). Dask
+/// workers call this with their share of the cores so that workers do not oversubscribe them.
+#[pyfunction]
+fn set_num_threads(n: usize) -> PyResult<()> {
+    let pool = if n == 0 {
+        None
+    } else {
+        Some(Arc::new(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| bad(format!("cannot build a pool of {n} threads: {e}")))?,
+        ))
+    };
+    *POOL.lock().map_err(|_| bad("thread pool lock poisoned"))? = pool;
+    Ok(())
+}
+
+/// Threads contactscope's parallel loops use in this process.
+#[pyfunction]
+fn get_num_threads() -> usize {
+    match POOL.lock().ok().and_then(|p| p.clone()) {
+        Some(pool) => pool.current_num_threads(),
+        None => rayon::current_num_threads(),
+    }
+}
+
+/// A pixel size given as one number (square pixels) or an (x, y) pair, metres.
+#[derive(FromPyObject, Clone)]
+pub(crate) enum PixelArg {
+    /// Square pixels.
+    Square(f64),
+    /// (x, y).
+    Pair((f64, f64)),
+    /// [x, y] (a list or an array).
+    List(Vec<f64>),
+}
+
+impl PixelArg {
+    /// (x, y) in metres after checking both are finite and positive.
+    pub(crate) fn xy(self) -> PyResult<(f64, f64)> {
+        let (x, y) = match self {
+            PixelArg::Square(s) => (s, s),
+            PixelArg::Pair(p) => p,
+            PixelArg::List(v) if v.len() == 2 => (v[0], v[1]),
+            PixelArg::List(v) => {
+                return Err(bad(format!(
+                    "pixel size needs one number or two (x, y); got {}",
+                    v.len()
+                )))
+            }
+        };
+        if !(x.is_finite() && x > 0.0 && y.is_finite() && y > 0.0) {
+            return Err(bad(format!(
+                "pixel size ({x:e}, {y:e}) m must be positive and finite (metres: 200 nm is 2e-7)"
+            )));
+        }
+        Ok((x, y))
+    }
+}
+
+/// Optional pixel size → optional (x, y).
+pub(crate) fn pixel_opt(p: Option<PixelArg>) -> PyResult<Option<(f64, f64)>> {
+    p.map(PixelArg::xy).transpose()
+}
+
+#[pymodule]
+fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("InputError", py.get_type::<InputError>())?;
+    m.add("FileError", py.get_type::<FileError>())?;
+    m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    m.add("InternalError", py.get_type::<InternalError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
+    images::register(m)?;
+    mechanics::register(m)?;
+    synth::register(m)?;
+    Ok(())
+}

@@ -1,0 +1,366 @@
+"""Every API function against the command line's outputs on the same inputs, and bad input
+against the exception classes."""
+
+import csv
+import json
+import pathlib
+
+import numpy as np
+import pytest
+
+import contactscope as cs
+
+from conftest import FORCES, ROOT
+
+
+def read_csv(path):
+    with open(path, newline="", encoding="utf-8") as f:
+        return list(csv.DictReader(f))
+
+
+def test_read_image_round_trip(tmp_path):
+    stack = np.random.default_rng(1).random((3, 20, 30)).astype(np.float32)
+    cs.write_tiff(tmp_path / "f.tif", stack, (1e-7, 2e-7))
+    r = cs.read_image(tmp_path / "f.tif")
+    assert r.images.shape == (3, 20, 30)
+    assert r.images.dtype == np.float64
+    np.testing.assert_array_equal(r.images, stack.astype(np.float64))
+    assert r.pixel_size_m == pytest.approx((1e-7, 2e-7), rel=1e-6)
+    # An override replaces the file's pixel size.
+    assert cs.read_image(tmp_path / "f.tif", pixel_size=5e-8).pixel_size_m == (5e-8, 5e-8)
+
+
+def test_read_series_keeps_sample_type_and_forces(series_tif):
+    path, s = series_tif
+    r = cs.read_series(path, forces=FORCES)
+    assert r.images.dtype == np.uint16
+    np.testing.assert_array_equal(r.images, s.images)
+    assert r.forces_n == FORCES
+    assert r.pages == [0, 1, 2]
+    assert r.pixel_size_m == pytest.approx((2e-7, 2e-7))
+    assert list(r.to_pandas()["force_n"]) == FORCES
+
+
+def test_read_series_manifest_matches_cli(cli, tmp_path):
+    manifest = ROOT / "fixtures" / "synthetic-series" / "manifest.csv"
+    r = cs.read_series(manifest)
+    assert all(f is not None and f > 0 for f in r.forces_n)
+    a = cs.analyze(r)
+    cli("analyze", "--manifest", manifest, "--out", tmp_path / "an", "-q")
+    rows = read_csv(tmp_path / "an" / "areas.csv")
+    assert len(rows) == len(a.rows) == len(r.forces_n)
+    for mine, theirs in zip(a.rows, rows):
+        assert mine["force_n"] * 1e3 == pytest.approx(float(theirs["force_mN"]), rel=1e-12)
+        assert mine["contact_pixels"] == int(theirs["contact_pixels"])
+        assert mine["area_m2"] * 1e12 == pytest.approx(float(theirs["area_um2"]), rel=1e-9)
+
+
+def test_otsu_threshold_matches_cli(cli, series_tif):
+    path, s = series_tif
+    out = cli("threshold", path)
+    assert cs.otsu_threshold(s.images) == float(out.split()[0])
+    # The threshold separates: the brightest pixels are above, the darkest below.
+    t = cs.otsu_threshold(s.images)
+    assert s.images.min() < t < s.images.max()
+
+
+def test_analyze_matches_cli(cli, series_tif, tmp_path):
+    path, s = series_tif
+    cli("analyze", path, "--forces", "2,4,8mN", "--out", tmp_path / "an", "-q")
+    rows = read_csv(tmp_path / "an" / "areas.csv")
+    a = cs.analyze(cs.read_series(path, forces=FORCES))
+    df = a.to_pandas()
+    assert list(df["contact_pixels"]) == [int(r["contact_pixels"]) for r in rows]
+    np.testing.assert_allclose(df["area_m2"] * 1e12, [float(r["area_um2"]) for r in rows],
+                               rtol=1e-12)
+    np.testing.assert_allclose(df["mean_intensity"], [float(r["mean_intensity"]) for r in rows],
+                               rtol=1e-12)
+    assert list(df["patches"]) == [int(r["patches"]) for r in rows]
+    np.testing.assert_allclose(df["mean_pressure_pa"] * 1e-6,
+                               [float(r["mean_pressure_MPa"]) for r in rows], rtol=1e-12)
+    np.testing.assert_allclose(df["equivalent_radius_m"] * 1e6,
+                               [float(r["equivalent_radius_um"]) for r in rows], rtol=1e-12)
+    assert a.threshold == float(rows[0]["threshold"])
+    summary = json.loads((tmp_path / "an" / "summary.json").read_text())
+    text = json.dumps(summary)
+    assert f"{a.power_law['exponent']:.6f}"[:6] in text
+    # And the areas are near the generator's truth.
+    np.testing.assert_allclose(df["area_m2"], s.true_area_m2, rtol=0.1)
+
+
+def test_measure_agrees_with_analyze(series_tif):
+    _, s = series_tif
+    a = cs.analyze(s.images, forces=FORCES, pixel_size=2e-7)
+    for i, row in enumerate(a.rows):
+        m = cs.measure(s.images[i], a.threshold, pixel_size=2e-7)
+        assert m.contact_pixels == row["contact_pixels"] == int(m.mask.sum())
+        assert m.area_m2 == pytest.approx(row["area_m2"])
+        np.testing.assert_array_equal(m.mask, s.images[i] > a.threshold)
+
+
+def test_psf_matches_cli(cli, tmp_path):
+    beads = cs.synth_beads(seed=5)
+    cs.write_tiff(tmp_path / "beads.tif", beads, 1e-7)
+    cli("psf", tmp_path / "beads.tif", "--out", tmp_path / "psf")
+    theirs = json.loads((tmp_path / "psf" / "psf.json").read_text())
+    mine = cs.psf(beads.astype(np.float64), 1e-7, saturation_level=4095)
+    assert mine.beads_used == theirs["beads_used"]
+    assert mine.fwhm_m * 1e9 == pytest.approx(theirs["fwhm_nm_mean"], rel=1e-9)
+    # σ = 1.91 px of 100 nm: FWHM ≈ 450 nm.
+    assert mine.fwhm_m == pytest.approx(2.3548 * 1.91e-7, rel=0.03)
+
+
+def test_autocorrelation_matches_cli(cli, series_tif, tmp_path):
+    path, s = series_tif
+    cli("autocorr", path, "--out", tmp_path / "ac")
+    theirs = json.loads((tmp_path / "ac" / "autocorr.json").read_text())["images"]
+    rows = [r for r in read_csv(tmp_path / "ac" / "autocorr.csv") if r["image"].endswith("page 0")]
+    mine = cs.autocorrelation(s.images[0].astype(np.float64), 2e-7)
+    assert mine.xi_1e_m * 1e6 == pytest.approx(theirs[0]["correlation_length_um_1e"], rel=1e-9)
+    assert len(mine.c) == len(rows)
+    np.testing.assert_allclose(mine.c, [float(r["acf"]) for r in rows], atol=1e-7)
+    assert mine.c[0] == pytest.approx(1.0)
+
+
+def test_newton_matches_cli(cli, tmp_path):
+    n = cs.synth_newton(seed=3)
+    cs.write_tiff(tmp_path / "r.tif", n.reflection, 2e-7)
+    cs.write_tiff(tmp_path / "f.tif", n.fluorescence, 2e-7)
+    cli("newton", tmp_path / "r.tif", "--contact", tmp_path / "f.tif", "--out", tmp_path / "nw")
+    theirs = json.loads((tmp_path / "nw" / "newton.json").read_text())
+    mine = cs.newton(n.reflection.astype(float), n.fluorescence.astype(float), 2e-7)
+    assert mine.detection_gap_m["mean"] * 1e9 == pytest.approx(theirs["detection_gap_nm_mean"],
+                                                                 rel=1e-9)
+    assert mine.profiles_used == theirs["profiles_used"]
+    assert mine.detection_gap_m["mean"] == pytest.approx(n.detection_gap_m, abs=2e-9)
+
+
+def test_blur_and_resample_keeps_area():
+    m = np.zeros((64, 64))
+    m[20:40, 10:30] = 1.0
+    img = cs.blur_and_resample(m, 50e-9, 300e-9, 200e-9)
+    assert img.shape == (16, 16)
+    # 400 map pixels of (50 nm)² = 25 image pixels of (200 nm)²; the blur keeps the sum.
+    assert img.sum() == pytest.approx(25.0, rel=1e-6)
+    # No blur: the block average.
+    sharp = cs.blur_and_resample(m, 50e-9, 0.0, 200e-9)
+    np.testing.assert_allclose(sharp, m.reshape(16, 4, 16, 4).mean(axis=(1, 3)), atol=1e-12)
+
+
+def test_surface_matches_cli(cli, surface_npy):
+    mine = cs.surface(128, 128, 100e-9, rms_height=50e-9, seed=3)
+    theirs = np.load(surface_npy)
+    np.testing.assert_allclose(mine, theirs, rtol=0, atol=1e-20)
+    assert mine.std() == pytest.approx(50e-9, rel=1e-9)
+
+
+def test_read_topography_matches_cli(cli, surface_npy):
+    t = cs.read_topography(surface_npy, pixel_size=100e-9)
+    out = cli("topography", surface_npy, "--pixel-size", "100nm")
+    h_rms_nm = float(out.split("h_rms:")[1].split()[0])
+    assert t.heights.std() * 1e9 == pytest.approx(h_rms_nm, rel=1e-5)
+    assert t.pixel_size_m == (100e-9, 100e-9)
+    raw = cs.read_topography(surface_npy, pixel_size=100e-9, detrend="none")
+    np.testing.assert_array_equal(raw.heights, np.load(surface_npy))
+
+
+def test_simulate_matches_cli(cli, surface_npy, tmp_path):
+    out = tmp_path / "sim"
+    cli("simulate", "--topography", surface_npy, "--pixel-size", "100nm", "--radius", "20um",
+        "--modulus", "1GPa", "--model", "hardening", "--hardening", "4MPa/nm",
+        "--loads", "20,40,80uN", "--out", out, "-q")
+    rows = read_csv(out / "areas.csv")
+    h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
+    r = cs.simulate(h, 100e-9, 1e9, [20e-6, 40e-6, 80e-6], "hardening", k=4e15, radius=20e-6)
+    df = r.to_pandas()
+    np.testing.assert_allclose(df["area_m2"] * 1e12, [float(x["area_um2"]) for x in rows],
+                               rtol=1e-12)
+    np.testing.assert_allclose(df["approach_m"] * 1e6, [float(x["approach_um"]) for x in rows],
+                               rtol=1e-12)
+    assert list(df["iterations"]) == [int(x["iterations"]) for x in rows]
+    for i in range(3):
+        p = cs.read_image(out / f"load_{i + 1:03}_pressure_MPa.tif").images[0]
+        np.testing.assert_allclose(r.pressure[i] * 1e-6, p, rtol=1e-6, atol=1e-6)
+        c = cs.read_image(out / f"load_{i + 1:03}_contact.tif").images[0]
+        np.testing.assert_array_equal(r.contact[i], c > 0.5)
+        g = cs.read_image(out / f"load_{i + 1:03}_gap_um.tif").images[0]
+        np.testing.assert_allclose(r.gap[i] * 1e6, g, rtol=1e-6, atol=1e-9)
+    # Force balance: Σ p·ΔA = load.
+    assert (r.pressure.sum(axis=(1, 2)) * 1e-14) == pytest.approx([20e-6, 40e-6, 80e-6],
+                                                                  rel=1e-6)
+    assert (r.plastic >= 0).all() and r.plastic.sum() > 0
+
+
+def test_simulate_gt_and_elastic_models(surface_npy):
+    h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
+    e = cs.simulate(h, 100e-9, 1e9, [20e-6], radius=20e-6, maps=False)
+    assert "pressure" not in e and e.rows[0]["plastic_volume_m3"] == 0.0
+    gt = cs.simulate(h, 100e-9, 1e9, [20e-6, 40e-6], "gt", radius=20e-6)
+    assert gt.rows[1]["area_m2"] > gt.rows[0]["area_m2"] > 0
+    assert gt.contact.shape == (2, 128, 128)
+    # The bearing-area map is the contact; GT has no pressure field.
+    np.testing.assert_allclose(gt.contact.sum(axis=(1, 2)) * 1e-14,
+                               [r["area_m2"] for r in gt.rows], rtol=1e-12)
+    assert np.isnan(gt.pressure).all()
+
+
+def test_compare_matches_cli(cli, series_tif, tmp_path):
+    path, s = series_tif
+    sim = tmp_path / "sim"
+    topo = tmp_path / "t.npy"
+    cli("surface", "--size", 96, "--pixel-size", "200nm", "--rms-height", "100nm", "--seed", 5,
+        "--out", topo)
+    cli("simulate", "--topography", topo, "--pixel-size", "200nm", "--radius", "290um",
+        "--modulus", "2GPa", "--model", "hardening", "--hardening", "4MPa/nm",
+        "--loads", "2,4,8mN", "--out", sim, "-q")
+    cli("compare", "--experiment", path, "--forces", "2,4,8mN", "--simulation", sim,
+        "--psf-fwhm", "450nm", "--out", tmp_path / "cmp")
+    theirs = read_csv(tmp_path / "cmp" / "compare.csv")
+    maps = np.stack([cs.read_image(sim / f"load_{i:03}_contact.tif").images[0]
+                     for i in (1, 2, 3)])
+    mine = cs.compare(s.images, FORCES, 2e-7, maps, FORCES, 2e-7, 450e-9)
+    assert len(mine.rows) == len(theirs) == 3
+    dice_col = next(k for k in theirs[0] if k.startswith("dice"))
+    for m, t in zip(mine.rows, theirs):
+        assert m["dice"] == pytest.approx(float(t[dice_col]), abs=1e-5)  # CSV: 5 decimals
+        assert 0.0 <= m["dice"] <= 1.0
+
+
+def test_fit_hardening_matches_cli(cli, surface_npy, tmp_path):
+    out = tmp_path / "sim"
+    cli("simulate", "--topography", surface_npy, "--pixel-size", "100nm", "--radius", "20um",
+        "--modulus", "1GPa", "--model", "hardening", "--hardening", "4MPa/nm",
+        "--loads", "20,40,80uN", "--out", out, "-q")
+    cli("fit-hardening", "--experiment", out / "areas.csv", "--topography", surface_npy,
+        "--pixel-size", "100nm", "--radius", "20um", "--modulus", "1GPa",
+        "--models", "hardening", "--out", tmp_path / "fit", "-q")
+    theirs = json.loads((tmp_path / "fit" / "fit.json").read_text())["models"][0]
+    rows = read_csv(out / "areas.csv")
+    forces = [float(r["force_mN"]) * 1e-3 for r in rows]
+    areas = [float(r["area_um2"]) * 1e-12 for r in rows]
+    h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
+    mine = cs.fit_hardening(forces, areas, h, 100e-9, 1e9, radius=20e-6)
+    assert mine.parameter * 1e-15 == pytest.approx(theirs["k_MPa_per_nm"], rel=1e-9)
+    assert mine.misfit == pytest.approx(theirs["misfit_rms_ln_area"], rel=1e-9)
+    assert mine.parameter == pytest.approx(4e15, rel=0.1)
+
+
+def test_ramp_and_misfit_agree_with_simulate(surface_npy):
+    h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
+    loads = [20e-6, 40e-6]
+    r = cs.ramp(h, 100e-9, 1e9, "hardening", 4e15, loads, radius=20e-6)
+    s = cs.simulate(h, 100e-9, 1e9, loads, "hardening", k=4e15, radius=20e-6, maps=False)
+    np.testing.assert_allclose(r.areas_m2, [x["area_m2"] for x in s.rows], rtol=1e-12)
+    assert cs.misfit(loads, r.areas_m2, r.areas_m2) == 0.0
+    assert cs.misfit(loads, r.areas_m2, np.e * r.areas_m2) == pytest.approx(1.0)
+
+
+def test_threads_setting():
+    before = cs.get_num_threads()
+    cs.set_num_threads(1)
+    assert cs.get_num_threads() == 1
+    cs.set_num_threads(0)
+    assert cs.get_num_threads() == before or cs.get_num_threads() >= 1
+
+
+# ----- bad input → the right exception, with the library's message -----
+
+def test_missing_file_is_oserror(tmp_path):
+    with pytest.raises(cs.FileError) as e:
+        cs.read_image(tmp_path / "nope.tif")
+    assert isinstance(e.value, OSError) and "nope.tif" in str(e.value)
+    with pytest.raises(OSError):
+        cs.read_series([tmp_path / "nope.tif"], forces=[1e-3])
+    with pytest.raises(OSError):
+        cs.read_topography(tmp_path / "nope.npy", pixel_size=1e-7)
+
+
+def test_garbage_tiff_is_valueerror(tmp_path):
+    (tmp_path / "bad.tif").write_bytes(b"II*\x00garbage" * 3)
+    with pytest.raises(cs.InputError) as e:
+        cs.read_image(tmp_path / "bad.tif")
+    assert isinstance(e.value, ValueError) and "bad.tif" in str(e.value)
+
+
+@pytest.mark.parametrize("call", [
+    lambda h: cs.simulate(h, -1e-7, 1e9, [1e-6]),
+    lambda h: cs.simulate(h, 1e-7, 1e9, [1e-6], model="plastic"),
+    lambda h: cs.simulate(h, 1e-7, 1e9, [1e-6], model="hardening"),
+    lambda h: cs.simulate(h, 1e-7, -1e9, [1e-6]),
+    lambda h: cs.simulate(h, 1e-7, 1e9, []),
+    lambda h: cs.simulate(np.full((8, 8), np.nan), 1e-7, 1e9, [1e-6]),
+    lambda h: cs.simulate(h, (1e-7, 1e-7, 1e-7), 1e9, [1e-6]),
+    lambda h: cs.simulate(h, 1e-7, 1e9, [1e-6], model="gt"),
+    lambda h: cs.surface(64, 64, 1e-7),
+    lambda h: cs.surface(64, 64, 1e-7, rms_height=1e-8, hurst=2.0),
+    lambda h: cs.analyze(np.zeros((2, 8, 8), np.uint16)),
+    lambda h: cs.analyze(np.zeros((1, 0, 0), np.uint16)),
+    lambda h: cs.analyze(np.arange(64, dtype=np.uint16).reshape(1, 8, 8), forces=[1, 2]),
+    lambda h: cs.analyze(np.arange(64, dtype=np.uint16).reshape(1, 8, 8), forces=[-1.0]),
+    lambda h: cs.analyze(np.arange(64, dtype=np.uint16).reshape(1, 8, 8), method="median"),
+    lambda h: cs.analyze(np.zeros(8)),
+    lambda h: cs.measure(np.zeros((8, 8)), float("nan")),
+    lambda h: cs.autocorrelation(np.ones((16, 16)), 1e-7, max_lag=-1.0),
+    lambda h: cs.blur_and_resample(np.ones((8, 8)), 1e-7, -1.0, 2e-7),
+    lambda h: cs.psf(np.zeros((16, 16)), 1e-7),
+    lambda h: cs.fit_hardening([1e-6], [1e-12], h, 1e-7, 1e9, radius=1e-5),
+    lambda h: cs.fit_hardening([1e-6, 2e-6], [1e-12, 2e-12], h, 1e-7, 1e9, family="x"),
+    lambda h: cs.ramp(h, 1e-7, 1e9, "hardness", None, [1e-6]),
+    lambda h: cs.misfit([1e-6, 2e-6], [1e-12, 2e-12], [1e-12]),
+    lambda h: cs.read_topography("x.npy", detrend="cubic"),
+])
+def test_bad_input_is_valueerror(call):
+    h = cs.surface(32, 32, 1e-7, rms_height=1e-8, seed=1)
+    with pytest.raises(ValueError) as e:
+        call(h)
+    assert str(e.value)  # the library's message, never empty
+    assert not isinstance(e.value, cs.InternalError)
+
+
+def test_results_are_plain_data():
+    s = cs.synth_series(96, 96, 2e-7, FORCES)
+    a = cs.analyze(s.images, forces=FORCES, pixel_size=2e-7)
+    assert a["rows"] is a.rows
+    with pytest.raises(AttributeError):
+        a.nothing
+    assert pathlib.Path  # noqa: B018 (imports used)
+
+
+def test_stubs_name_every_function():
+    import ast
+
+    import contactscope._contactscope as ext
+
+    stub = pathlib.Path(cs.__file__).with_name("_contactscope.pyi")
+    tree = ast.parse(stub.read_text(encoding="utf-8"))
+    named = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    assert named == {n for n in dir(ext) if not n.startswith("_")}
+    assert set(cs.__all__) <= set(dir(cs))
+
+
+def test_float_series_matches_cli(cli, series_tif, tmp_path):
+    # Float data take the library's float histogram path (finite range, then bins).
+    _, s = series_tif
+    stack = (s.images.astype(np.float32) / 4095.0)
+    cs.write_tiff(tmp_path / "f.tif", stack, 2e-7)
+    r = cs.read_series(tmp_path / "f.tif", forces=FORCES)
+    assert r.images.dtype == np.float32
+    a = cs.analyze(r)
+    cli("analyze", tmp_path / "f.tif", "--forces", "2,4,8mN", "--out", tmp_path / "an", "-q")
+    rows = read_csv(tmp_path / "an" / "areas.csv")
+    assert [x["contact_pixels"] for x in a.rows] == [int(x["contact_pixels"]) for x in rows]
+    assert a.threshold == pytest.approx(float(rows[0]["threshold"]), rel=1e-6)
+    assert 0.0 < a.threshold < 1.0
+
+
+def test_read_topography_gsf_carries_its_pixel_size(cli, tmp_path):
+    gsf = tmp_path / "s.gsf"
+    cli("surface", "--size", 64, "--pixel-size", "50nm", "--rms-height", "20nm", "--seed", 9,
+        "--out", gsf)
+    t = cs.read_topography(gsf, detrend="none")
+    assert t.pixel_size_m == pytest.approx((50e-9, 50e-9), rel=1e-9)
+    np.testing.assert_allclose(t.heights, cs.surface(64, 64, 50e-9, rms_height=20e-9, seed=9),
+                               rtol=1e-6, atol=1e-15)
+    with pytest.raises(cs.InputError, match="extension"):
+        (tmp_path / "s.xyz").write_text("1 2 3")
+        cs.read_topography(tmp_path / "s.xyz", pixel_size=1e-7)

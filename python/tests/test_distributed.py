@@ -1,0 +1,103 @@
+"""Dask: a loopback-only LocalCluster(n_workers=2, threads_per_worker=1); sweeps and fits on it
+equal the serial path exactly, and the fit agrees with the library's own."""
+
+import math
+
+import numpy as np
+import pytest
+
+import contactscope as cs
+
+distributed = pytest.importorskip("dask.distributed")
+from contactscope import distributed as dd  # noqa: E402
+
+SPEC = dict(nx=64, ny=64, pixel_size=2e-7, rms_height=1e-7, hurst=0.8)
+LOADS = [2e-5, 4e-5, 8e-5]
+RADIUS = 20e-6
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1",
+                                       dashboard_address="127.0.0.1:0", processes=True)
+    c = distributed.Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def test_cluster_listens_on_loopback_only(client):
+    info = client.scheduler_info()
+    assert info["address"].startswith("tcp://127.0.0.1:")
+    assert len(info["workers"]) == 2
+    assert all(w.startswith("tcp://127.0.0.1:") for w in info["workers"])
+
+
+def test_sweep_equals_serial(client):
+    h = cs.surface(seed=1, **SPEC)
+    kwargs = dict(family="hardening", values=[1e15, 4e15, 16e15], heights=h,
+                  surface_spec=SPEC, seeds=[2, 3], radius=RADIUS)
+    on_dask = dd.sweep(LOADS, 2e-7, 1e9, client=client, **kwargs)
+    serial = dd.sweep(LOADS, 2e-7, 1e9, client="serial", **kwargs)
+    assert len(on_dask.rows) == len(serial.rows) == 9
+    for a, b in zip(on_dask.rows, serial.rows):
+        assert (a["surface"], a["seed"], a["parameter"]) == (b["surface"], b["seed"],
+                                                             b["parameter"])
+        np.testing.assert_array_equal(a["areas_m2"], b["areas_m2"])
+    # Each ramp is the library's: the first surface's ramp at k = 4 MPa/nm.
+    ref = cs.ramp(h, 2e-7, 1e9, "hardening", 4e15, LOADS, radius=RADIUS)
+    np.testing.assert_array_equal(on_dask.rows[1]["areas_m2"], ref.areas_m2)
+    # A softer material (smaller k) gives more area at every load.
+    assert (on_dask.rows[0]["areas_m2"] >= on_dask.rows[2]["areas_m2"]).all()
+    df = on_dask.to_pandas()
+    assert len(df) == 9 * len(LOADS)
+
+
+def test_sweep_reports_infeasible_values(client):
+    h = cs.surface(seed=1, **SPEC)
+    r = dd.sweep(LOADS, 2e-7, 1e9, family="hardness", values=[1.0, 1e9], heights=h,
+                 radius=RADIUS, client=client)
+    assert r.rows[0]["areas_m2"] is None and "exceeds" in r.rows[0]["error"]
+    assert r.rows[1]["error"] is None
+
+
+def test_fit_equals_serial_and_library(client):
+    h = cs.surface(seed=4, **SPEC)
+    truth = cs.ramp(h, 2e-7, 1e9, "hardening", 4e15, LOADS, radius=RADIUS).areas_m2
+    kwargs = dict(radius=RADIUS, grid=5)
+    on_dask = dd.fit_hardening(LOADS, truth, h, 2e-7, 1e9, client=client, **kwargs)
+    serial = dd.fit_hardening(LOADS, truth, h, 2e-7, 1e9, client="serial", **kwargs)
+    assert on_dask.parameter == serial.parameter
+    assert on_dask.misfit == serial.misfit
+    assert on_dask.trace == serial.trace
+    np.testing.assert_array_equal(on_dask.areas_m2, serial.areas_m2)
+    library = cs.fit_hardening(LOADS, truth, h, 2e-7, 1e9, **kwargs)
+    # Both searches end in the same misfit valley (areas are whole pixels, so the valley is flat).
+    assert on_dask.misfit <= library.misfit + 1e-3
+    assert math.log(on_dask.parameter / library.parameter) == pytest.approx(0.0, abs=0.1)
+    assert on_dask.parameter == pytest.approx(4e15, rel=0.2)
+    # The client= argument of the top-level function goes the same way.
+    via_top = cs.fit_hardening(LOADS, truth, h, 2e-7, 1e9, client=client, **kwargs)
+    assert via_top.parameter == on_dask.parameter
+
+
+def test_fit_bad_input_fails_before_tasks():
+    h = cs.surface(seed=4, **SPEC)
+    with pytest.raises(ValueError):
+        dd.fit_hardening([1e-5], [1e-12], h, 2e-7, 1e9, client="serial")
+    with pytest.raises(ValueError):
+        dd.fit_hardening(LOADS, [1e-12] * 3, h, 2e-7, 1e9, family="plastic", client="serial")
+    with pytest.raises(ValueError):
+        dd.sweep(LOADS, 2e-7, 1e9, client="serial")
+
+
+def test_brent_finds_minimum():
+    calls = []
+
+    def f(x):
+        calls.append(x)
+        return (x - 0.3) ** 2 + 1.0
+
+    x = dd.brent_minimum(f, -1.0, 2.0, 1e-6)
+    assert x == pytest.approx(0.3, abs=1e-5)
+    assert len(calls) < 30
