@@ -192,3 +192,41 @@ fn channel_by_name_for_simulate_and_fit_hardening() {
     let e = one_line_error(&args);
     assert!(e.contains("no channel 'Nope'"), "{e}");
 }
+
+/// Gwyddion's `test.gwy` has no units: its 1 m pixels are outside the plausible range. The
+/// summary as stored is still printed (the "every file gives its statistics"), with
+/// the reason as a note; `simulate` refuses it with one line, and `--pixel-size` is the way out.
+#[test]
+fn implausible_pixel_size_is_summarised_and_refused_for_contact() {
+    let Some(dir) = shared_data("real-formats") else {
+        return;
+    };
+    let gwy = dir.join("gwy/test.gwy");
+    let o = run_ok(&["topography", s(&gwy), "--json"]);
+    let t: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((t["nx"].as_u64(), t["ny"].as_u64()), (Some(128), Some(128)));
+    assert_eq!(t["pixel_size_um"]["x"].as_f64(), Some(1e6));
+    let note = t["note"].as_str().unwrap_or_default();
+    assert!(note.contains("pixel size"), "{t}");
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("sim");
+    let e = one_line_error(&[
+        "simulate",
+        "--topography",
+        s(&gwy),
+        "--modulus",
+        "3GPa",
+        "--model",
+        "elastic",
+        "--loads",
+        "0.1mN",
+        "--out",
+        s(&out),
+    ]);
+    assert!(e.contains("test.gwy") && e.contains("pixel size"), "{e}");
+    assert!(!out.exists());
+    // With a pixel size given, the map is usable.
+    let o = run_ok(&["topography", s(&gwy), "--pixel-size", "100nm", "--json"]);
+    let t: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(t["note"].is_null(), "{t}");
+}

@@ -77,11 +77,13 @@ pub fn run_topography(request: &TopographyRequest) -> Result<TopographyOutcome> 
                 note: None,
             })
         }
-        Err(e) if summary.valid_points < summary.nx * summary.ny => Ok(TopographyOutcome {
+        // Only a vendor map gets here with an error (invalid points, or a pixel size or heights
+        // outside the plausible ranges): its summary as stored still stands, with the reason
+        // it cannot be used for a contact calculation.
+        Err(e) => Ok(TopographyOutcome {
             summary,
             detrended: None,
             note: Some(e.to_string()),
         }),
-        Err(e) => Err(e),
     }
 }
