@@ -2,6 +2,7 @@
 //! analysis, the PSF, the autocorrelation, Newton rings, the microscope's blur and the comparison
 //! of simulated maps with micrographs. Lengths in metres, forces in newtons.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use ndarray::{Array2, Array3};
@@ -13,8 +14,8 @@ use contactscope::analysis::fit::fit_power_law;
 use contactscope::analysis::{self, AnalysisOptions, PlaneSource};
 use contactscope::compare::{compare_maps, CompareSettings, Micrograph, Micrographs, SimulatedMap};
 use contactscope::image::{Image, PixelSize, PixelSizeSource, Plane, SampleType, Samples};
+use contactscope::io::microscopy::select::{read_images, LoadAxis, Selection};
 use contactscope::io::series::{self, Series};
-use contactscope::io::tiff::read_pages;
 use contactscope::numerics::stats::MeanSd;
 use contactscope::optics::blur::{microscope_image, Grid};
 use contactscope::optics::newton::{analyse, NewtonOptions};
@@ -125,18 +126,58 @@ fn pixel_size_dict<'py>(py: Python<'py>, p: Option<PixelSize>) -> PyResult<Bound
     })
 }
 
-/// Every page of one channel of a TIFF file as float64 (pages, rows, columns), with the pixel
-/// size (m) from the file or `pixel_size`.
+/// The selection of a CZI, ND2 or LIF file (and the channel of a TIFF), as the command line's
+/// `--series`, `--channel`, `--z`, `--t` and `--axis NAME=INDEX`.
+fn selection(
+    series: Option<usize>,
+    channel: Option<usize>,
+    z: Option<usize>,
+    t: Option<usize>,
+    axes: Option<BTreeMap<String, usize>>,
+) -> Selection {
+    Selection {
+        series,
+        channel,
+        z,
+        t,
+        extra: axes.unwrap_or_default(),
+    }
+}
+
+/// `"t"`, `"z"` or `"series"` as the command line's `--load-axis`.
+fn load_axis_of(name: Option<&str>) -> PyResult<Option<LoadAxis>> {
+    match name {
+        None => Ok(None),
+        Some("t") => Ok(Some(LoadAxis::T)),
+        Some("z") => Ok(Some(LoadAxis::Z)),
+        Some("series") => Ok(Some(LoadAxis::Series)),
+        Some(other) => Err(bad(format!(
+            "load_axis '{other}' is not one of t, z, series"
+        ))),
+    }
+}
+
+/// Images of a TIFF (every page of one channel) or of a CZI, ND2 or LIF file (the plane the
+/// selection names, or every plane along `load_axis`) as float64 (images, rows, columns), with
+/// the pixel size (m) from the file or `pixel_size`.
 #[pyfunction]
-#[pyo3(signature = (path, channel=None, pixel_size=None))]
+#[pyo3(signature = (path, channel=None, pixel_size=None, series=None, z=None, t=None, axes=None, load_axis=None))]
+#[allow(clippy::too_many_arguments)]
 fn read_image<'py>(
     py: Python<'py>,
     path: PathBuf,
     channel: Option<usize>,
     pixel_size: Option<PixelArg>,
+    series: Option<usize>,
+    z: Option<usize>,
+    t: Option<usize>,
+    axes: Option<BTreeMap<String, usize>>,
+    load_axis: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let px = pixel_opt(pixel_size)?;
-    let pages = compute(py, || read_pages(&path, channel, px))?;
+    let along = load_axis_of(load_axis)?;
+    let chosen = selection(series, channel, z, t, axes);
+    let pages = compute(py, || read_images(&path, &chosen, along, px))?;
     let (h, w) = (pages[0].height, pages[0].width);
     let values: Vec<f64> = pages
         .iter()
@@ -155,10 +196,13 @@ fn read_image<'py>(
     Ok(d)
 }
 
-/// A load series from files (or folders, in natural order) or a manifest CSV: the planes in
-/// their own sample type, forces (N), file and page of each image and the pixel size (m).
+/// A load series from files (TIFF, CZI, ND2, LIF; folders in natural order) or a manifest CSV:
+/// the planes in their own sample type, forces (N), file and page of each image and the pixel
+/// size (m). A vendor file gives the plane its selection names, or every plane along
+/// `load_axis` (one load each).
 #[pyfunction]
-#[pyo3(signature = (inputs, channel=None, forces=None, pixel_size=None, manifest=false))]
+#[pyo3(signature = (inputs, channel=None, forces=None, pixel_size=None, manifest=false, series=None, z=None, t=None, axes=None, load_axis=None))]
+#[allow(clippy::too_many_arguments)]
 fn read_series<'py>(
     py: Python<'py>,
     inputs: Vec<PathBuf>,
@@ -166,8 +210,15 @@ fn read_series<'py>(
     forces: Option<Vec<f64>>,
     pixel_size: Option<PixelArg>,
     manifest: bool,
+    series: Option<usize>,
+    z: Option<usize>,
+    t: Option<usize>,
+    axes: Option<BTreeMap<String, usize>>,
+    load_axis: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let px = pixel_opt(pixel_size)?;
+    let along = load_axis_of(load_axis)?;
+    let chosen = selection(series, channel, z, t, axes);
     let (series, planes, size, warnings) = compute(py, move || {
         let mut series: Series = if manifest {
             if inputs.len() != 1 {
@@ -175,9 +226,9 @@ fn read_series<'py>(
                     "give one manifest".into(),
                 ));
             }
-            series::from_manifest(&inputs[0], channel)?
+            series::from_manifest_selected(&inputs[0], &chosen, along)?
         } else {
-            series::from_files(&inputs, channel)?
+            series::from_files_selected(&inputs, &chosen, along)?
         };
         if let Some(f) = &forces {
             series::assign_forces(&mut series, f)?;

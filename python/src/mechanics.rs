@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use contactscope::error::{Error, Result};
-use contactscope::io::topography::read_topography as read_height_map;
+use contactscope::io::topography::{FillInvalid, TopographySource};
 use contactscope::measure::patches::count_patches;
 use contactscope::model_fit::{fit_parameter, Family, Imaging, Measured, ModelBody, Search};
 use contactscope::solver::cg::SolverOptions;
@@ -46,27 +46,44 @@ fn heights_to_py<'py>(py: Python<'py>, t: Topography) -> Bound<'py, PyAny> {
 }
 
 /// Read a height map of any format contactscope reads (npy, TIFF, GSF, text, WSxM, Nanoscope
-/// and the vendor AFM formats recognised by content), in m, with its pixel size (m), then
-/// detrend it ("none", "mean" or "plane", the command line's default).
+/// and the vendor AFM and profilometer formats recognised by content), in m, with its pixel
+/// size (m), then detrend it ("none", "mean" or "plane", the command line's default). `channel`
+/// names the channel of a multi-channel vendor file (default: its height channel); a map with
+/// invalid points is refused unless `fill_invalid` is "mean" or "nearest" (the notes say how
+/// many were filled).
 #[pyfunction]
-#[pyo3(signature = (path, pixel_size=None, height_unit=None, detrend="plane"))]
+#[pyo3(signature = (path, pixel_size=None, height_unit=None, detrend="plane", channel=None, fill_invalid=None))]
 fn read_topography<'py>(
     py: Python<'py>,
     path: PathBuf,
     pixel_size: Option<PixelArg>,
     height_unit: Option<f64>,
     detrend: &str,
+    channel: Option<String>,
+    fill_invalid: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let px = crate::pixel_opt(pixel_size)?;
-    let detrend = detrend_of(detrend)?;
-    let t = compute(py, move || {
-        let mut t = read_height_map(&path, px, height_unit)?;
-        t.detrend(detrend);
-        Ok(t)
-    })?;
+    let source = TopographySource {
+        path,
+        pixel_size_m: crate::pixel_opt(pixel_size)?,
+        height_unit_m: height_unit,
+        detrend: detrend_of(detrend)?,
+        channel,
+        fill_invalid: match fill_invalid {
+            None => None,
+            Some("mean") => Some(FillInvalid::Mean),
+            Some("nearest") => Some(FillInvalid::Nearest),
+            Some(other) => {
+                return Err(bad(format!(
+                    "fill_invalid '{other}' is not one of mean, nearest"
+                )))
+            }
+        },
+    };
+    let (t, notes) = compute(py, move || source.read_with_notes())?;
     let d = PyDict::new(py);
     d.set_item("pixel_size_m", (t.dx_m, t.dy_m))?;
     d.set_item("heights", heights_to_py(py, t))?;
+    d.set_item("notes", notes)?;
     Ok(d)
 }
 

@@ -17,7 +17,7 @@ Distributed sweeps and fits on Dask: :mod:`contactscope.distributed`.
 from __future__ import annotations
 
 import os
-from typing import Any, Iterable, Optional, Sequence, Union
+from typing import Any, Dict, Iterable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -129,24 +129,37 @@ def _f64(a: Any, ndim: int, what: str) -> np.ndarray:
 
 
 def read_image(path: PathLike, channel: Optional[int] = None,
-               pixel_size: Optional[PixelSize] = None) -> Results:
-    """Every page of one channel of a TIFF file.
+               pixel_size: Optional[PixelSize] = None, *, series: Optional[int] = None,
+               z: Optional[int] = None, t: Optional[int] = None,
+               axes: Optional[Dict[str, int]] = None,
+               load_axis: Optional[str] = None) -> Results:
+    """Images of a TIFF (every page of one channel) or of a Zeiss CZI, Nikon ND2 or Leica LIF
+    file (found by content).
 
-    Returns ``images`` (pages, rows, columns) as float64 in the file's intensity units,
+    A vendor file gives the plane that ``series``, ``channel``, ``z``, ``t`` and ``axes`` (extra
+    axes by name, e.g. ``{"H": 3}`` for an Airyscan phase) select, index 0 where not given, or
+    every plane along ``load_axis`` ("t", "z" or "series") — as the command line's selection
+    flags. Returns ``images`` (images, rows, columns) as float64 in the file's intensity units,
     ``pixel_size_m`` ((x, y) in m from the file's metadata or ``pixel_size``, m; ``None`` if
     unknown) and ``pixel_size_source``.
     """
-    return Results(_cs.read_image(os.fspath(path), channel, pixel_size))
+    return Results(_cs.read_image(os.fspath(path), channel, pixel_size, series, z, t, axes,
+                                  load_axis))
 
 
 def read_series(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
                 forces: Optional[Sequence[float]] = None, channel: Optional[int] = None,
-                pixel_size: Optional[PixelSize] = None) -> Series:
-    """A load series: TIFF files and folders (natural order) or one manifest CSV (``.csv``:
-    columns ``file``, ``page``, ``force``… as for the command line).
+                pixel_size: Optional[PixelSize] = None, *, series: Optional[int] = None,
+                z: Optional[int] = None, t: Optional[int] = None,
+                axes: Optional[Dict[str, int]] = None,
+                load_axis: Optional[str] = None) -> Series:
+    """A load series: TIFF, CZI, ND2 or LIF files and folders (natural order) or one manifest
+    CSV (``.csv``: columns ``file``, ``page``, ``force``… as for the command line).
 
     ``forces`` (N), one per image, when the files do not come with a manifest; ``pixel_size``
-    (m, or (x, y)) overrides the files' metadata. Returns a :class:`Series`.
+    (m, or (x, y)) overrides the files' metadata. A vendor file contributes the plane its
+    selection (``series``, ``channel``, ``z``, ``t``, ``axes``) names, or one image per plane
+    along ``load_axis`` ("t", "z" or "series"). Returns a :class:`Series`.
     """
     if isinstance(paths_or_manifest, (str, os.PathLike)):
         paths = [os.fspath(paths_or_manifest)]
@@ -154,7 +167,8 @@ def read_series(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
         paths = [os.fspath(p) for p in paths_or_manifest]
     manifest = len(paths) == 1 and paths[0].lower().endswith(".csv")
     forces = None if forces is None else [float(f) for f in forces]
-    return Series(_cs.read_series(paths, channel, forces, pixel_size, manifest))
+    return Series(_cs.read_series(paths, channel, forces, pixel_size, manifest, series, z, t,
+                                  axes, load_axis))
 
 
 def otsu_threshold(images: Any) -> float:
@@ -237,12 +251,19 @@ def compare(micrographs: Any, forces: Sequence[float], pixel_size: PixelSize, ma
 
 
 def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
-                    height_unit: Optional[float] = None, detrend: str = "plane") -> Results:
+                    height_unit: Optional[float] = None, detrend: str = "plane", *,
+                    channel: Optional[str] = None,
+                    fill_invalid: Optional[str] = None) -> Results:
     """A height map from any format contactscope reads (npy, TIFF, GSF, text, WSxM, Nanoscope,
-    Gwyddion, SPIP, X3P, Digital Surf, … by extension or content): ``heights`` (rows = y, m) and
+    Igor ibw, Nanosurf nid, PicoView mi, Park TIFF, Gwyddion, X3P, SDF, Wyko opd, Sensofar plu,
+    Digital Surf sur, FRT … by extension or content): ``heights`` (rows = y, m) and
     ``pixel_size_m`` ((x, y), m), after ``detrend`` ("none", "mean", "plane" as the command
-    line's default). ``height_unit``: metres per stored unit for files without one."""
-    return Results(_cs.read_topography(os.fspath(path), pixel_size, height_unit, detrend))
+    line's default). ``height_unit``: metres per stored unit for files without one.
+    ``channel`` names the channel of a multi-channel file (default: its height channel). A map
+    with invalid (unmeasured) points raises :class:`InputError` unless ``fill_invalid`` is
+    "mean" or "nearest"; ``notes`` then says how many points were filled."""
+    return Results(_cs.read_topography(os.fspath(path), pixel_size, height_unit, detrend,
+                                       channel, fill_invalid))
 
 
 def surface(nx: int, ny: int, pixel_size: float, hurst: float = 0.8,

@@ -31,7 +31,14 @@ def get_num_threads() -> int: ...
 
 # Micrographs
 def read_image(
-    path: Path, channel: Optional[int] = None, pixel_size: Optional[PixelSize] = None
+    path: Path,
+    channel: Optional[int] = None,
+    pixel_size: Optional[PixelSize] = None,
+    series: Optional[int] = None,
+    z: Optional[int] = None,
+    t: Optional[int] = None,
+    axes: Optional[Dict[str, int]] = None,
+    load_axis: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def read_series(
     inputs: Sequence[Path],
@@ -39,6 +46,11 @@ def read_series(
     forces: Optional[Sequence[float]] = None,
     pixel_size: Optional[PixelSize] = None,
     manifest: bool = False,
+    series: Optional[int] = None,
+    z: Optional[int] = None,
+    t: Optional[int] = None,
+    axes: Optional[Dict[str, int]] = None,
+    load_axis: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def otsu_threshold(images: Stack) -> Dict[str, Any]: ...
 def measure(
@@ -89,6 +101,8 @@ def read_topography(
     pixel_size: Optional[PixelSize] = None,
     height_unit: Optional[float] = None,
     detrend: str = "plane",
+    channel: Optional[str] = None,
+    fill_invalid: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def surface(
     nx: int,

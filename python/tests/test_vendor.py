@@ -1,0 +1,74 @@
+"""Vendor files through the Python readers (issue 14: "the Python reader once it exists"): the
+real CZI and AFM samples beside the checkout (``../shared/data``; skipped when absent), checked
+against the command line's ``info --json --stats`` and ``topography --json`` on the same files."""
+
+import json
+
+import numpy as np
+import pytest
+
+import contactscope as cs
+from conftest import ROOT
+
+REAL = ROOT.parent / "shared" / "data" / "real-formats"
+
+
+def sample(relative):
+    path = REAL / relative
+    if not path.exists():
+        pytest.skip(f"{path} not found (the shared test data sits beside the checkout)")
+    return path
+
+
+def test_czi_planes_along_t_match_cli_stats(cli):
+    czi = sample("czi/CellDivision_T3_Z5_CH2_X240_Y170.czi")
+    r = cs.read_image(czi, channel=1, z=2, load_axis="t")
+    assert r.images.shape == (3, 170, 240)
+    info = json.loads(cli("info", czi, "--json", "--stats"))
+    planes = [p for p in info["series"][0]["planes"] if p["z"] == 2 and p["c"] == 1]
+    assert [p["t"] for p in planes] == [0, 1, 2]
+    for image, p in zip(r.images, planes):
+        assert (image.min(), image.max(), image.sum()) == (p["min"], p["max"], p["sum"])
+    px = info["series"][0]["pixel_size_um"]
+    assert r.pixel_size_m == pytest.approx((px["x"] * 1e-6, px["y"] * 1e-6), rel=1e-12)
+    # One plane by its selection equals the same plane of the load axis.
+    one = cs.read_image(czi, channel=1, z=2, t=1).images
+    np.testing.assert_array_equal(one[0], r.images[1])
+    # The same file as a load series: integer samples kept, one image per time point.
+    s = cs.read_series(czi, forces=[4e-3, 40e-3, 400e-3], channel=1, z=2, load_axis="t")
+    assert s.images.dtype == np.uint16 and s.images.shape == (3, 170, 240)
+    np.testing.assert_array_equal(s.images, r.images.astype(np.uint16))
+
+
+def test_czi_selection_errors_are_input_errors():
+    czi = sample("czi/CellDivision_T3_Z5_CH2_X240_Y170.czi")
+    with pytest.raises(cs.InputError, match="CellDivision"):
+        cs.read_image(czi, channel=7)
+    with pytest.raises(cs.InputError, match="load_axis"):
+        cs.read_image(czi, load_axis="w")
+
+
+def test_vendor_height_maps_match_cli(cli):
+    ibw = sample("ibw/spot_1-1000nm.ibw")
+    t = cs.read_topography(ibw, channel="HeightTrace", detrend="none")
+    summary = json.loads(cli("topography", ibw, "--json", "--channel", "HeightTrace"))
+    assert t.heights.shape == (summary["ny"], summary["nx"])
+    assert t.heights.std() * 1e6 == pytest.approx(summary["h_rms_um"], rel=1e-6)
+    assert t.pixel_size_m[0] * 1e6 == pytest.approx(summary["pixel_size_um"]["x"], rel=1e-12)
+    with pytest.raises(cs.InputError, match="channel"):
+        cs.read_topography(ibw, channel="NoSuchChannel")
+
+
+def test_invalid_points_refused_unless_filled(cli):
+    opd = sample("opd/opd-1.opd")
+    with pytest.raises(cs.InputError, match="invalid"):
+        cs.read_topography(opd)
+    t = cs.read_topography(opd, fill_invalid="mean", detrend="none")
+    summary = json.loads(cli("topography", opd, "--json"))
+    invalid = summary["nx"] * summary["ny"] - summary["valid_points"]
+    assert invalid > 0 and str(invalid) in t.notes[0]
+    assert np.isfinite(t.heights).all()
+    # Filled with the mean of the valid heights: the mean is unchanged.
+    assert t.heights.mean() * 1e6 == pytest.approx(summary["height_mean_um"], rel=1e-9)
+    with pytest.raises(cs.InputError, match="fill_invalid"):
+        cs.read_topography(opd, fill_invalid="zero")
