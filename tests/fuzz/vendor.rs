@@ -134,7 +134,10 @@ pub const TEMPLATES: &[Template] = &[
     info!("czi-info", "vendor/t.czi"),
     info!("real-czi-info", "real/newCZI_compressed.czi"),
     info!("real-nd2-info", "real/cluster.nd2"),
-    info!("real-lif-info", "real/LeicaLASX_wavelength-sweep_example.lif"),
+    info!(
+        "real-lif-info",
+        "real/LeicaLASX_wavelength-sweep_example.lif"
+    ),
     topo!("real-sdf", "real/sdf-1.sdf"),
     topo!("real-gwy", "real/test.gwy"),
     topo!("real-frt", "real/frt-2.frt"),
