@@ -194,6 +194,62 @@ fn absurd_sizes_on_the_command_line_are_refused() {
     );
 }
 
+/// Fuzz seed 7 (30 000 cases): `--upsample 4294967296` asked for 51 GB, `18446744073709551615`
+/// overflowed a capacity; a squeeze row of 1e308 mN printed E* = inf.
+#[test]
+fn registration_upsampling_and_squeeze_numbers_are_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for n in ["0", "101", "4294967296", "18446744073709551615"] {
+        refused_in(
+            d,
+            &[
+                "compare",
+                "--experiment",
+                "exp.tif",
+                "--forces",
+                "1mN",
+                "--simulation",
+                "sim",
+                "--psf-fwhm",
+                "450nm",
+                "--upsample",
+                n,
+                "--out",
+                "out",
+            ],
+            1,
+            &["--upsample", "1 to 100"],
+        );
+    }
+    // R = 290 µm, E* = 3.7 MPa: 2δ from F, then one absurd force or vanishing displacements.
+    let rows = |f: &dyn Fn(usize) -> (String, String)| {
+        let mut text = String::from("force_mN,displacement_um\n");
+        for i in 1..=8 {
+            let (force, disp) = f(i);
+            text.push_str(&format!("{force},{disp}\n"));
+        }
+        text
+    };
+    let hertz = |force: f64| 2.0 * (9.0 * force * force / (16.0 * 290e-6 * 3.7e6 * 3.7e6)).cbrt();
+    let absurd = rows(&|i| {
+        let f = 0.5e-3 * i as f64;
+        let force = if i == 8 {
+            "1e308".to_string()
+        } else {
+            (f * 1e3).to_string()
+        };
+        (force, (hertz(f) * 1e6).to_string())
+    });
+    fs::write(d.join("absurd.csv"), absurd).unwrap();
+    let args = ["hertz", "absurd.csv", "--radius", "290um", "--out", "out"];
+    refused_in(d, &args, 1, &["absurd.csv", "line 9", "force_mN"]);
+    let tiny = rows(&|i| ((0.5 * i as f64).to_string(), format!("{i}e-290")));
+    fs::write(d.join("tiny.csv"), tiny).unwrap();
+    let args = ["hertz", "tiny.csv", "--radius", "290um", "--out", "out"];
+    refused_in(d, &args, 1, &["no finite Hertz fit"]);
+}
+
 #[test]
 fn usage_errors_are_one_line_and_negative_values_reach_the_range_check() {
     let dir = tempfile::tempdir().unwrap();

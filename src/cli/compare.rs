@@ -8,6 +8,7 @@ use contactscope::compare::CompareSettings;
 use contactscope::io::results::fwhm_from_psf_json;
 use contactscope::io::units::{self, Dimension};
 use contactscope::jobs::compare::{run_compare, CompareRequest, ExperimentInput};
+use contactscope::spectral::register::MAX_UPSAMPLE;
 
 use super::args::{default_out, fraction, LoadAxisArg, OutputFolder, PixelSizeArg, SelectionArgs};
 use super::{command_line, print_warnings, print_written};
@@ -43,7 +44,7 @@ pub struct Args {
     /// Also try mirror images and 90° rotations when registering.
     #[arg(long)]
     dihedral: bool,
-    /// Sub-pixel registration resolution: 1/N pixel.
+    /// Sub-pixel registration resolution: 1/N pixel (N from 1 to 100).
     #[arg(long, default_value_t = 20)]
     upsample: usize,
     /// Largest relative force difference for loads to match (e.g. 1% or 0.01).
@@ -78,8 +79,11 @@ pub fn run(args: Args) -> Result<()> {
         )?,
         (None, None) => bail!("give --psf psf.json or --psf-fwhm"),
     };
-    if args.upsample == 0 {
-        bail!("--upsample must be at least 1");
+    if !(1..=MAX_UPSAMPLE).contains(&args.upsample) {
+        bail!(
+            "--upsample {}: give 1 to {MAX_UPSAMPLE} (a sub-pixel resolution of 1/N pixel)",
+            args.upsample
+        );
     }
     let request = CompareRequest {
         experiment,

@@ -13,6 +13,10 @@
 //! * **normal force** (optional): `normal_force_mN` or `normal_force_N`; its median is the
 //!   trace's N. Without it the caller's N (`--normal-force`) is used; neither is an error.
 //!
+//! Values beyond plausible bounds (forces ±100 N, torques ±100 N·m, displacements ±1 m, angles
+//! ±10⁶ rad, times ±10⁹ s) are refused with their line: they are unit mistakes or corruption,
+//! and would overflow what is computed from them.
+//!
 //! Other columns are ignored, except names that start like a known quantity (`friction_`,
 //! `torque_`, `normal_force_`, `time_`, `displacement_`, `angle_`) with an unknown unit, which
 //! are refused rather than silently skipped. Lines starting with `#` are comments.
@@ -25,6 +29,7 @@
 
 use std::path::Path;
 
+use super::ranges::Quantity;
 use super::table::Table;
 use crate::error::{Error, Location, Result};
 use crate::mechanics::friction::{Trace, XAxis, MIN_SAMPLES};
@@ -34,6 +39,22 @@ use crate::numerics::stats::median;
 const FRICTION_COLUMNS: [(&str, f64); 2] = [("friction_mN", 1e-3), ("friction_N", 1.0)];
 const TORQUE_COLUMNS: [(&str, f64); 2] = [("torque_mNm", 1e-3), ("torque_Nm", 1.0)];
 const NORMAL_COLUMNS: [(&str, f64); 2] = [("normal_force_mN", 1e-3), ("normal_force_N", 1.0)];
+/// Largest |force| read, N (the plausible force range of `io::ranges`).
+const MAX_FORCE_N: f64 = Quantity::Force.range().1;
+/// Largest |torque| read, N·m.
+const MAX_TORQUE_NM: f64 = 100.0;
+/// Largest |displacement| read, m.
+const MAX_DISPLACEMENT_M: f64 = 1.0;
+
+/// Largest |x| of a trace, SI.
+fn max_x(axis: XAxis) -> f64 {
+    match axis {
+        XAxis::Displacement => MAX_DISPLACEMENT_M,
+        XAxis::Angle => 1e6,
+        XAxis::Time => 1e9,
+    }
+}
+
 const QUANTITY_STEMS: [&str; 6] = [
     "friction_",
     "torque_",
@@ -52,10 +73,10 @@ pub fn read_trace(path: &Path, rotation_radius_m: Option<f64>) -> Result<Trace> 
         .into_iter()
         .find(|a| table.header().iter().any(|h| h == a.column()))
         .ok_or_else(|| table.missing("x", &XAxis::ALL.map(XAxis::column)))?;
-    let x = table.numbers(x_axis.column(), x_axis.si_per_unit())?;
+    let x = table.numbers_within(x_axis.column(), x_axis.si_per_unit(), max_x(x_axis))?;
     let friction_n = friction_column(&table, rotation_radius_m)?;
     let normal_force_n = match pick(&table, &NORMAL_COLUMNS)? {
-        Some((name, factor)) => Some(median(&table.numbers(name, factor)?)),
+        Some((name, factor)) => Some(median(&table.numbers_within(name, factor, MAX_FORCE_N)?)),
         None => None,
     };
     if table.len() < MIN_SAMPLES {
@@ -128,7 +149,7 @@ fn friction_column(table: &Table, rotation_radius_m: Option<f64>) -> Result<Vec<
             table.location(),
             format!("both {f} and {t}; keep one friction column"),
         )),
-        (Some((name, factor)), None) => table.numbers(name, factor),
+        (Some((name, factor)), None) => table.numbers_within(name, factor, MAX_FORCE_N),
         (None, Some((name, factor))) => {
             let r = rotation_radius_m.ok_or_else(|| {
                 Error::bad_input(
@@ -144,7 +165,11 @@ fn friction_column(table: &Table, rotation_radius_m: Option<f64>) -> Result<Vec<
                 )));
             }
             // F = T / r: the sphere sits at distance r from the rheometer axis (paper, Methods).
-            Ok(table.numbers(name, factor)?.iter().map(|t| t / r).collect())
+            Ok(table
+                .numbers_within(name, factor, MAX_TORQUE_NM)?
+                .iter()
+                .map(|t| t / r)
+                .collect())
         }
         (None, None) => {
             let accepted: Vec<&str> = FRICTION_COLUMNS
@@ -171,8 +196,8 @@ pub fn read_squeeze(path: &Path) -> Result<Vec<SqueezePoint>> {
     if table.one_of(&["displacement_um"])?.is_none() {
         return Err(table.missing("displacement", &["displacement_um"]));
     }
-    let forces = table.numbers(force_column, factor)?;
-    let displacements = table.numbers("displacement_um", 1e-6)?;
+    let forces = table.numbers_within(force_column, factor, MAX_FORCE_N)?;
+    let displacements = table.numbers_within("displacement_um", 1e-6, MAX_DISPLACEMENT_M)?;
     let points: Vec<SqueezePoint> = forces
         .iter()
         .zip(&displacements)

@@ -35,7 +35,7 @@ pub enum Quantity {
 
 impl Quantity {
     /// (lowest, highest), SI, both included.
-    pub fn range(self) -> (f64, f64) {
+    pub const fn range(self) -> (f64, f64) {
         match self {
             Quantity::Force => (1e-9, 100.0),
             Quantity::PixelSize => (1e-10, 1e-3),

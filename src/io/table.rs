@@ -125,6 +125,24 @@ impl Table {
     }
 
     /// File line of data row `k` (for messages).
+    /// [`Self::numbers`], each also within ±`max_abs` (SI, after `factor`): a plausibility
+    /// bound that keeps absurd values (1e308 mN) from overflowing what is computed from them.
+    pub(crate) fn numbers_within(&self, name: &str, factor: f64, max_abs: f64) -> Result<Vec<f64>> {
+        let values = self.numbers(name, factor)?;
+        if let Some(k) = values.iter().position(|v| v.abs() > max_abs) {
+            return Err(Error::bad_input(
+                self.location(),
+                format!(
+                    "line {}, column {name}: {:e} is beyond ±{:e} (a wrong unit?)",
+                    self.line(k),
+                    values[k] / factor,
+                    max_abs / factor
+                ),
+            ));
+        }
+        Ok(values)
+    }
+
     pub(crate) fn line(&self, k: usize) -> u64 {
         self.rows.get(k).map_or(k as u64 + 2, |r| line_of(r, k))
     }

@@ -139,7 +139,10 @@ pub fn fit_hertz_with_offset(points: &[SqueezePoint], radius_m: f64) -> Result<H
 }
 
 fn no_fit() -> Error {
-    Error::InvalidArgument("the squeeze data give no Hertz fit (all δ^(3/2) are zero)".into())
+    Error::InvalidArgument(
+        "the squeeze data give no finite Hertz fit (all δ^(3/2) are zero, or the numbers overflow)"
+            .into(),
+    )
 }
 
 pub(crate) fn check_radius(radius_m: f64) -> Result<()> {
@@ -187,13 +190,19 @@ fn fit_with_offset(
     let slope_se = (res / dof as f64 / sxx).sqrt();
     // P = (4/3)E*√R·δ^{3/2}: E* = 3s/(4√R).
     let scale = 3.0 / (4.0 * radius_m.sqrt());
-    Some(HertzFit {
+    let fit = HertzFit {
         e_star_pa: scale * slope,
         e_star_se_pa: scale * slope_se,
         r_squared: if tot > 0.0 { 1.0 - res / tot } else { 1.0 },
         offset_m: d0,
         fitted_n,
-    })
+    };
+    // A fit that overflowed (absurd forces or vanishing displacements) is no fit.
+    let finite = [fit.e_star_pa, fit.e_star_se_pa, fit.r_squared]
+        .iter()
+        .chain(&fit.fitted_n)
+        .all(|v| v.is_finite());
+    finite.then_some(fit)
 }
 
 fn ss_res(points: &[SqueezePoint], fit: &HertzFit) -> f64 {
