@@ -180,6 +180,23 @@ pub fn parse_quantity_list(text: &str, dim: Dimension) -> Result<Vec<f64>> {
     Ok(values)
 }
 
+/// The most values a range such as `4mN..400mN:12` may ask for.
+pub const MAX_RANGE_COUNT: usize = 10_000;
+
+/// The count of a range (`…:N`), 2 ..= [`MAX_RANGE_COUNT`].
+fn range_count(count: &str, text: &str) -> Result<usize> {
+    let n: usize = count
+        .trim()
+        .parse()
+        .map_err(|_| Error::InvalidArgument(format!("'{count}' in '{text}' is not a count")))?;
+    if !(2..=MAX_RANGE_COUNT).contains(&n) {
+        return Err(Error::InvalidArgument(format!(
+            "range '{text}' asks for {n} values; give 2 to {MAX_RANGE_COUNT}"
+        )));
+    }
+    Ok(n)
+}
+
 /// Parse loads: a list (`4,10,40mN`) or a log-spaced range `4mN..400mN:12` (12 values from 4 to
 /// 400 mN, equal ratios). Returns newtons; every value must be positive.
 pub fn parse_loads(text: &str) -> Result<Vec<f64>> {
@@ -194,10 +211,8 @@ pub fn parse_loads(text: &str) -> Result<Vec<f64>> {
                 parse_quantity(from, Dimension::Force)?,
                 parse_quantity(to, Dimension::Force)?,
             );
-            let n: usize = count.trim().parse().map_err(|_| {
-                Error::InvalidArgument(format!("'{count}' in '{text}' is not a count"))
-            })?;
-            if n < 2 || !(a > 0.0 && b > a) {
+            let n = range_count(count, text)?;
+            if !(a > 0.0 && b > a) {
                 return Err(Error::InvalidArgument(format!(
                     "load range '{text}' needs 0 < start < end and at least 2 values"
                 )));
@@ -237,12 +252,9 @@ pub fn parse_value_list(text: &str, parse_one: &dyn Fn(&str) -> Result<f64>) -> 
         let (to, count) = rest.split_once(':').ok_or_else(|| {
             Error::InvalidArgument(format!("range '{text}' needs a count, e.g. 1..10MPa/nm:10"))
         })?;
-        let n: usize = count
-            .trim()
-            .parse()
-            .map_err(|_| Error::InvalidArgument(format!("'{count}' in '{text}' is not a count")))?;
+        let n = range_count(count, text)?;
         let (a, b) = (parse_one(&with_unit_of(from, to))?, parse_one(to)?);
-        if n < 2 || b <= a {
+        if b <= a {
             return Err(Error::InvalidArgument(format!(
                 "range '{text}' needs start < end and at least 2 values"
             )));
@@ -392,6 +404,11 @@ mod tests {
         assert_eq!(parse_loads("4,10mN").unwrap(), [4e-3, 10e-3]);
         assert!(parse_loads("4mN..400mN").is_err());
         assert!(parse_loads("400mN..4mN:3").is_err());
+        let e = parse_loads("4mN..400mN:1099511627776")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("2 to 10000"), "{e}");
+        assert!(parse_value_list("1..10MPa/nm:100000", &|t| Ok(t.len() as f64)).is_err());
         assert!(parse_loads("0mN,1mN").is_err());
         assert_relative_eq!(
             parse_ratio("4MPa/nm", Dimension::Pressure, Dimension::Length).unwrap(),
