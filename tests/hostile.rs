@@ -334,3 +334,53 @@ fn files_named_inside_inputs_are_never_overwritten() {
     );
     assert!(!d.join("res/compare.csv").exists(), "nothing committed");
 }
+
+/// A Greenwood–Tripp load whose bearing area covers no pixel has no mean pressure: before, the
+/// CSV held `NaN` and the table printed it. Now: an empty cell, a warning, nothing non-finite.
+#[test]
+fn zero_area_load_writes_no_nan() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let ok = |args: &[&str]| {
+        let o = run_in(d, args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        (String::from_utf8_lossy(&o.stdout).into_owned(), stderr(&o))
+    };
+    ok(&[
+        "surface",
+        "--size",
+        "32",
+        "--pixel-size",
+        "200nm",
+        "--rms-height",
+        "20nm",
+        "--out",
+        "t.npy",
+    ]);
+    let (stdout, err) = ok(&[
+        "simulate",
+        "--topography",
+        "t.npy",
+        "--pixel-size",
+        "200nm",
+        "--radius",
+        "20um",
+        "--modulus",
+        "3.7GPa",
+        "--model",
+        "gt",
+        "--loads",
+        "1e-6mN,0.1mN",
+        "--out",
+        "gt",
+    ]);
+    assert!(err.contains("no pixel in contact"), "{err}");
+    let csv = fs::read_to_string(d.join("gt/areas.csv")).unwrap();
+    let summary = fs::read_to_string(d.join("gt/summary.json")).unwrap();
+    for text in [&stdout, &csv, &summary] {
+        assert!(!text.to_lowercase().contains("nan"), "{text}");
+        assert!(!text.contains("inf"), "{text}");
+    }
+    let first = csv.lines().nth(1).unwrap();
+    assert_eq!(first.split(',').nth(3), Some(""), "{first}");
+}

@@ -147,12 +147,17 @@ pub fn run(args: Args) -> Result<()> {
         "force_mN", "area_µm²", "fraction", "p_mean_MPa", "patches", "iters"
     );
     for l in &outcome.loads {
+        let p_mean = if l.mean_pressure_pa.is_finite() {
+            format!("{:.2}", l.mean_pressure_pa * 1e-6)
+        } else {
+            "—".to_string()
+        };
         println!(
-            "{:>10.4} {:>12.4} {:>9.5} {:>10.2} {:>8} {:>6}",
+            "{:>10.4} {:>12.4} {:>9.5} {:>10} {:>8} {:>6}",
             l.force_n * 1e3,
             l.area_m2 * 1e12,
             l.contact_fraction,
-            l.mean_pressure_pa * 1e-6,
+            p_mean,
             l.patches,
             l.iterations
         );

@@ -66,10 +66,12 @@ impl Quantity {
         }
     }
 
-    /// Whether `value` (SI) lies in the range; NaN and infinities never do.
+    /// Whether `value` (SI) lies in the range; NaN and infinities never do. The bounds are
+    /// widened by 1e-12 relative, so that a bound written in another unit (`1e-6mN` for 1 nN)
+    /// is not refused for the rounding of its conversion.
     pub fn contains(self, value: f64) -> bool {
         let (lo, hi) = self.range();
-        value.is_finite() && (lo..=hi).contains(&value)
+        value.is_finite() && (lo * (1.0 - 1e-12)..=hi * (1.0 + 1e-12)).contains(&value)
     }
 
     /// The message for a value outside the range.
@@ -138,6 +140,9 @@ mod tests {
         assert!(!Quantity::PixelSize.contains(1e-309));
         assert!(!Quantity::PixelSize.contains(f64::INFINITY));
         assert!(Quantity::Hardening.contains(4e15));
+        // A bound written in another unit survives the rounding of its conversion.
+        assert!(Quantity::Force.contains(1e-6 * 1e-3));
+        assert!(!Quantity::Force.contains(0.999e-9));
         let err = Quantity::PixelSize
             .check(1e-300, "--pixel-size")
             .unwrap_err();

@@ -72,7 +72,8 @@ pub struct SimulatedLoad {
     pub area_m2: f64,
     /// Contact fraction of the map.
     pub contact_fraction: f64,
-    /// Force / area, Pa.
+    /// Force / area, Pa; NaN where the area is zero (a Greenwood–Tripp load whose bearing
+    /// area covers no pixel): an empty cell in `areas.csv`, `null` in `summary.json`.
     pub mean_pressure_pa: f64,
     /// Largest pressure, Pa.
     pub max_pressure_pa: f64,
@@ -135,6 +136,12 @@ pub fn run_simulate(
         }
     };
     warnings.splice(0..0, notes);
+    for l in loads.iter().filter(|l| l.area_m2 <= 0.0) {
+        warnings.push(format!(
+            "{:.6} mN: no pixel in contact (the contact is smaller than a pixel); mean pressure left empty",
+            l.force_n * 1e3
+        ));
+    }
     staging.write("areas.csv", &areas_csv(&loads)?)?;
     staging.write("area_vs_load.png", &area_plot(request, &loads).to_png()?)?;
     let summary = summary_json(request, &roughness, &stats, &loads, &warnings);
@@ -323,6 +330,15 @@ fn run_gt(
     Ok((rows, Vec::new()))
 }
 
+/// A number for a CSV cell; an empty cell for an undefined (non-finite) one.
+fn finite_cell(v: f64) -> String {
+    if v.is_finite() {
+        v.to_string()
+    } else {
+        String::new()
+    }
+}
+
 fn areas_csv(loads: &[SimulatedLoad]) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let csv_err = |e: csv::Error| Error::InvalidArgument(format!("CSV: {e}"));
@@ -345,8 +361,8 @@ fn areas_csv(loads: &[SimulatedLoad]) -> Result<Vec<u8>> {
             (l.force_n * 1e3).to_string(),
             (l.area_m2 * 1e12).to_string(),
             l.contact_fraction.to_string(),
-            (l.mean_pressure_pa * 1e-6).to_string(),
-            (l.max_pressure_pa * 1e-6).to_string(),
+            finite_cell(l.mean_pressure_pa * 1e-6),
+            finite_cell(l.max_pressure_pa * 1e-6),
             (l.approach_m * 1e6).to_string(),
             l.patches.to_string(),
             l.iterations.to_string(),
