@@ -150,6 +150,54 @@ pub const TEMPLATES: &[Template] = &[
         ]
     ),
     t!(
+        "simulate-gt",
+        ["t.npy"],
+        ["t.npy"],
+        [
+            "simulate",
+            "--topography",
+            "t.npy",
+            "--pixel-size",
+            "200nm",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--model",
+            "gt",
+            "--loads",
+            "0.001,0.1mN",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
+        "simulate-hardening",
+        ["t.npy"],
+        ["t.npy"],
+        [
+            "simulate",
+            "--topography",
+            "t.npy",
+            "--pixel-size",
+            "200nm",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--model",
+            "hardening",
+            "--hardening",
+            "4MPa/nm",
+            "--loads",
+            "0.05,0.1mN",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
         "simulate-gsf",
         ["t.gsf"],
         ["t.gsf"],
