@@ -11,34 +11,13 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::czi::{czi, Tile};
-use common::{column, read_csv, run, run_ok, shared_data, stderr};
-use contactscope::io::microscopy::{MicroscopyFile, PlaneIndex};
+use common::{column, export_tiff, read_csv, run, run_ok, shared_data, stderr};
+use contactscope::io::microscopy::PlaneIndex;
 use contactscope::io::tiff::encode_u16_stack;
 use serde_json::Value;
 
 fn s(p: &Path) -> &str {
     p.to_str().expect("UTF-8 path")
-}
-
-/// The planes `(series, index)` of `file` as one multi-page u16 TIFF at `out`, with the given
-/// pixel size.
-fn export_tiff(file: &Path, planes: &[(usize, PlaneIndex)], px: Option<(f64, f64)>, out: &Path) {
-    let mut f = MicroscopyFile::open(file).unwrap();
-    let mut pages = Vec::new();
-    let (mut w, mut h) = (0, 0);
-    for (series, index) in planes {
-        let plane = f.read_plane(*series, index).unwrap();
-        (w, h) = (plane.width, plane.height);
-        pages.push(
-            plane
-                .to_f64()
-                .iter()
-                .map(|&v| u16::try_from(v as i64).expect("u16 sample"))
-                .collect::<Vec<u16>>(),
-        );
-    }
-    let refs: Vec<&[u16]> = pages.iter().map(Vec::as_slice).collect();
-    std::fs::write(out, encode_u16_stack(&refs, w, h, px, "").unwrap()).unwrap();
 }
 
 /// `analyze` into `out` with `args`; returns (areas.csv header and rows, summary.json).

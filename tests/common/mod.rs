@@ -111,3 +111,33 @@ pub fn column(header: &[String], rows: &[Vec<String>], name: &str) -> Vec<f64> {
         .unwrap_or_else(|| panic!("column {name} in {header:?}"));
     rows.iter().map(|r| r[i].parse().expect("number")).collect()
 }
+
+/// The planes `(series, index)` of `file` as one multi-page u16 TIFF at `out`, with the given
+/// pixel size.
+pub fn export_tiff(
+    file: &Path,
+    planes: &[(usize, contactscope::io::microscopy::PlaneIndex)],
+    px: Option<(f64, f64)>,
+    out: &Path,
+) {
+    let mut f = contactscope::io::microscopy::MicroscopyFile::open(file).unwrap();
+    let mut pages = Vec::new();
+    let (mut w, mut h) = (0, 0);
+    for (series, index) in planes {
+        let plane = f.read_plane(*series, index).unwrap();
+        (w, h) = (plane.width, plane.height);
+        pages.push(
+            plane
+                .to_f64()
+                .iter()
+                .map(|&v| u16::try_from(v as i64).expect("u16 sample"))
+                .collect::<Vec<u16>>(),
+        );
+    }
+    let refs: Vec<&[u16]> = pages.iter().map(Vec::as_slice).collect();
+    std::fs::write(
+        out,
+        contactscope::io::tiff::encode_u16_stack(&refs, w, h, px, "").unwrap(),
+    )
+    .unwrap();
+}
