@@ -18,8 +18,6 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 
-use contactscope::io::tiff::{encode_u16_stack, read_pages};
-use contactscope::io::topography::{read_npy, write_npy};
 use contactscope::mechanics::hertz;
 use contactscope::mechanics::squeeze::{fit_hertz_with_offset, SqueezePoint};
 use contactscope::optics::psf::{measure_psf, PsfOptions};
@@ -28,6 +26,9 @@ use contactscope::solver::gt::{
 };
 use contactscope::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
 use contactscope::synth::beads::{synth_beads, BeadParams};
+use contactscope_formats::tiff::{encode_u16_stack, read_pages};
+use contactscope_formats::topography::read_npy;
+use contactscope_jobs::heights::write_npy;
 
 fn special(c: &mut Criterion) {
     let mut g = c.benchmark_group("special");

@@ -25,16 +25,16 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
 
-use contactscope::io::series::DEFAULT_MEMORY_BUDGET;
-use contactscope::io::series::{self, Series};
-use contactscope::io::tiff::write::{encode_u16_stack_compressed, Compression};
-use contactscope::io::tiff::TiffReader;
-use contactscope::io::units::{self, Dimension};
-use contactscope::jobs::analyze::report::Report;
-use contactscope::jobs::analyze::{analyze_series, AnalyzeOptions};
 use contactscope::measure::{measure, patch_stats};
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::{Binning, Histogram, Threshold};
+use contactscope_formats::tiff::write::{encode_u16_stack_compressed, Compression};
+use contactscope_formats::tiff::TiffReader;
+use contactscope_formats::units::{self, Dimension};
+use contactscope_jobs::analyze::report::Report;
+use contactscope_jobs::analyze::{analyze_series, AnalyzeOptions};
+use contactscope_jobs::series::DEFAULT_MEMORY_BUDGET;
+use contactscope_jobs::series::{self, Series};
 
 const SIZE: usize = 1024;
 const IMAGES: usize = 40;

@@ -1,12 +1,10 @@
 //! `contactscope demo`: the whole method on a generated experiment; every recovered number must
 //! match the generator's truth, and the report must be complete.
 
-mod common;
-
 use std::fs;
 use std::path::Path;
 
-use common::{run, stderr};
+use crate::common::{run, stderr};
 use serde_json::Value;
 
 fn s(p: &Path) -> &str {

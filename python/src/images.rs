@@ -14,14 +14,14 @@ use contactscope::analysis::fit::fit_power_law;
 use contactscope::analysis::{self, AnalysisOptions, PlaneSource};
 use contactscope::compare::{compare_maps, CompareSettings, Micrograph, Micrographs, SimulatedMap};
 use contactscope::image::{Image, PixelSize, PixelSizeSource, Plane, SampleType, Samples};
-use contactscope::io::microscopy::select::{read_images, LoadAxis, Selection};
-use contactscope::io::series::{self, Series};
 use contactscope::numerics::stats::MeanSd;
 use contactscope::optics::blur::{microscope_image, Grid};
 use contactscope::optics::newton::{analyse, NewtonOptions};
 use contactscope::optics::psf::{measure_psf, PsfOptions, FWHM_PER_SIGMA};
 use contactscope::spectral::autocorrelation::AcfCurve;
 use contactscope::threshold::{Method, Threshold};
+use contactscope_formats::microscopy::select::{read_images, LoadAxis, Selection};
+use contactscope_jobs::series::{self, Series};
 
 use crate::{bad, compute, pixel_opt, PixelArg};
 

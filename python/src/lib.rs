@@ -15,10 +15,13 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
-use contactscope::error::Error;
+use contactscope_jobs::Error;
 
+mod convert;
+mod heights;
 mod images;
 mod mechanics;
+mod simulate;
 mod synth;
 
 create_exception!(
@@ -47,11 +50,18 @@ create_exception!(
 );
 
 /// The library's error as the matching Python exception, with the library's message.
-pub(crate) fn to_py(e: Error) -> PyErr {
+pub(crate) fn to_py(e: impl Into<Error>) -> PyErr {
+    use contactscope_formats::Error as FormatError;
+    let e = e.into();
     let message = e.to_string();
     match e {
-        Error::Io { .. } | Error::Output { .. } => FileError::new_err(message),
-        Error::NotConverged { .. } => ConvergenceError::new_err(message),
+        Error::Output { .. }
+        | Error::Format(FormatError::Io { .. } | FormatError::Output { .. }) => {
+            FileError::new_err(message)
+        }
+        Error::Algorithm(contactscope::Error::NotConverged { .. }) => {
+            ConvergenceError::new_err(message)
+        }
         _ => InputError::new_err(message),
     }
 }
@@ -65,9 +75,9 @@ pub(crate) fn bad(message: impl Into<String>) -> PyErr {
 static POOL: Mutex<Option<Arc<rayon::ThreadPool>>> = Mutex::new(None);
 
 /// Run `f` with the GIL released, on the configured thread pool, with panics caught.
-pub(crate) fn compute<T: Send>(
+pub(crate) fn compute<T: Send, E: Into<Error> + Send>(
     py: Python<'_>,
-    f: impl FnOnce() -> contactscope::error::Result<T> + Send,
+    f: impl FnOnce() -> Result<T, E> + Send,
 ) -> PyResult<T> {
     let pool = POOL.lock().map(|p| p.clone()).unwrap_or(None);
     let outcome = py.detach(move || {
@@ -160,6 +170,8 @@ pub(crate) fn pixel_opt(p: Option<PixelArg>) -> PyResult<Option<(f64, f64)>> {
 #[pymodule]
 fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    // Messages name parameters as keywords (`pixel_size=`).
+    contactscope_formats::param::set_front_end(contactscope_formats::param::FrontEnd::Python);
     m.add("InputError", py.get_type::<InputError>())?;
     m.add("FileError", py.get_type::<FileError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
@@ -169,6 +181,7 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
     images::register(m)?;
     mechanics::register(m)?;
+    simulate::register(m)?;
     synth::register(m)?;
     Ok(())
 }

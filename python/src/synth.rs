@@ -9,10 +9,10 @@ use numpy::{IntoPyArray, PyReadonlyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use contactscope::io::tiff::write::{encode_f32_stack, encode_u16_stack};
 use contactscope::synth::beads::{synth_beads as make_beads, BeadParams};
 use contactscope::synth::rings::{synth_newton as make_newton, NewtonSynthParams};
 use contactscope::synth::{generate, SynthParams};
+use contactscope_formats::tiff::write::{encode_f32_stack, encode_u16_stack};
 
 use crate::{bad, compute, pixel_opt, PixelArg};
 

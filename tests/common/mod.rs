@@ -116,11 +116,11 @@ pub fn column(header: &[String], rows: &[Vec<String>], name: &str) -> Vec<f64> {
 /// pixel size.
 pub fn export_tiff(
     file: &Path,
-    planes: &[(usize, contactscope::io::microscopy::PlaneIndex)],
+    planes: &[(usize, contactscope_formats::microscopy::PlaneIndex)],
     px: Option<(f64, f64)>,
     out: &Path,
 ) {
-    let mut f = contactscope::io::microscopy::MicroscopyFile::open(file).unwrap();
+    let mut f = contactscope_formats::microscopy::MicroscopyFile::open(file).unwrap();
     let mut pages = Vec::new();
     let (mut w, mut h) = (0, 0);
     for (series, index) in planes {
@@ -137,7 +137,7 @@ pub fn export_tiff(
     let refs: Vec<&[u16]> = pages.iter().map(Vec::as_slice).collect();
     std::fs::write(
         out,
-        contactscope::io::tiff::encode_u16_stack(&refs, w, h, px, "").unwrap(),
+        contactscope_formats::tiff::encode_u16_stack(&refs, w, h, px, "").unwrap(),
     )
     .unwrap();
 }

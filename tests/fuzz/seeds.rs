@@ -7,11 +7,11 @@ use std::fs;
 use std::path::Path;
 use std::process::Command;
 
-use contactscope::io::tiff::encode_u16_stack;
 use contactscope::mechanics::friction::XAxis;
 use contactscope::synth::beads::{synth_beads, BeadParams};
 use contactscope::synth::rings::{synth_newton, NewtonSynthParams};
 use contactscope::synth::traces::{synthetic_trace, trace_csv, CsvLayout, TraceParams};
+use contactscope_formats::tiff::encode_u16_stack;
 
 /// Run the binary in `dir` and insist on success.
 fn cli(dir: &Path, args: &[&str]) {

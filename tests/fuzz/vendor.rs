@@ -9,7 +9,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use super::cases::Template;
-use super::czi::{czi, Tile};
+use crate::common::czi::{czi, Tile};
 
 /// A 48×40 CZI with three time points (one load each): a bright disc that grows with t on a
 /// dark background, 12-bit values in Gray16, no metadata (so `--pixel-size` is needed).

@@ -17,6 +17,7 @@ Distributed sweeps and fits on Dask: :mod:`contactscope.distributed`.
 from __future__ import annotations
 
 import os
+import warnings as _warnings
 from typing import Any, Dict, Iterable, Optional, Sequence, Union
 
 import numpy as np
@@ -37,6 +38,7 @@ PathLike = Union[str, "os.PathLike[str]"]
 PixelSize = Union[float, "tuple[float, float]"]
 
 __all__ = [
+    "ContactscopeWarning",
     "ConvergenceError",
     "FileError",
     "InputError",
@@ -64,9 +66,23 @@ __all__ = [
 ]
 
 
+class ContactscopeWarning(UserWarning):
+    """A warning of a contactscope job (the command line prints the same text on stderr); the
+    result keeps every warning in its ``warnings`` list."""
+
+
 class Results(dict):
-    """A result: a dict whose keys are also attributes; ``rows`` (one dict per image or load)
-    become a table with :meth:`to_pandas`."""
+    """A result: the job's outcome as a dict (SI units, keys naming their unit) whose keys are
+    also attributes; ``rows`` (one dict per image or load: the outcome's table) become a table
+    with :meth:`to_pandas`."""
+
+    #: The key of the per-item table (``"loads"`` for :func:`simulate`).
+    _table = "rows"
+
+    def __init__(self, *args: Any, table: Optional[str] = None, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        if table is not None:
+            self._table = table
 
     def __getattr__(self, name: str) -> Any:
         try:
@@ -74,13 +90,24 @@ class Results(dict):
         except KeyError:
             raise AttributeError(name) from None
 
+    @property
+    def rows(self) -> list:
+        """The per-image or per-load table: a list of dicts."""
+        return self[self._table]
+
     def to_pandas(self):
         """The per-image or per-load rows as a ``pandas.DataFrame`` (needs pandas)."""
         try:
             import pandas as pd
         except ImportError as e:  # pragma: no cover - depends on the environment
             raise ImportError("to_pandas() needs pandas: pip install pandas") from e
-        return pd.DataFrame(list(self["rows"]))
+        return pd.DataFrame(list(self.rows))
+
+
+def _warn(result: Dict[str, Any]) -> None:
+    """Each of the job's warnings as a :class:`ContactscopeWarning` (they stay on the result)."""
+    for text in result.get("warnings") or ():
+        _warnings.warn(text, ContactscopeWarning, stacklevel=3)
 
 
 class Series(Results):
@@ -276,30 +303,44 @@ def surface(nx: int, ny: int, pixel_size: float, hurst: float = 0.8,
     return _cs.surface(nx, ny, pixel_size, hurst, rms_height, rms_slope, rolloff, cutoff, seed)
 
 
-def simulate(heights: Any, pixel_size: PixelSize, modulus: float, loads: Iterable[float],
-             model: str = "elastic", *, hardness: Optional[float] = None,
-             k: Optional[float] = None, initial_hardness: float = 0.0,
+def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
+             loads: Iterable[float], model: str = "elastic", *, hardness: Optional[float] = None,
+             k: Optional[float] = None, initial_hardness: Optional[float] = None,
              alpha: Optional[float] = None, radius: Optional[float] = None,
-             periodic: bool = False, tolerance: float = 1e-8, max_iterations: int = 5000,
-             maps: bool = True) -> Results:
-    """A load ramp on a rough body (heights in m, rows = y, positive towards the flat; pixel
-    size in m; a sphere of ``radius`` m is added when given) pressed on a flat of contact
-    modulus E* ``modulus`` (Pa) at normal forces ``loads`` (N, in order; the plastic state carries
-    from load to load).
+             periodic: bool = False, tolerance: Optional[float] = None,
+             max_iterations: Optional[int] = None, maps: bool = True, detrend: str = "plane",
+             height_unit: Optional[float] = None, channel: Optional[str] = None,
+             fill_invalid: Optional[str] = None) -> Results:
+    """A load ramp on a rough body pressed on a flat of contact modulus E* ``modulus`` (Pa) at
+    normal forces ``loads`` (N, in order; the plastic state carries from load to load): the
+    command line's ``simulate``, with the same defaults, checks and warnings.
+
+    ``heights``: a height-map file of any format the command line reads (``pixel_size``,
+    ``height_unit``, ``channel`` and ``fill_invalid`` as its flags), or an array of heights in m
+    (rows = y, positive towards the flat) with its ``pixel_size`` (m). The map is detrended by
+    ``detrend`` ("plane" by default, as the command line; "mean" or "none"). A sphere of
+    ``radius`` m is added when given.
 
     Models: "elastic"; "hardness" (p ≤ ``hardness`` Pa; ``alpha`` for the volume-conserving
     update); "hardening" (p_Y = ``initial_hardness`` + ``k``·h_pl, k in Pa/m); "gt"
-    (Greenwood–Tripp bearing area, needs ``radius``).
+    (Greenwood–Tripp bearing area, needs ``radius``). Solver limits: ``tolerance`` (default
+    1e-8) and ``max_iterations`` per load (default 5000).
 
-    Returns ``rows`` (per load: ``force_n``, ``area_m2``, ``mean_pressure_pa``,
-    ``approach_m``, ``patches``, ``plastic_volume_m3``, …) and, with ``maps``, the per-load
-    stacks ``pressure`` (Pa), ``gap`` (m), ``contact`` (bool) and ``plastic`` (m), each
-    (loads, ny, nx).
+    Returns the outcome the command line writes as ``summary.json``, in SI units: ``loads``
+    (per load: ``force_n``, ``area_m2``, ``mean_pressure_pa``, ``approach_m``, ``patches``,
+    ``plastic_volume_m3``, ``edge_contact``, …; also :attr:`Results.rows`), ``topography``,
+    ``model``, ``power_law`` and ``warnings`` (also issued as :class:`ContactscopeWarning`), and
+    with ``maps`` the per-load stacks ``pressure`` (Pa), ``gap`` (m), ``contact`` (bool) and
+    ``plastic`` (m), each (loads, ny, nx).
     """
-    return Results(_cs.simulate(_f64(heights, 2, "heights"), pixel_size, float(modulus),
-                                [float(f) for f in loads], model, hardness, k,
-                                initial_hardness, alpha, radius, periodic, tolerance,
-                                max_iterations, maps))
+    if not isinstance(heights, (str, os.PathLike)):
+        heights = _f64(heights, 2, "heights")
+    result = Results(_cs.simulate(heights, pixel_size, float(modulus), [float(f) for f in loads],
+                                  model, hardness, k, initial_hardness, alpha, radius, periodic,
+                                  tolerance, max_iterations, maps, detrend, height_unit,
+                                  channel, fill_invalid), table="loads")
+    _warn(result)
+    return result
 
 
 def ramp(heights: Any, pixel_size: PixelSize, modulus: float, family: str,

@@ -1,0 +1,201 @@
+//! `contactscope analyze`: a load series → one global Otsu threshold, contact area per image,
+//! fits, plots.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+
+use contactscope::analysis::Pass;
+use contactscope::threshold::Method;
+use contactscope_formats::units::{self, Dimension};
+use contactscope_jobs::analyze::{
+    run_analyze, AnalyzeOptions, AnalyzeOutcome, AnalyzeRequest, AreaUnit, HertzParams,
+};
+use contactscope_jobs::series::{self, Series, DEFAULT_MEMORY_BUDGET};
+
+use super::args::{default_out, LoadAxisArg, OutputFolder, PixelSizeArg, Quiet, SelectionArgs};
+use super::common::{command_line, progress_bar};
+
+default_out!(Out, "contactscope-out");
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// TIFF, CZI, ND2 or LIF files, or directories of them (natural sort order). Not with
+    /// --manifest.
+    inputs: Vec<PathBuf>,
+    /// CSV with columns file, [page], force_mN, [friction_mN]; paths relative to the CSV.
+    #[arg(long, conflicts_with_all = ["inputs", "forces"])]
+    manifest: Option<PathBuf>,
+    /// Normal forces, one per image, with a unit: 4,10,20,40mN.
+    #[arg(long)]
+    forces: Option<String>,
+    #[command(flatten)]
+    select: SelectionArgs,
+    /// Axis of a CZI, ND2 or LIF file whose planes are the loads, in order.
+    #[arg(long, value_enum)]
+    load_axis: Option<LoadAxisArg>,
+    /// otsu (one threshold for the series), per-image, or a number (contact is value > t).
+    #[arg(long, default_value = "otsu")]
+    threshold: String,
+    #[command(flatten)]
+    pixel_size: PixelSizeArg,
+    /// Sphere radius for Hertz columns, e.g. 290um (needs --modulus).
+    #[arg(long, requires = "modulus")]
+    radius: Option<String>,
+    /// Contact modulus E* for Hertz columns, e.g. 3.7GPa (needs --radius).
+    #[arg(long, requires = "radius")]
+    modulus: Option<String>,
+    #[command(flatten)]
+    out: OutputFolder<Out>,
+    /// Write one PNG per image with contact edges in green.
+    #[arg(long)]
+    overlays: bool,
+    /// Write the contact masks as TIFF.
+    #[arg(long)]
+    save_masks: bool,
+    /// Decoded images of compressed files kept in memory between the two passes, in MiB.
+    #[arg(long, default_value_t = DEFAULT_MEMORY_BUDGET >> 20)]
+    memory_mib: usize,
+    #[command(flatten)]
+    quiet: Quiet,
+}
+
+fn build_series(args: &Args) -> Result<Series> {
+    let selection = args.select.selection();
+    let load_axis = args.load_axis.map(LoadAxisArg::axis);
+    let mut series = match &args.manifest {
+        Some(manifest) => series::from_manifest_selected(manifest, &selection, load_axis)?,
+        None => {
+            if args.inputs.is_empty() {
+                bail!("give image files or directories, or --manifest");
+            }
+            series::from_files_selected(&args.inputs, &selection, load_axis)?
+        }
+    };
+    if let Some(text) = &args.forces {
+        let forces = units::parse_quantity_list(text, Dimension::Force)
+            .with_context(|| format!("--forces {text}"))?;
+        series::assign_forces(&mut series, &forces)?;
+    }
+    Ok(series)
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let series = build_series(&args)?;
+    let hertz = match (&args.radius, &args.modulus) {
+        (Some(r), Some(e)) => Some(HertzParams {
+            radius_m: contactscope_formats::ranges::Quantity::Radius.check_text(
+                units::parse_positive(r, Dimension::Length).context("--radius")?,
+                "--radius",
+            )?,
+            modulus_pa: contactscope_formats::ranges::Quantity::Modulus.check_text(
+                units::parse_positive(e, Dimension::Pressure).context("--modulus")?,
+                "--modulus",
+            )?,
+        }),
+        _ => None,
+    };
+    let options = AnalyzeOptions {
+        method: Method::parse(&args.threshold)?,
+        pixel_size_override: args.pixel_size.metres()?,
+        hertz,
+        memory_budget: args.memory_mib << 20,
+    };
+    let request = AnalyzeRequest {
+        series,
+        options,
+        out_dir: args.out.out.clone(),
+        overlays: args.overlays,
+        save_masks: args.save_masks,
+        command_line: command_line(),
+    };
+    let outcome = run_with_progress(&request, args.quiet.quiet)?;
+    print_outcome(&outcome, &args.out.out);
+    Ok(())
+}
+
+fn run_with_progress(request: &AnalyzeRequest, quiet: bool) -> Result<AnalyzeOutcome> {
+    let bar = progress_bar(request.series.images.len(), 4, quiet);
+    let progress = |pass: Pass, done: usize, _total: usize| {
+        bar.set_message(match pass {
+            Pass::Histogram => "histogram",
+            Pass::Measure => "measure",
+        });
+        bar.set_position(done as u64);
+    };
+    let outcome = run_analyze(request, &progress);
+    bar.finish_and_clear();
+    Ok(outcome?)
+}
+
+fn print_outcome(outcome: &AnalyzeOutcome, out: &Path) {
+    let a = &outcome.analysis;
+    let r = &outcome.report;
+    super::common::print_warnings(&a.warnings);
+    match a.series_threshold {
+        Some(t) => println!(
+            "threshold: {} ({}), contact is value > t, from {} pixels",
+            t.value,
+            a.method.name(),
+            a.histogram_pixels
+        ),
+        None => println!("threshold: one Otsu threshold per image (see areas.csv)"),
+    }
+    match a.pixel_size {
+        Some(p) => println!(
+            "pixel size: {:.5} × {:.5} µm from {}",
+            p.x_m * 1e6,
+            p.y_m * 1e6,
+            p.source.describe()
+        ),
+        None => println!("pixel size: unknown, areas in pixels"),
+    }
+    let unit = match r.unit {
+        AreaUnit::SquareMicrometre => "µm²",
+        AreaUnit::Pixel => "px",
+    };
+    println!(
+        "{:>10} {:>12} {:>8} {:>10}",
+        "force_mN",
+        format!("area_{unit}"),
+        "patches",
+        "p_MPa"
+    );
+    for row in &r.rows {
+        let f = row.force_mn.map_or("-".into(), |f| format!("{f:.3}"));
+        let p = row
+            .mean_pressure_mpa
+            .map_or("-".into(), |p| format!("{p:.1}"));
+        println!("{f:>10} {:>12.2} {:>8} {p:>10}", row.area, row.patches);
+    }
+    if let Some(fit) = r.power_law {
+        let se = fit
+            .exponent_se
+            .map_or(String::new(), |s| format!(" ± {s:.3}"));
+        println!(
+            "power law: A ∝ N^β, β = {:.3}{se}, R² = {:.4}",
+            fit.exponent, fit.r_squared
+        );
+    }
+    if let Some((p, _)) = r.proportional_mpa {
+        println!("proportional fit: A = N/p, p = {p:.1} MPa");
+    }
+    println!(
+        "wrote {} files to {}:",
+        outcome.written.len(),
+        out.display()
+    );
+    for path in outcome.written.iter().filter(|p| !is_per_image(p)) {
+        println!("  {}", path.display());
+    }
+    let per_image = outcome.written.iter().filter(|p| is_per_image(p)).count();
+    if per_image > 0 {
+        println!("  … and {per_image} overlay/mask files");
+    }
+}
+
+fn is_per_image(path: &Path) -> bool {
+    path.file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.starts_with("overlay_") || n.starts_with("mask_"))
+}

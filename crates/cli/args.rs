@@ -1,0 +1,333 @@
+//! Argument groups shared by several commands, defined once: the pixel-size override, the output
+//! folder, `--quiet`, the height-map options and the rough sphere (`--topography`, `--radius`,
+//! `--modulus`); and the conversions of their text into library types (SI units).
+
+use std::marker::PhantomData;
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::ValueEnum;
+
+use contactscope::solver::cg::SolverOptions;
+use contactscope::surface::fill::FillInvalid;
+use contactscope::surface::Detrend;
+use contactscope_formats::microscopy::select::{LoadAxis, Selection};
+use contactscope_formats::ranges::Quantity;
+use contactscope_formats::units::{self, Dimension};
+use contactscope_jobs::heights::TopographySource;
+
+/// `--pixel-size`: overrides the files' calibration.
+#[derive(clap::Args, Clone, Debug)]
+pub struct PixelSizeArg {
+    /// Pixel size overriding the files' metadata: 200nm, 0.2um, or 200x210nm (x × y).
+    #[arg(long)]
+    pub pixel_size: Option<String>,
+}
+
+impl PixelSizeArg {
+    /// (x, y) in metres, if given.
+    pub fn metres(&self) -> Result<Option<(f64, f64)>> {
+        optional_pixel_size(&self.pixel_size, "--pixel-size")
+    }
+}
+
+/// The default output folder of one command.
+pub trait DefaultOut: Clone + Send + Sync + 'static {
+    /// Folder used without `--out`.
+    const PATH: &'static str;
+}
+
+/// `--out`: the output folder, written all or nothing (`io::staging`).
+#[derive(clap::Args, Clone, Debug)]
+pub struct OutputFolder<D: DefaultOut> {
+    /// Output folder.
+    #[arg(long, default_value = D::PATH)]
+    pub out: PathBuf,
+    #[arg(skip)]
+    default: PhantomData<D>,
+}
+
+/// Declares the marker type of a command's default output folder.
+macro_rules! default_out {
+    ($name:ident, $path:literal) => {
+        #[derive(Clone, Debug)]
+        pub struct $name;
+        impl $crate::args::DefaultOut for $name {
+            const PATH: &'static str = $path;
+        }
+    };
+}
+pub(crate) use default_out;
+
+/// The contact solver's stopping rule (`simulate`, `fit-hardening`).
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct SolverArgs {
+    /// Relative CG tolerance.
+    #[arg(long, default_value_t = 1e-8)]
+    pub tolerance: f64,
+    /// Most CG iterations per load.
+    #[arg(long, default_value_t = 5000)]
+    pub max_iterations: usize,
+}
+
+impl SolverArgs {
+    /// The solver options (no progress monitor).
+    pub fn options(&self) -> SolverOptions<'static> {
+        SolverOptions {
+            max_iterations: self.max_iterations,
+            tolerance: self.tolerance,
+            monitor: None,
+            ..SolverOptions::default()
+        }
+    }
+}
+
+/// `--quiet`, `-q`.
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct Quiet {
+    /// No progress output (bar or stage messages).
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Detrending of a height map.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum DetrendArg {
+    /// Keep the heights as read.
+    None,
+    /// Subtract the mean height.
+    Mean,
+    /// Subtract the least-squares plane.
+    Plane,
+}
+
+impl DetrendArg {
+    /// The library's detrending.
+    pub fn detrend(self) -> Detrend {
+        match self {
+            DetrendArg::None => Detrend::None,
+            DetrendArg::Mean => Detrend::Mean,
+            DetrendArg::Plane => Detrend::Plane,
+        }
+    }
+}
+
+/// How to read and level a height map.
+#[derive(clap::Args, Clone, Debug)]
+pub struct HeightMapOptions {
+    /// Pixel size (needed for .npy and text; overrides metadata): 32nm or 32x40nm.
+    #[arg(long)]
+    pub pixel_size: Option<String>,
+    /// Height unit of files that do not state one (.npy, text, TIFF), e.g. 1nm; default metres.
+    #[arg(long)]
+    pub height_unit: Option<String>,
+    /// Detrending before anything else.
+    #[arg(long, value_enum, default_value = "plane")]
+    pub detrend: DetrendArg,
+}
+
+impl HeightMapOptions {
+    /// The height map at `path`, read with these options.
+    pub fn source(&self, path: PathBuf) -> Result<TopographySource> {
+        Ok(TopographySource {
+            path,
+            pixel_size_m: optional_pixel_size(&self.pixel_size, "--pixel-size")?,
+            height_unit_m: optional_quantity(&self.height_unit, "--height-unit", Quantity::Height)?,
+            detrend: self.detrend.detrend(),
+            channel: None,
+            fill_invalid: None,
+        })
+    }
+}
+
+/// `--fill-invalid`: how to fill a vendor height map's invalid points.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum FillInvalidArg {
+    /// The mean of the valid heights.
+    Mean,
+    /// The height of the nearest valid point (city-block distance).
+    Nearest,
+}
+
+/// `--topography FILE` with its reading options.
+#[derive(clap::Args, Clone, Debug)]
+pub struct TopographyInput {
+    /// Height map: .npy, float TIFF, .gsf, text matrix (.txt/.csv/.dat), WSxM .top, Nanoscope
+    /// .di, or a vendor AFM/profilometer file recognised by content (docs/formats.md).
+    #[arg(long = "topography")]
+    pub path: PathBuf,
+    #[command(flatten)]
+    pub options: HeightMapOptions,
+    /// Channel of a multi-channel vendor height map, by name (e.g. Height); default: the
+    /// file's height channel.
+    #[arg(long)]
+    pub channel: Option<String>,
+    /// Fill a vendor map's invalid (unmeasured, masked) points instead of refusing the map:
+    /// mean (of the valid heights) or nearest (valid point, city-block distance).
+    #[arg(long, value_enum)]
+    pub fill_invalid: Option<FillInvalidArg>,
+}
+
+impl TopographyInput {
+    /// The height map to read, with channel and filling.
+    pub fn source(&self) -> Result<TopographySource> {
+        Ok(TopographySource {
+            channel: self.channel.clone(),
+            fill_invalid: self.fill_invalid.map(|f| match f {
+                FillInvalidArg::Mean => FillInvalid::Mean,
+                FillInvalidArg::Nearest => FillInvalid::Nearest,
+            }),
+            ..self.options.source(self.path.clone())?
+        })
+    }
+}
+
+/// The rough sphere and its material, as `simulate` and `fit-hardening` take them.
+#[derive(clap::Args, Clone, Debug)]
+pub struct BodyArgs {
+    #[command(flatten)]
+    pub input: TopographyInput,
+    /// Sphere radius added to a flattened map (and the GT sphere), e.g. 290um; centred at
+    /// ((N−1)/2, (N−1)/2) pixels.
+    #[arg(long)]
+    pub radius: Option<String>,
+    /// Contact modulus E*, e.g. 3.7GPa.
+    #[arg(long)]
+    pub modulus: String,
+}
+
+/// The validated body: topography source, optional sphere radius (m), E* (Pa).
+pub struct Body {
+    pub topography: TopographySource,
+    pub radius_m: Option<f64>,
+    pub e_star_pa: f64,
+}
+
+impl BodyArgs {
+    /// Parsed into library units.
+    pub fn body(&self) -> Result<Body> {
+        Ok(Body {
+            topography: self.input.source()?,
+            radius_m: optional_quantity(&self.radius, "--radius", Quantity::Radius)?,
+            e_star_pa: Quantity::Modulus.check_text(
+                units::parse_positive(&self.modulus, Dimension::Pressure).context("--modulus")?,
+                "--modulus",
+            )?,
+        })
+    }
+}
+
+/// An optional pixel size (x, y) in metres from `200nm` or `200x210nm`.
+pub fn optional_pixel_size(text: &Option<String>, flag: &str) -> Result<Option<(f64, f64)>> {
+    text.as_deref()
+        .map(units::parse_pixel_size)
+        .transpose()
+        .with_context(|| flag.to_string())
+}
+
+/// An optional positive length in metres.
+pub fn optional_length(text: &Option<String>, flag: &str) -> Result<Option<f64>> {
+    optional_quantity(text, flag, Quantity::Length)
+}
+
+/// A length-valued option checked against the plausible range of `quantity`.
+pub fn optional_quantity(
+    text: &Option<String>,
+    flag: &str,
+    quantity: Quantity,
+) -> Result<Option<f64>> {
+    text.as_deref()
+        .map(|t| {
+            let v =
+                units::parse_positive(t, Dimension::Length).with_context(|| flag.to_string())?;
+            Ok(quantity.check_text(v, flag)?)
+        })
+        .transpose()
+}
+
+/// A fraction in [0, 1) from `1%` or `0.01`.
+pub fn fraction(text: &str, flag: &str) -> Result<f64> {
+    let value = match text.trim().strip_suffix('%') {
+        Some(pct) => pct.trim().parse::<f64>().map(|p| p / 100.0),
+        None => text.trim().parse::<f64>(),
+    };
+    match value {
+        Ok(v) if (0.0..1.0).contains(&v) => Ok(v),
+        _ => bail!("{flag}: {text:?} is not a fraction in [0, 1) such as 1% or 0.01"),
+    }
+}
+
+/// `--series`, `--channel`, `--z`, `--t`: which plane(s) of a confocal file, shared by every
+/// command that reads micrographs (rules in `io::microscopy::select`).
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct SelectionArgs {
+    /// Series of a CZI (scene) or LIF (image) file; needed when the file has several.
+    #[arg(long)]
+    pub series: Option<usize>,
+    /// Channel; needed when the file has several (TIFF: samples or ImageJ channels).
+    #[arg(long)]
+    pub channel: Option<usize>,
+    /// Focal plane of a CZI, ND2 or LIF file; needed when it has several.
+    #[arg(long)]
+    pub z: Option<usize>,
+    /// Time point of a CZI, ND2 or LIF file; needed when it has several.
+    #[arg(long)]
+    pub t: Option<usize>,
+    /// Index along another axis of a CZI, ND2 or LIF file, by the name `info` shows: H=0
+    /// (Airyscan phase), S=1 (green of an RGB pixel), lambda_emission=3, … Repeatable.
+    #[arg(long = "axis", value_name = "NAME=INDEX", value_parser = parse_axis)]
+    pub axis: Vec<(String, usize)>,
+}
+
+/// `NAME=INDEX` of `--axis`.
+fn parse_axis(text: &str) -> std::result::Result<(String, usize), String> {
+    let (name, index) = text
+        .split_once('=')
+        .ok_or_else(|| format!("{text:?} is not NAME=INDEX (e.g. H=0)"))?;
+    let index = index
+        .trim()
+        .parse::<usize>()
+        .map_err(|_| format!("{text:?}: the index must be a non-negative integer"))?;
+    match name.trim() {
+        "" => Err(format!("{text:?}: the axis name is empty")),
+        n if ["T", "Z", "C", "X", "Y"].contains(&n) => Err(format!(
+            "{text:?}: use --t, --z or --channel for T, Z and C (X and Y are the plane)"
+        )),
+        n => Ok((n.to_string(), index)),
+    }
+}
+
+impl SelectionArgs {
+    /// The library's selection.
+    pub fn selection(&self) -> Selection {
+        Selection {
+            series: self.series,
+            channel: self.channel,
+            z: self.z,
+            t: self.t,
+            extra: self.axis.iter().cloned().collect(),
+        }
+    }
+}
+
+/// `--load-axis`: the axis of one CZI, ND2 or LIF file whose planes are the loads.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum LoadAxisArg {
+    /// Time points.
+    T,
+    /// Focal planes.
+    Z,
+    /// Series (CZI scenes, LIF images).
+    Series,
+}
+
+impl LoadAxisArg {
+    /// The library's load axis.
+    pub fn axis(self) -> LoadAxis {
+        match self {
+            LoadAxisArg::T => LoadAxis::T,
+            LoadAxisArg::Z => LoadAxis::Z,
+            LoadAxisArg::Series => LoadAxis::Series,
+        }
+    }
+}

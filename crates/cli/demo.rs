@@ -1,0 +1,63 @@
+//! `contactscope demo`: the whole method on a generated experiment with known truth.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+
+use contactscope_jobs::demo::{run_demo, DemoParams};
+
+use super::args::Quiet;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Report folder (an earlier demo report there is replaced).
+    #[arg(long, default_value = "contactscope-out/demo")]
+    out: PathBuf,
+    /// The reduced demo of the test suite (smaller maps, fewer loads).
+    #[arg(long)]
+    small: bool,
+    #[command(flatten)]
+    quiet: Quiet,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let params = if args.small {
+        DemoParams::reduced()
+    } else {
+        DemoParams::standard()
+    };
+    let start = std::time::Instant::now();
+    let quiet = args.quiet.quiet;
+    let progress = |stage: &str| {
+        if !quiet {
+            eprintln!("[{:>5.1} s] {stage}", start.elapsed().as_secs_f64());
+        }
+    };
+    let outcome = run_demo(&args.out, &params, &progress)?;
+    println!(
+        "{:<32} {:>12} {:>22} {:>8}  by",
+        "quantity", "truth", "recovered", "error"
+    );
+    for r in &outcome.recovered {
+        let unc = r
+            .uncertainty
+            .map_or(String::new(), |u| format!(" ± {u:.3}"));
+        println!(
+            "{:<32} {:>12} {:>22} {:>7.1}%  {}",
+            r.quantity,
+            format!("{:.3} {}", r.truth, r.unit),
+            format!("{:.3}{unc}", r.recovered),
+            100.0 * r.relative_error(),
+            r.by
+        );
+    }
+    for (model, dice) in &outcome.dice {
+        println!("mean Dice against the micrographs, {model}: {dice:.3}");
+    }
+    println!(
+        "report: {} ({:.1} s)",
+        outcome.index.display(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}

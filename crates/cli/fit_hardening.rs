@@ -1,0 +1,236 @@
+//! `contactscope fit-hardening`: fit contact models to a measured area–load curve.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use anyhow::{bail, Context, Result};
+
+use contactscope::compare::CompareSettings;
+use contactscope::model_fit::{Family, Imaging, ProgressHook, RampEvent, Search};
+use contactscope_formats::units::{self, Dimension};
+use contactscope_jobs::compare::ExperimentInput;
+use contactscope_jobs::fit_hardening::{run_fit, FitRequest, Sweep, SweepMicrographs};
+
+use super::args::{default_out, optional_pixel_size, BodyArgs, OutputFolder, SolverArgs};
+use indicatif::ProgressStyle;
+
+use super::args::Quiet;
+use super::common::{command_line, print_warnings, print_written, progress_bar};
+
+default_out!(Out, "contactscope-out/fit");
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// areas.csv of `contactscope analyze` (force_mN, area_um2).
+    #[arg(long)]
+    experiment: PathBuf,
+    #[command(flatten)]
+    body: BodyArgs,
+    /// Models to fit or score, comma-separated.
+    #[arg(long, default_value = "gt,elastic,hardness,hardening")]
+    models: String,
+    /// Search range for k.
+    #[arg(long, default_value = "0.1..100MPa/nm")]
+    k_range: String,
+    /// Search range for the penetration hardness p_Y.
+    #[arg(long, default_value = "10MPa..10GPa")]
+    hardness_range: String,
+    /// Parameter sweep: k=1..10MPa/nm:10 (evenly spaced), k=1,2,4MPa/nm, or hardness=….
+    #[arg(long)]
+    sweep: Option<String>,
+    /// Micrographs for Dice in the sweep: a manifest CSV or a folder with manifest.csv.
+    #[arg(long)]
+    micrographs: Option<PathBuf>,
+    /// PSF FWHM for Dice in the sweep (e.g. 450nm).
+    #[arg(long)]
+    psf_fwhm: Option<String>,
+    /// Micrograph pixel size (e.g. 200nm): overrides the micrographs' metadata, and sets the
+    /// image grid for --imaged-areas.
+    #[arg(long)]
+    micrograph_pixel_size: Option<String>,
+    /// Count simulated areas as the microscope sees them (blur with --psf-fwhm onto
+    /// --micrograph-pixel-size pixels, Otsu), like areas measured on micrographs.
+    #[arg(long)]
+    imaged_areas: bool,
+    /// Periodic boundaries (nominally flat periodic maps).
+    #[arg(long)]
+    periodic: bool,
+    #[command(flatten)]
+    solver: SolverArgs,
+    #[command(flatten)]
+    out: OutputFolder<Out>,
+    #[command(flatten)]
+    quiet: Quiet,
+}
+
+/// `hardening k = 4.02 MPa/nm, load 3/8`.
+fn ramp_label(event: &RampEvent) -> String {
+    let parameter = match (event.family, event.parameter) {
+        (Family::Hardening, Some(k)) => format!(" k = {:.3} MPa/nm", k * 1e-15),
+        (Family::Hardness, Some(p)) => format!(" p_Y = {:.1} MPa", p * 1e-6),
+        _ => String::new(),
+    };
+    format!(
+        "{}{parameter}, load {}/{}",
+        event.family.name(),
+        event.load,
+        event.loads
+    )
+}
+
+fn searches(args: &Args) -> Result<Vec<(Family, Search)>> {
+    let k = units::parse_range(&args.k_range, &|t| {
+        units::parse_ratio(t, Dimension::Pressure, Dimension::Length)
+    })
+    .context("--k-range")?;
+    let p = units::parse_range(&args.hardness_range, &|t| {
+        units::parse_positive(t, Dimension::Pressure)
+    })
+    .context("--hardness-range")?;
+    Ok(vec![
+        (
+            Family::Hardening,
+            Search {
+                range: k,
+                ..Search::default_for(Family::Hardening)
+            },
+        ),
+        (
+            Family::Hardness,
+            Search {
+                range: p,
+                ..Search::default_for(Family::Hardness)
+            },
+        ),
+    ])
+}
+
+fn sweep_micrographs(args: &Args) -> Result<Option<SweepMicrographs>> {
+    let Some(path) = &args.micrographs else {
+        return Ok(None);
+    };
+    let fwhm = args
+        .psf_fwhm
+        .as_deref()
+        .context("--micrographs needs --psf-fwhm")?;
+    Ok(Some(SweepMicrographs {
+        experiment: ExperimentInput::Manifest(path.clone()),
+        channel: None,
+        pixel_size_m: optional_pixel_size(&args.micrograph_pixel_size, "--micrograph-pixel-size")?,
+        settings: CompareSettings {
+            psf_fwhm_m: contactscope_formats::ranges::Quantity::Fwhm.check_text(
+                units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+                "--psf-fwhm",
+            )?,
+            dihedral: false,
+            upsample: 20,
+            force_tolerance: 0.01,
+        },
+    }))
+}
+
+fn imaging(args: &Args) -> Result<Option<Imaging>> {
+    if !args.imaged_areas {
+        return Ok(None);
+    }
+    let (Some(fwhm), Some(pixel)) = (&args.psf_fwhm, &args.micrograph_pixel_size) else {
+        bail!("--imaged-areas needs --psf-fwhm and --micrograph-pixel-size");
+    };
+    Ok(Some(Imaging {
+        fwhm_m: contactscope_formats::ranges::Quantity::Fwhm.check_text(
+            units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+            "--psf-fwhm",
+        )?,
+        pixel_m: units::parse_pixel_size(pixel).context("--micrograph-pixel-size")?,
+    }))
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let families = args
+        .models
+        .split(',')
+        .map(Family::parse)
+        .collect::<std::result::Result<Vec<_>, _>>()
+        .context("--models")?;
+    let sweep = args
+        .sweep
+        .as_deref()
+        .map(Sweep::parse)
+        .transpose()
+        .context("--sweep")?;
+    if args.micrographs.is_some() && sweep.is_none() {
+        bail!("--micrographs scores a --sweep; give one");
+    }
+    let body = args.body.body()?;
+    let request = FitRequest {
+        experiment: args.experiment.clone(),
+        topography: body.topography,
+        radius_m: body.radius_m,
+        e_star_pa: body.e_star_pa,
+        periodic: args.periodic,
+        families,
+        searches: searches(&args)?,
+        sweep,
+        micrographs: sweep_micrographs(&args)?,
+        imaging: imaging(&args)?,
+        options: args.solver.options(),
+        out_dir: args.out.out.clone(),
+        command_line: command_line(),
+        progress: None,
+    };
+    let mut request = request;
+    let bar = progress_bar(1, 1, args.quiet.quiet);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "[{bar:30}] {pos}/~{len} loads solved ({elapsed}, about {eta} left) {msg}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    bar.set_length(0);
+    let ramps = request.expected_ramps() as u64;
+    let hook_bar = bar.clone();
+    request.progress = Some(ProgressHook(Arc::new(move |event: &RampEvent| {
+        if hook_bar.length() == Some(0) {
+            hook_bar.set_length(ramps * event.loads as u64);
+        }
+        if hook_bar.position() + 1 >= hook_bar.length().unwrap_or(0) {
+            hook_bar.inc_length(event.loads as u64);
+        }
+        hook_bar.inc(1);
+        hook_bar.set_message(ramp_label(event));
+    })));
+    let outcome = run_fit(&request);
+    bar.finish_and_clear();
+    let outcome = outcome?;
+    print_warnings(&outcome.warnings);
+    println!("{:>10} {:>22} {:>10}", "model", "parameter", "misfit");
+    for fit in &outcome.fits {
+        let parameter = match (fit.family, fit.best.parameter) {
+            (Family::Hardening, Some(k)) => format!(
+                "k = {:.3} ± {} MPa/nm",
+                k * 1e-15,
+                fit.parameter_se
+                    .map_or("?".into(), |s| format!("{:.3}", s * 1e-15))
+            ),
+            (Family::Hardness, Some(p)) => format!(
+                "p_Y = {:.1} ± {} MPa",
+                p * 1e-6,
+                fit.parameter_se
+                    .map_or("?".into(), |s| format!("{:.1}", s * 1e-6))
+            ),
+            _ => "—".into(),
+        };
+        println!(
+            "{:>10} {:>22} {:>10.4}",
+            fit.family.name(),
+            parameter,
+            fit.best.misfit
+        );
+    }
+    if let Some(best) = outcome.best() {
+        println!("best model: {}", best.family.name());
+    }
+    print_written(outcome.written.len(), &args.out.out);
+    Ok(())
+}

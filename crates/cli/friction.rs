@@ -1,0 +1,103 @@
+//! `contactscope friction`: static and kinetic friction from rheometer traces; τ of F = τ·A.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+
+use contactscope::mechanics::friction::SlipOptions;
+use contactscope_formats::units::{self, Dimension};
+use contactscope_jobs::friction::{run_friction, FrictionRequest};
+
+use super::args::{default_out, fraction, OutputFolder};
+use super::common::{command_line, print_warnings, print_written};
+
+default_out!(Out, "contactscope-out/friction");
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Trace CSVs: time_s | displacement_um | angle_rad, friction_mN | friction_N | torque_mNm |
+    /// torque_Nm, optional normal_force_mN | normal_force_N.
+    #[arg(required = true)]
+    traces: Vec<PathBuf>,
+    /// Normal force for traces without a normal-force column (e.g. 40mN).
+    #[arg(long)]
+    normal_force: Option<String>,
+    /// Rotation radius of the sphere on the rheometer plate, turns torque into force (e.g. 5mm).
+    #[arg(long)]
+    rotation_radius: Option<String>,
+    /// areas.csv from `contactscope analyze` (force_mN, area_um2), for F = τ·A.
+    #[arg(long)]
+    areas: Option<PathBuf>,
+    /// Largest relative difference between a trace's normal force and an area row (e.g. 2%).
+    #[arg(long, default_value = "2%")]
+    force_tolerance: String,
+    #[command(flatten)]
+    out: OutputFolder<Out>,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let quantity = |text: &Option<String>, flag: &str, dim: Dimension| -> Result<Option<f64>> {
+        text.as_deref()
+            .map(|t| units::parse_positive(t, dim))
+            .transpose()
+            .with_context(|| flag.to_string())
+    };
+    let request = FrictionRequest {
+        traces: args.traces.clone(),
+        normal_force_n: quantity(&args.normal_force, "--normal-force", Dimension::Force)?,
+        rotation_radius_m: quantity(
+            &args.rotation_radius,
+            "--rotation-radius",
+            Dimension::Length,
+        )?,
+        areas: args.areas.clone(),
+        force_tolerance: fraction(&args.force_tolerance, "--force-tolerance")?,
+        slip: SlipOptions::default(),
+        out_dir: args.out.out.clone(),
+        command_line: command_line(),
+    };
+    let outcome = run_friction(&request)?;
+    print_warnings(&outcome.warnings);
+    println!(
+        "{:>9} {:>9} {:>9} {:>12} {:>7} {:>7}  file",
+        "N_mN", "F_s_mN", "F_k_mN", "slip_at", "μ_s", "μ_k"
+    );
+    for t in &outcome.traces {
+        let slip = t.x_axis.to_column_unit(t.slip.x);
+        let unit = t.x_axis.slip_column().trim_start_matches("slip_at_");
+        println!(
+            "{:>9.3} {:>9.4} {:>9.4} {:>12} {:>7.4} {:>7.4}  {}",
+            t.normal_force_n * 1e3,
+            t.slip.static_friction_n * 1e3,
+            t.slip.kinetic_friction_n * 1e3,
+            format!("{slip:.4} {unit}"),
+            t.mu_static(),
+            t.mu_kinetic(),
+            t.file.display()
+        );
+    }
+    if let Some(fit) = &outcome.shear {
+        let se = fit
+            .tau_se_pa
+            .map_or(String::new(), |s| format!(" ± {:.2}", s * 1e-6));
+        let r2 = fit.r_squared.map_or("—".into(), |r| format!("{r:.4}"));
+        println!("F_s = τ·A: τ = {:.2}{se} MPa (R² {r2})", fit.tau_pa * 1e-6);
+    }
+    if let Some(m) = &outcome.mu_trend {
+        let se = m
+            .exponent_se
+            .map_or(String::new(), |s| format!(" ± {s:.3}"));
+        let verdict = match m.varies {
+            Some(true) => "μ depends on N (not Amontons)",
+            Some(false) => "μ constant within the scatter",
+            None => "too few loads to judge",
+        };
+        println!(
+            "μ_s ∝ N^m: m = {:.3}{se}, spread {:.1} %: {verdict}",
+            m.exponent,
+            m.relative_spread * 100.0
+        );
+    }
+    print_written(outcome.written.len(), &args.out.out);
+    Ok(())
+}

@@ -1,0 +1,68 @@
+//! `contactscope hertz`: the contact modulus E* from a squeeze test.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+
+use contactscope_formats::units::{self, Dimension};
+use contactscope_jobs::hertz::{run_hertz, HertzRequest};
+
+use super::args::{default_out, OutputFolder};
+use super::common::{command_line, print_written};
+
+default_out!(Out, "contactscope-out/hertz");
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Squeeze CSV: force_mN | force_N and displacement_um (total plate displacement 2δ).
+    input: PathBuf,
+    /// Sphere radius (e.g. 290um).
+    #[arg(long)]
+    radius: String,
+    /// Loads at which to predict the Hertz contact radius (default: the measured forces).
+    #[arg(long)]
+    loads: Option<String>,
+    #[command(flatten)]
+    out: OutputFolder<Out>,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let request = HertzRequest {
+        input: args.input.clone(),
+        radius_m: contactscope_formats::ranges::Quantity::Radius.check_text(
+            units::parse_positive(&args.radius, Dimension::Length).context("--radius")?,
+            "--radius",
+        )?,
+        loads_n: args
+            .loads
+            .as_deref()
+            .map(units::parse_loads)
+            .transpose()
+            .context("--loads")?,
+        out_dir: args.out.out.clone(),
+        command_line: command_line(),
+    };
+    let outcome = run_hertz(&request)?;
+    let fit = &outcome.fit;
+    println!(
+        "E* = {:.4} ± {:.4} GPa (R² {:.5}, {} points, fit through the origin)",
+        fit.e_star_pa * 1e-9,
+        fit.e_star_se_pa * 1e-9,
+        fit.r_squared,
+        outcome.points.len()
+    );
+    if let Some(free) = &outcome.offset_fit {
+        println!(
+            "with a free contact point: E* = {:.4} ± {:.4} GPa, offset {:.4} µm of plate displacement",
+            free.e_star_pa * 1e-9,
+            free.e_star_se_pa * 1e-9,
+            2.0 * free.offset_m * 1e6
+        );
+    }
+    println!("{:>10} {:>12}", "load_mN", "a_Hertz_µm");
+    for (p, a) in &outcome.predicted {
+        println!("{:>10.3} {:>12.4}", p * 1e3, a * 1e6);
+    }
+    print_written(outcome.written.len(), &args.out.out);
+    Ok(())
+}

@@ -1,0 +1,139 @@
+//! `contactscope info`: describe a micrograph file: TIFF in detail; Zeiss CZI, Nikon ND2 and
+//! Leica LIF (and TIFF with `--json`/`--stats`) by series, axes, sample type and pixel size.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+
+use contactscope_formats::microscopy::summary::{info_summary_selected, InfoSummary};
+use contactscope_formats::units;
+use contactscope_jobs::info::{run_info, InfoRequest};
+
+use super::args::SelectionArgs;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// A TIFF, CZI, ND2 or LIF file.
+    file: PathBuf,
+    /// Print JSON: {"file", "format", "series": [{"index", "name", "axes", "dtype",
+    /// "pixel_size_um": {"x", "y", "z"}, "pixel_size_source", "planes"}]} (docs/formats.md).
+    #[arg(long)]
+    json: bool,
+    /// Decode every plane and add its min, max, mean and sum ("planes").
+    #[arg(long)]
+    stats: bool,
+    /// Restrict the listing: --series keeps one series, --channel/--z/--t the planes of --stats.
+    #[command(flatten)]
+    select: SelectionArgs,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let selection = args.select.selection();
+    let selected = selection != Default::default();
+    if args.json || args.stats || selected || !is_tiff(&args.file) {
+        let summary = info_summary_selected(&args.file, args.stats, &selection)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&summary)?);
+        } else {
+            print_summary(&summary);
+        }
+        return Ok(());
+    }
+    let i = run_info(&InfoRequest { file: args.file })?;
+    println!("file:         {}", i.path.display());
+    println!("pages:        {}", i.pages.len());
+    println!(
+        "shape:        {} × {} px (width × height)",
+        i.width, i.height
+    );
+    println!(
+        "sample type:  {} ({} bits)",
+        i.sample_type.name(),
+        i.bits_per_sample
+    );
+    println!(
+        "channels:     {} ({})",
+        i.channels,
+        i.channel_layout.describe()
+    );
+    println!(
+        "compression:  {} (predictor: {}), {}{}, {}-endian",
+        i.compression,
+        i.predictor,
+        if i.tiled { "tiled" } else { "strips" },
+        if i.bigtiff { ", BigTIFF" } else { "" },
+        i.byte_order
+    );
+    println!("description:  {}", i.description_kind);
+    match i.pixel_size {
+        Some(p) => println!(
+            "pixel size:   {} × {} from {}",
+            units::format_length(p.x_m),
+            units::format_length(p.y_m),
+            p.source.describe()
+        ),
+        None => println!("pixel size:   none in the metadata (use --pixel-size)"),
+    }
+    for note in &i.notes {
+        println!("note:         {note}");
+    }
+    Ok(())
+}
+
+/// A TIFF by its signature (classic or BigTIFF, either byte order); unreadable files are left to
+/// the readers, whose errors name them.
+fn is_tiff(path: &Path) -> bool {
+    let mut head = [0u8; 4];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|()| matches!(&head, b"II*\0" | b"MM\0*" | b"II+\0" | b"MM\0+"))
+}
+
+fn print_summary(summary: &InfoSummary) {
+    println!("file:         {}", summary.file);
+    println!("format:       {}", summary.format);
+    for s in &summary.series {
+        let a = &s.axes;
+        let name = if s.name.is_empty() {
+            String::new()
+        } else {
+            format!(" '{}'", s.name)
+        };
+        let extra: String = a
+            .extra
+            .iter()
+            .map(|(axis, n)| format!(" × {axis} {n}"))
+            .collect();
+        println!(
+            "series {}{name}: T {} × Z {} × C {}{extra} × Y {} × X {}, {}",
+            s.index, a.t, a.z, a.c, a.y, a.x, s.dtype
+        );
+        let p = &s.pixel_size_um;
+        match (p.x, p.y) {
+            (Some(x), Some(y)) => println!(
+                "  pixel size: {} × {}{} from {}",
+                units::format_length(x * 1e-6),
+                units::format_length(y * 1e-6),
+                p.z.map_or(String::new(), |z| format!(
+                    ", z step {}",
+                    units::format_length(z * 1e-6)
+                )),
+                s.pixel_size_source.as_deref().unwrap_or("the file")
+            ),
+            _ => println!("  pixel size: none in the metadata (use --pixel-size)"),
+        }
+        for plane in s.planes.iter().flatten() {
+            println!(
+                "  t {} z {} c {}: min {} max {} mean {:.4} sum {}",
+                plane.index.t,
+                plane.index.z,
+                plane.index.c,
+                plane.min,
+                plane.max,
+                plane.mean,
+                plane.sum
+            );
+        }
+    }
+}

@@ -1,0 +1,172 @@
+//! The `contactscope` command line: parse the arguments, dispatch to the command's file, print
+//! one line per error. No analysis here: each command builds the request of its job in
+//! `contactscope-jobs`, runs it and prints the outcome (`docs/architecture.md`).
+
+mod args;
+mod common;
+mod errors;
+mod signals;
+
+mod analyze;
+mod autocorr;
+mod compare;
+mod demo;
+mod fit_hardening;
+mod friction;
+mod hertz;
+mod info;
+mod newton;
+mod psf;
+mod simulate;
+mod surface;
+mod synth_series;
+mod threshold;
+mod topography;
+
+use std::process::ExitCode;
+
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "contactscope",
+    version,
+    about = "Real-contact-area microscopy: confocal load series → contact area versus load"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+    /// On failure, print every cause of the error on its own line (default: one line)
+    #[arg(long, global = true)]
+    verbose: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Analyse a load series: one global Otsu threshold, contact area per image, fits, plots.
+    Analyze(analyze::Args),
+    /// Print the global Otsu threshold of all pages of all inputs.
+    Threshold(threshold::Args),
+    /// Describe a TIFF file: pages, shape, sample type, compression, channels, pixel size.
+    Info(info::Args),
+    /// Generate a synthetic load series with known ground truth (seeded).
+    SynthSeries(synth_series::Args),
+    /// Analyse the bundled synthetic load series and compare with its ground truth.
+    Demo(demo::Args),
+    /// Simulate contact of a rough topography under a load sweep (elastic, hardness, hardening, gt).
+    Simulate(simulate::Args),
+    /// Generate a self-affine random surface (Fourier filtering, seeded).
+    Surface(surface::Args),
+    /// Print a topography's size, pixel size and roughness statistics.
+    Topography(topography::Args),
+    /// Radially averaged intensity autocorrelation of images (several go on one plot).
+    Autocorr(autocorr::Args),
+    /// Compare simulated contact maps with micrographs load by load (blur, register, score).
+    Compare(compare::Args),
+    /// Fit the hardening coefficient k (and p_Y, and score elastic and GT) to a measured area–load curve.
+    FitHardening(fit_hardening::Args),
+    /// Detection gap from Newton rings in a reflection image and the fluorescent contact.
+    Newton(newton::Args),
+    /// Measure the microscope PSF on a bead image or z stack (radial Gaussian fits, FWHM).
+    Psf(psf::Args),
+    /// Static and kinetic friction from rheometer traces; τ of F = τ·A with measured areas.
+    Friction(friction::Args),
+    /// Contact modulus E* from a squeeze test of one sphere between two plates (Hertz).
+    Hertz(hertz::Args),
+}
+
+/// The command line's grammar, with option values allowed to start with `-` (`--radius -1um` is
+/// then refused by the range check with its reason, not by clap as an unknown flag `-1`).
+fn grammar() -> clap::Command {
+    fn hyphen_values(arg: clap::Arg) -> clap::Arg {
+        let one_value = arg
+            .get_num_args()
+            .is_none_or(|r| r.min_values() == 1 && r.max_values() == 1);
+        if arg.get_long().is_some() && arg.get_action().takes_values() && one_value {
+            arg.allow_hyphen_values(true)
+        } else {
+            arg
+        }
+    }
+    Cli::command().mut_subcommands(|sub| sub.mut_args(hyphen_values))
+}
+
+fn main() -> ExitCode {
+    let parsed = grammar()
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m));
+    let cli = match parsed {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help and --version
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("{}", errors::usage_line(&e));
+            return ExitCode::from(2);
+        }
+    };
+    let (command, verbose) = (cli.command, cli.verbose);
+    // Messages name parameters as flags (`--pixel-size`).
+    contactscope_formats::param::set_front_end(contactscope_formats::param::FrontEnd::CommandLine);
+    signals::discard_on_interrupt();
+    let result = match command {
+        Command::Analyze(args) => analyze::run(args),
+        Command::Threshold(args) => threshold::run(args),
+        Command::Info(args) => info::run(args),
+        Command::SynthSeries(args) => synth_series::run(args),
+        Command::Demo(args) => demo::run(args),
+        Command::Simulate(args) => simulate::run(args),
+        Command::Surface(args) => surface::run(args),
+        Command::Topography(args) => topography::run(args),
+        Command::Autocorr(args) => autocorr::run(args),
+        Command::Compare(args) => compare::run(args),
+        Command::FitHardening(args) => fit_hardening::run(args),
+        Command::Newton(args) => newton::run(args),
+        Command::Psf(args) => psf::run(args),
+        Command::Friction(args) => friction::run(args),
+        Command::Hertz(args) => hertz::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(_) if signals::interrupted() => loop {
+            // The signal handler reports and exits; the run's error is a consequence.
+            std::thread::park();
+        },
+        Err(e) => {
+            eprintln!("{}", errors::report(&e, verbose));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// Flattened argument groups (selection flags, height-map options) must not clash with a
+    /// command's own flags. clap checks this only with debug assertions, which the release
+    /// profile the tests run in turns off, so the long names are compared here.
+    #[test]
+    fn no_command_has_two_flags_of_one_name() {
+        for command in super::Cli::command().get_subcommands() {
+            let mut names: Vec<&str> = command
+                .get_arguments()
+                .filter_map(|a| a.get_long())
+                .collect();
+            let n = names.len();
+            names.sort_unstable();
+            names.dedup();
+            assert_eq!(names.len(), n, "{}: {names:?}", command.get_name());
+        }
+        let analyze = super::Cli::command();
+        let analyze = analyze.find_subcommand("analyze").unwrap();
+        for flag in ["series", "channel", "z", "t", "axis", "load-axis"] {
+            assert!(
+                analyze.get_arguments().any(|a| a.get_long() == Some(flag)),
+                "analyze --{flag}"
+            );
+        }
+    }
+}

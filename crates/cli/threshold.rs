@@ -1,0 +1,50 @@
+//! `contactscope threshold`: the global Otsu threshold of all pages of all inputs.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+
+use contactscope_jobs::threshold::{run_threshold, ThresholdRequest};
+
+use super::args::{LoadAxisArg, SelectionArgs};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// TIFF, CZI, ND2 or LIF files, or directories of them.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    #[command(flatten)]
+    select: SelectionArgs,
+    /// Axis of a CZI, ND2 or LIF file whose planes are the loads, in order.
+    #[arg(long, value_enum)]
+    load_axis: Option<LoadAxisArg>,
+    /// Print a JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let outcome = run_threshold(&ThresholdRequest {
+        inputs: args.inputs,
+        selection: args.select.selection(),
+        load_axis: args.load_axis.map(LoadAxisArg::axis),
+    })?;
+    super::common::print_warnings(&outcome.warnings);
+    if args.json {
+        let value = serde_json::json!({
+            "threshold": outcome.threshold.value,
+            "method": "otsu-global",
+            "contact_rule": "value > threshold",
+            "pixels": outcome.pixels,
+            "images": outcome.images,
+            "files": outcome.files,
+        });
+        println!("{}", serde_json::to_string_pretty(&value)?);
+    } else {
+        println!(
+            "{} (global Otsu over {} pixels in {} images; contact is value > threshold)",
+            outcome.threshold.value, outcome.pixels, outcome.images
+        );
+    }
+    Ok(())
+}

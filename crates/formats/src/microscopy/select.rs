@@ -1,0 +1,393 @@
+//! Which planes of a confocal file a command uses: the `--series`, `--channel`, `--z` and `--t`
+//! selection shared by every command that reads confocal images, and the load axis
+//! (`--load-axis t|z|series`) along which one file holds a whole load series (issue 14, item 1).
+//!
+//! Rules ([`Selection::planes`]): an axis of length 1 defaults to 0; an axis longer than 1 must
+//! be selected unless it is the load axis, otherwise the error names the axis, its length and
+//! the flag ("FILE: 3 channels; choose one with --channel 0..2"). Extra axes (Airyscan phases
+//! `H`, colour samples `S`, spectral sweeps, …) are chosen by name (`--axis H=0`,
+//! [`Selection::extra`]); one longer than 1 and not chosen is refused the same way, naming it
+//! (`info` lists them).
+//!
+//! TIFF files keep their own model (every page of the chosen channel is one image, see
+//! [`crate::io::series`]): on a TIFF only `--channel` applies, and a non-zero `--series`, `--z`
+//! or `--t` is refused.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::{MicroscopyFile, MicroscopyFormat, PlaneIndex, SeriesInfo};
+use crate::error::{Error, Location, Result};
+use crate::image::{pixel_size_or, Image, PixelSize, PixelSizeSource};
+
+/// The selection flags: each `None` when not given.
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
+pub struct Selection {
+    /// `--series`: CZI scene, LIF image (ND2 and TIFF have one series).
+    pub series: Option<usize>,
+    /// `--channel`.
+    pub channel: Option<usize>,
+    /// `--z`: focal plane.
+    pub z: Option<usize>,
+    /// `--t`: time point.
+    pub t: Option<usize>,
+    /// `--axis NAME=INDEX`: indices along extra axes (`H`, `S`, `lambda_emission`, …).
+    pub extra: BTreeMap<String, usize>,
+}
+
+/// The axis along which one file holds the loads of a series, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LoadAxis {
+    /// Time points.
+    T,
+    /// Focal planes.
+    Z,
+    /// Series (CZI scenes, LIF images).
+    Series,
+}
+
+impl LoadAxis {
+    /// The flag value (`t`, `z`, `series`).
+    pub fn name(self) -> &'static str {
+        match self {
+            LoadAxis::T => "t",
+            LoadAxis::Z => "z",
+            LoadAxis::Series => "series",
+        }
+    }
+}
+
+/// One selected plane of a file: its series, its index, and its position along the load axis
+/// (0 without one).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct SelectedPlane {
+    /// Series index in the file.
+    pub series: usize,
+    /// The plane within the series.
+    pub index: PlaneIndex,
+    /// Position along the load axis.
+    pub load_index: usize,
+}
+
+impl SelectedPlane {
+    /// `series 0, t 2, z 0, c 1` for labels.
+    pub fn describe(&self) -> String {
+        let mut s = format!(
+            "series {}, t {}, z {}, c {}",
+            self.series, self.index.t, self.index.z, self.index.c
+        );
+        for (axis, i) in &self.index.extra {
+            s.push_str(&format!(", {axis} {i}"));
+        }
+        s
+    }
+}
+
+impl Selection {
+    /// Only a channel (the older `--channel` of TIFF commands).
+    pub fn channel(channel: Option<usize>) -> Self {
+        Selection {
+            channel,
+            ..Selection::default()
+        }
+    }
+
+    /// Refuse flags that do not apply to a TIFF file (a non-zero series, z or t).
+    pub fn check_tiff(&self, path: &Path) -> Result<()> {
+        for (flag, value) in [("--series", self.series), ("--z", self.z), ("--t", self.t)] {
+            if let Some(v) = value.filter(|v| *v > 0) {
+                return Err(Error::bad_input(
+                    Location::file(path),
+                    format!(
+                        "{flag} {v}: a TIFF's pages are its images; {flag} applies to CZI, ND2 and LIF files"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The planes of `file` this selection names, in load order: one plane without a load axis,
+    /// every plane along `along` otherwise.
+    pub fn planes(
+        &self,
+        file: &MicroscopyFile,
+        along: Option<LoadAxis>,
+    ) -> Result<Vec<SelectedPlane>> {
+        let path = &file.path;
+        let bad = |reason: String| Error::bad_input(Location::file(path), reason);
+        let n_series = file.series.len();
+        if n_series == 0 {
+            return Err(bad("the file holds no image series".into()));
+        }
+        let series: Vec<usize> = if along == Some(LoadAxis::Series) {
+            if self.series.is_some() {
+                return Err(Error::InvalidArgument(
+                    "--series cannot be combined with --load-axis series".into(),
+                ));
+            }
+            (0..n_series).collect()
+        } else {
+            vec![pick(path, "series", "--series", self.series, n_series)?]
+        };
+        let mut out = Vec::new();
+        for (k, &s) in series.iter().enumerate() {
+            let info = &file.series[s];
+            let extra = self.extra_index(path, info)?;
+            let a = &info.axes;
+            let what = |axis: &'static str| match n_series {
+                1 => axis.to_string(),
+                _ => format!("{axis} in series {s}"),
+            };
+            let c = pick(path, &what("channels"), "--channel", self.channel, a.c)?;
+            let zs = along_or_pick(
+                path,
+                &what("z planes"),
+                "--z",
+                self.z,
+                a.z,
+                along,
+                LoadAxis::Z,
+            )?;
+            let ts = along_or_pick(
+                path,
+                &what("time points"),
+                "--t",
+                self.t,
+                a.t,
+                along,
+                LoadAxis::T,
+            )?;
+            for &t in &ts {
+                for &z in &zs {
+                    let load_index = match along {
+                        Some(LoadAxis::T) => t,
+                        Some(LoadAxis::Z) => z,
+                        Some(LoadAxis::Series) => k,
+                        None => 0,
+                    };
+                    let mut index = PlaneIndex::tzc(t, z, c);
+                    index.extra = extra.clone();
+                    out.push(SelectedPlane {
+                        series: s,
+                        index,
+                        load_index,
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The index along an axis of length `n`: the requested one (checked), or 0 when `n` is 1.
+fn pick(path: &Path, what: &str, flag: &str, requested: Option<usize>, n: usize) -> Result<usize> {
+    let bad = |reason: String| Error::bad_input(Location::file(path), reason);
+    match requested {
+        Some(i) if i < n => Ok(i),
+        Some(i) => Err(bad(format!(
+            "{flag} {i} requested; the file has {n} {what} (0..{})",
+            n.saturating_sub(1)
+        ))),
+        None if n == 1 => Ok(0),
+        None => Err(bad(format!(
+            "{n} {what}; choose one with {flag} 0..{}",
+            n - 1
+        ))),
+    }
+}
+
+/// Every index when the axis is the load axis (a selection of it is then refused), else one.
+fn along_or_pick(
+    path: &Path,
+    what: &str,
+    flag: &str,
+    requested: Option<usize>,
+    n: usize,
+    along: Option<LoadAxis>,
+    axis: LoadAxis,
+) -> Result<Vec<usize>> {
+    if along == Some(axis) {
+        if requested.is_some() {
+            return Err(Error::InvalidArgument(format!(
+                "{flag} cannot be combined with --load-axis {}",
+                axis.name()
+            )));
+        }
+        return Ok((0..n).collect());
+    }
+    Ok(vec![pick(path, what, flag, requested, n)?])
+}
+
+impl Selection {
+    /// The indices along the series' extra axes: each axis longer than 1 must be chosen; a
+    /// chosen axis the series does not have is an error (length-1 axes accept index 0).
+    fn extra_index(&self, path: &Path, info: &SeriesInfo) -> Result<BTreeMap<String, usize>> {
+        let bad = |reason: String| Error::bad_input(Location::file(path), reason);
+        let mut out = BTreeMap::new();
+        for (axis, &n) in &info.axes.extra {
+            let meaning = match axis.as_str() {
+                "H" => " (Airyscan detector phases)",
+                "S" => " (colour samples of an RGB pixel: 0 blue, 1 green, 2 red)",
+                "P" => " (stage positions)",
+                _ => "",
+            };
+            match self.extra.get(axis) {
+                Some(&i) if i < n => {
+                    out.insert(axis.clone(), i);
+                }
+                Some(&i) => {
+                    return Err(bad(format!(
+                        "--axis {axis}={i} requested; series {} has {n} planes along {axis} (0..{})",
+                        info.index,
+                        n - 1
+                    )))
+                }
+                None if n > 1 => {
+                    return Err(bad(format!(
+                        "series {} has {n} planes along axis {axis}{meaning}; choose one with --axis {axis}=0..{}",
+                        info.index,
+                        n - 1
+                    )))
+                }
+                None => {}
+            }
+        }
+        if let Some((axis, &i)) = self
+            .extra
+            .iter()
+            .find(|(a, &i)| !info.axes.extra.contains_key(*a) && i > 0)
+        {
+            return Err(bad(format!(
+                "--axis {axis}={i} requested; series {} has no axis {axis} longer than 1",
+                info.index
+            )));
+        }
+        Ok(out)
+    }
+}
+
+/// The lateral pixel size of a series from its metadata (both x and y needed), with the
+/// metadata element as source.
+pub fn series_pixel_size(format: MicroscopyFormat, info: &SeriesInfo) -> Option<PixelSize> {
+    let source = match format {
+        MicroscopyFormat::Czi => PixelSizeSource::CziScaling,
+        MicroscopyFormat::Nd2 => PixelSizeSource::Nd2Calibration,
+        MicroscopyFormat::Lif => PixelSizeSource::LifDimensions,
+        // TIFF files go through `io::tiff`, which knows the finer source.
+        MicroscopyFormat::Tiff => return None,
+    };
+    Some(PixelSize {
+        x_m: info.pixel_size.x_m?,
+        y_m: info.pixel_size.y_m?,
+        source,
+    })
+}
+
+/// Whether a file is a TIFF (by content; an unreadable file counts as TIFF so that the TIFF
+/// reader reports the problem as before).
+pub fn is_tiff(path: &Path) -> bool {
+    let mut head = [0u8; 16];
+    let n = std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
+        .unwrap_or(0);
+    !matches!(
+        super::detect(&head[..n]),
+        Some(MicroscopyFormat::Czi | MicroscopyFormat::Nd2 | MicroscopyFormat::Lif)
+    )
+}
+
+/// The selected planes of any confocal file as [`Image`]s, in load order: for a TIFF, every page
+/// of the channel (as [`crate::tiff::read_pages`]); for CZI, ND2 and LIF, the planes
+/// [`Selection::planes`] names. `page` of each image is its position along the load axis for
+/// vendor files. Pixel size: the override, else the file's metadata.
+pub fn read_images(
+    path: &Path,
+    selection: &Selection,
+    along: Option<LoadAxis>,
+    pixel_size_m: Option<(f64, f64)>,
+) -> Result<Vec<Image>> {
+    if is_tiff(path) {
+        selection.check_tiff(path)?;
+        return crate::tiff::read_pages(path, selection.channel, pixel_size_m);
+    }
+    let mut file = MicroscopyFile::open(path)?;
+    let planes = selection.planes(&file, along)?;
+    let mut images = Vec::with_capacity(planes.len());
+    for p in planes {
+        let plane = file.read_plane(p.series, &p.index)?;
+        let pixel_size = pixel_size_or(
+            series_pixel_size(file.format, &file.series[p.series]),
+            pixel_size_m,
+        );
+        images.push(Image {
+            values: plane.to_f64(),
+            width: plane.width,
+            height: plane.height,
+            pixel_size,
+            path: PathBuf::from(path),
+            page: p.load_index,
+        });
+    }
+    Ok(images)
+}
+
+/// The one image a selection names (a TIFF must have a single page).
+pub fn read_one_image(
+    path: &Path,
+    selection: &Selection,
+    pixel_size_m: Option<(f64, f64)>,
+) -> Result<Image> {
+    if is_tiff(path) {
+        selection.check_tiff(path)?;
+        return crate::tiff::read_image(path, selection.channel, pixel_size_m);
+    }
+    let mut images = read_images(path, selection, None, pixel_size_m)?;
+    Ok(images.remove(0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pick_defaults_and_errors() {
+        let p = Path::new("f.czi");
+        assert_eq!(pick(p, "channels", "--channel", None, 1).unwrap(), 0);
+        assert_eq!(pick(p, "channels", "--channel", Some(2), 3).unwrap(), 2);
+        let e = pick(p, "channels", "--channel", None, 3)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "f.czi: 3 channels; choose one with --channel 0..2");
+        let e = pick(p, "channels", "--channel", Some(3), 3)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--channel 3") && e.contains("3 channels (0..2)"),
+            "{e}"
+        );
+        let all = along_or_pick(
+            p,
+            "z planes",
+            "--z",
+            None,
+            4,
+            Some(LoadAxis::Z),
+            LoadAxis::Z,
+        );
+        assert_eq!(all.unwrap(), vec![0, 1, 2, 3]);
+        let both = along_or_pick(
+            p,
+            "z planes",
+            "--z",
+            Some(1),
+            4,
+            Some(LoadAxis::Z),
+            LoadAxis::Z,
+        );
+        assert!(both.unwrap_err().to_string().contains("--load-axis z"));
+    }
+}

@@ -1,0 +1,551 @@
+//! TIFF pages → [`Plane`]s, with the facts `contactscope info` prints.
+//!
+//! Built on the `tiff` crate's decoder. Two of its behaviours are handled here on purpose
+//! (`../shared/docs/images.md` §2): `read_image` returns only the first plane of a planar
+//! (PlanarConfiguration = 2) file, so we use `read_image_to_buffer` and check that every plane
+//! arrived; and packed 12-bit or palette images are reported as unsupported, never guessed at.
+//! Reduced-resolution pages (NewSubfileType bit 0, e.g. LSM thumbnails) are skipped.
+
+use std::fs::File;
+use std::io::{BufReader, Read, Seek};
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use tiff::decoder::{Decoder, DecodingResult, Limits};
+use tiff::tags::Tag;
+use tiff::{ColorType, TiffError};
+
+use super::metadata::{self, ImageJDescription};
+use crate::error::{Error, Location, Result};
+use crate::image::{PixelSize, PixelSizeSource, Plane, SampleType, Samples};
+
+/// Largest decoded page we accept (bytes); guards allocations against absurd header dimensions.
+pub const MAX_PAGE_BYTES: usize = crate::limits::Limits::DEFAULT.max_plane_bytes;
+
+/// How the channels of a file are stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ChannelLayout {
+    /// One sample per pixel and one channel.
+    Single,
+    /// Several samples per pixel, interleaved (PlanarConfiguration = 1).
+    Contiguous,
+    /// Several samples per pixel, one plane each (PlanarConfiguration = 2).
+    Planar,
+    /// An ImageJ hyperstack: one channel per page, channel index fastest.
+    ImageJPages,
+}
+
+impl ChannelLayout {
+    /// A short description for people.
+    pub fn describe(self) -> &'static str {
+        match self {
+            ChannelLayout::Single => "one channel",
+            ChannelLayout::Contiguous => "interleaved samples per pixel",
+            ChannelLayout::Planar => "one plane per sample (planar)",
+            ChannelLayout::ImageJPages => "ImageJ hyperstack, one page per channel",
+        }
+    }
+}
+
+/// What a TIFF file holds, read from its headers without decoding pixel data.
+#[derive(Debug, Clone, Serialize)]
+pub struct TiffInfo {
+    /// The file.
+    pub path: PathBuf,
+    /// IFD indices of full-resolution pages (thumbnails excluded).
+    pub pages: Vec<usize>,
+    /// Width of the first page in pixels.
+    pub width: usize,
+    /// Height of the first page in pixels.
+    pub height: usize,
+    /// Sample type of the first page.
+    pub sample_type: SampleType,
+    /// Bits per sample as stored.
+    pub bits_per_sample: u8,
+    /// Number of channels (samples per pixel, or ImageJ `channels=`).
+    pub channels: usize,
+    /// How the channels are stored.
+    pub channel_layout: ChannelLayout,
+    /// Compression of the first page, by name.
+    pub compression: String,
+    /// Predictor of the first page, by name.
+    pub predictor: String,
+    /// `true` for strips, `false` for tiles.
+    pub tiled: bool,
+    /// `true` for BigTIFF.
+    pub bigtiff: bool,
+    /// "little" or "big".
+    pub byte_order: String,
+    /// Pixel size from the file's metadata, if any.
+    pub pixel_size: Option<PixelSize>,
+    /// What kind of ImageDescription the file has ("ImageJ", "OME-XML", "text" or "none").
+    pub description_kind: String,
+    /// Notes about ignored or doubtful metadata.
+    pub notes: Vec<String>,
+}
+
+impl TiffInfo {
+    /// The IFD indices that hold `channel` (all pages unless the channels are ImageJ pages).
+    pub fn pages_of_channel(&self, channel: usize) -> Vec<usize> {
+        match self.channel_layout {
+            ChannelLayout::ImageJPages => self
+                .pages
+                .iter()
+                .copied()
+                .skip(channel)
+                .step_by(self.channels)
+                .collect(),
+            _ => self.pages.clone(),
+        }
+    }
+}
+
+/// An open TIFF file that decodes pages on request.
+pub struct TiffReader {
+    decoder: Decoder<BufReader<File>>,
+    info: TiffInfo,
+}
+
+fn tiff_error(at: Location, err: TiffError) -> Error {
+    match err {
+        TiffError::UnsupportedError(e) => Error::Unsupported {
+            at,
+            reason: e.to_string(),
+        },
+        TiffError::LimitsExceeded => Error::Unsupported {
+            at,
+            reason: format!(
+                "page larger than the {} GiB limit (header dimensions too large?)",
+                MAX_PAGE_BYTES >> 30
+            ),
+        },
+        TiffError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => Error::BadTiff {
+            at,
+            reason: "file is truncated".into(),
+        },
+        other => Error::BadTiff {
+            at,
+            reason: other.to_string(),
+        },
+    }
+}
+
+fn compression_name(code: u16) -> String {
+    match code {
+        1 => "none".into(),
+        2 => "CCITT RLE".into(),
+        5 => "LZW".into(),
+        6 | 7 => "JPEG".into(),
+        8 | 32946 => "Deflate".into(),
+        32773 => "PackBits".into(),
+        34887 => "LERC".into(),
+        50000 => "zstd".into(),
+        other => format!("code {other}"),
+    }
+}
+
+fn predictor_name(code: u16) -> String {
+    match code {
+        1 => "none".into(),
+        2 => "horizontal".into(),
+        3 => "floating-point".into(),
+        other => format!("code {other}"),
+    }
+}
+
+fn rational(value: Option<tiff::decoder::ifd::Value>) -> Option<f64> {
+    use tiff::decoder::ifd::Value;
+    let v = match value? {
+        Value::Rational(n, d) if d != 0 => f64::from(n) / f64::from(d),
+        Value::Float(f) => f64::from(f),
+        Value::Double(f) => f,
+        Value::Unsigned(n) => f64::from(n),
+        Value::Short(n) => f64::from(n),
+        _ => return None,
+    };
+    (v.is_finite() && v > 0.0).then_some(v)
+}
+
+impl TiffReader {
+    /// Open a TIFF file and read its headers (every IFD, no pixel data).
+    pub fn open(path: &Path) -> Result<Self> {
+        crate::inputs::note_input(path);
+        let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        let mut decoder =
+            Decoder::new(BufReader::new(file)).map_err(|e| tiff_error(Location::file(path), e))?;
+        let mut limits = Limits::default();
+        limits.decoding_buffer_size = MAX_PAGE_BYTES;
+        decoder = decoder.with_limits(limits);
+        let info = read_info(path, &mut decoder)?;
+        Ok(TiffReader { decoder, info })
+    }
+
+    /// Header facts of the file.
+    pub fn info(&self) -> &TiffInfo {
+        &self.info
+    }
+
+    /// Decode page `page` (an IFD index) and return channel `channel` of it. For ImageJ
+    /// hyperstacks the channel is the page itself, so `channel` is ignored here.
+    pub fn read_page(&mut self, page: usize, channel: usize) -> Result<Plane> {
+        let at = Location::page(&self.info.path, page);
+        self.decoder
+            .seek_to_image(page)
+            .map_err(|e| tiff_error(at.clone(), e))?;
+        let (width, height) = self
+            .decoder
+            .dimensions()
+            .map_err(|e| tiff_error(at.clone(), e))?;
+        let colortype = self
+            .decoder
+            .colortype()
+            .map_err(|e| tiff_error(at.clone(), e))?;
+        let samples_per_pixel = check_colortype(colortype, &at)?;
+        let planar = self
+            .decoder
+            .find_tag_unsigned::<u16>(Tag::PlanarConfiguration)
+            .ok()
+            .flatten()
+            == Some(2);
+        let mut buffer = DecodingResult::U8(Vec::new());
+        let layout = self
+            .decoder
+            .read_image_to_buffer(&mut buffer)
+            .map_err(|e| tiff_error(at.clone(), e))?;
+        if buffer.as_buffer(0).as_bytes().len() < layout.complete_len {
+            return Err(Error::Unsupported {
+                at,
+                reason: "not all sample planes could be decoded within the size limit".into(),
+            });
+        }
+        let (width, height) = (width as usize, height as usize);
+        let spp = samples_per_pixel as usize;
+        let channel = if spp > 1 { channel } else { 0 };
+        if channel >= spp {
+            return Err(Error::bad_input(
+                at,
+                format!("channel {channel} requested but the page has {spp} samples per pixel"),
+            ));
+        }
+        let pick = ChannelPick {
+            pixels: width * height,
+            spp,
+            planar,
+            channel,
+        };
+        let (sample_type, samples) = convert_samples(buffer, pick, &at)?;
+        Ok(Plane {
+            width,
+            height,
+            sample_type,
+            samples,
+        })
+    }
+}
+
+/// Which samples of a decoded buffer form the requested channel.
+#[derive(Clone, Copy)]
+struct ChannelPick {
+    pixels: usize,
+    spp: usize,
+    planar: bool,
+    channel: usize,
+}
+
+impl ChannelPick {
+    fn apply<T: Copy>(self, mut values: Vec<T>) -> Vec<T> {
+        if self.spp == 1 {
+            values.truncate(self.pixels);
+            values
+        } else if self.planar {
+            let start = self.channel * self.pixels;
+            values[start..start + self.pixels].to_vec()
+        } else {
+            values
+                .iter()
+                .skip(self.channel)
+                .step_by(self.spp)
+                .take(self.pixels)
+                .copied()
+                .collect()
+        }
+    }
+}
+
+fn convert_samples(
+    buffer: DecodingResult,
+    pick: ChannelPick,
+    at: &Location,
+) -> Result<(SampleType, Samples)> {
+    let int = |codes: Vec<u16>, offset: i32| Samples::Int { codes, offset };
+    let converted = match buffer {
+        DecodingResult::U8(v) => (
+            SampleType::U8,
+            int(pick.apply(v).into_iter().map(u16::from).collect(), 0),
+        ),
+        DecodingResult::U16(v) => (SampleType::U16, int(pick.apply(v), 0)),
+        DecodingResult::I16(v) => (
+            SampleType::I16,
+            int(
+                pick.apply(v)
+                    .into_iter()
+                    .map(|x| (i32::from(x) + 32768) as u16)
+                    .collect(),
+                -32768,
+            ),
+        ),
+        DecodingResult::F32(v) => (SampleType::F32, Samples::Float(pick.apply(v))),
+        DecodingResult::F64(v) => (
+            SampleType::F64,
+            Samples::Float(pick.apply(v).into_iter().map(|x| x as f32).collect()),
+        ),
+        other => {
+            return Err(Error::Unsupported {
+                at: at.clone(),
+                reason: format!(
+                "sample format {} (contactscope reads uint8, uint16, int16, float32 and float64)",
+                decoding_name(&other)
+            ),
+            })
+        }
+    };
+    Ok(converted)
+}
+
+fn decoding_name(result: &DecodingResult) -> &'static str {
+    match result {
+        DecodingResult::U8(_) => "uint8",
+        DecodingResult::U16(_) => "uint16",
+        DecodingResult::U32(_) => "uint32",
+        DecodingResult::U64(_) => "uint64",
+        DecodingResult::F16(_) => "float16",
+        DecodingResult::F32(_) => "float32",
+        DecodingResult::F64(_) => "float64",
+        DecodingResult::I8(_) => "int8",
+        DecodingResult::I16(_) => "int16",
+        DecodingResult::I32(_) => "int32",
+        DecodingResult::I64(_) => "int64",
+    }
+}
+
+/// Samples per pixel for colour types we read; a clear error for the rest.
+fn check_colortype(colortype: ColorType, at: &Location) -> Result<u16> {
+    let unsupported = |reason: String| Error::Unsupported {
+        at: at.clone(),
+        reason,
+    };
+    let (bits, spp) = match colortype {
+        ColorType::Gray(b) => (b, 1),
+        ColorType::GrayA(b) => (b, 2),
+        ColorType::RGB(b) => (b, 3),
+        ColorType::RGBA(b) => (b, 4),
+        ColorType::Multiband {
+            bit_depth,
+            num_samples,
+        } => (bit_depth, num_samples),
+        ColorType::Palette(_) => {
+            return Err(unsupported(
+                "palette (indexed colour) image; a micrograph must store intensities".into(),
+            ))
+        }
+        other => {
+            return Err(unsupported(format!(
+                "colour type {other:?}; contactscope reads grey or multi-channel intensities"
+            )))
+        }
+    };
+    if ![8, 16, 32, 64].contains(&bits) {
+        return Err(unsupported(format!(
+            "{bits}-bit packed samples (BitsPerSample = {bits}); save the image with 16-bit samples"
+        )));
+    }
+    Ok(spp)
+}
+
+fn sample_type_of(bits: u8, format: u16, at: &Location) -> Result<SampleType> {
+    match (bits, format) {
+        (8, 1) => Ok(SampleType::U8),
+        (16, 1) => Ok(SampleType::U16),
+        (16, 2) => Ok(SampleType::I16),
+        (32, 3) => Ok(SampleType::F32),
+        (64, 3) => Ok(SampleType::F64),
+        _ => Err(Error::Unsupported {
+            at: at.clone(),
+            reason: format!(
+                "{bits}-bit {} samples (contactscope reads uint8, uint16, int16, float32 and float64)",
+                match format {
+                    1 => "unsigned integer",
+                    2 => "signed integer",
+                    3 => "floating-point",
+                    _ => "undefined-format",
+                }
+            ),
+        }),
+    }
+}
+
+fn read_info<R: Read + Seek>(path: &Path, decoder: &mut Decoder<R>) -> Result<TiffInfo> {
+    let at = Location::page(path, 0);
+    let err = |e| tiff_error(at.clone(), e);
+    let (width, height) = decoder.dimensions().map_err(err)?;
+    let colortype = decoder.colortype().map_err(err)?;
+    let spp = check_colortype(colortype, &at)?;
+    let bits = decoder
+        .find_tag_unsigned_vec::<u16>(Tag::BitsPerSample)
+        .map_err(err)?
+        .and_then(|v| v.first().copied())
+        .unwrap_or(1) as u8;
+    let format = decoder
+        .find_tag_unsigned_vec::<u16>(Tag::SampleFormat)
+        .map_err(err)?
+        .and_then(|v| v.first().copied())
+        .unwrap_or(1);
+    let sample_type = sample_type_of(bits, format, &at)?;
+    let tag_u16 = |d: &mut Decoder<R>, tag| d.find_tag_unsigned::<u16>(tag).ok().flatten();
+    let compression = compression_name(tag_u16(decoder, Tag::Compression).unwrap_or(1));
+    let predictor = predictor_name(tag_u16(decoder, Tag::Predictor).unwrap_or(1));
+    let planar = tag_u16(decoder, Tag::PlanarConfiguration) == Some(2);
+    let tiled = decoder.find_tag(Tag::TileWidth).ok().flatten().is_some();
+    let description = match decoder.find_tag(Tag::ImageDescription) {
+        Ok(Some(tiff::decoder::ifd::Value::Ascii(s))) => Some(s),
+        _ => None,
+    };
+    let imagej = description.as_deref().and_then(metadata::parse_imagej);
+    let mut notes = Vec::new();
+    let pixel_size = pixel_size_from_tags(decoder, description.as_deref(), &imagej, &mut notes);
+    let bigtiff = is_bigtiff(path);
+    let byte_order = match decoder.byte_order() {
+        tiff::tags::ByteOrder::LittleEndian => "little",
+        tiff::tags::ByteOrder::BigEndian => "big",
+    };
+    let pages = list_pages(decoder, path)?;
+
+    let (channels, channel_layout) = match (spp, imagej.as_ref().and_then(|m| m.channels)) {
+        (1, Some(c)) if c > 1 && pages.len() % c == 0 => (c, ChannelLayout::ImageJPages),
+        (1, _) => (1, ChannelLayout::Single),
+        (s, _) if planar => (s as usize, ChannelLayout::Planar),
+        (s, _) => (s as usize, ChannelLayout::Contiguous),
+    };
+    let description_kind = match (&description, &imagej) {
+        (_, Some(_)) => "ImageJ",
+        (Some(d), None) if d.contains("<OME") => "OME-XML",
+        (Some(_), None) => "text",
+        (None, _) => "none",
+    };
+    Ok(TiffInfo {
+        path: path.to_path_buf(),
+        pages,
+        width: width as usize,
+        height: height as usize,
+        sample_type,
+        bits_per_sample: bits,
+        channels,
+        channel_layout,
+        compression,
+        predictor,
+        tiled,
+        bigtiff,
+        byte_order: byte_order.into(),
+        pixel_size,
+        description_kind: description_kind.into(),
+        notes,
+    })
+}
+
+fn is_bigtiff(path: &Path) -> bool {
+    let mut head = [0u8; 4];
+    File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok()
+        && (head[2..] == [0, 43] || head[2..] == [43, 0])
+}
+
+/// Walk the IFD chain; keep full-resolution pages. Leaves the decoder on the first page.
+fn list_pages<R: Read + Seek>(decoder: &mut Decoder<R>, path: &Path) -> Result<Vec<usize>> {
+    let mut pages = Vec::new();
+    let mut index = 0;
+    loop {
+        let reduced = decoder
+            .find_tag_unsigned::<u32>(Tag::NewSubfileType)
+            .ok()
+            .flatten()
+            .is_some_and(|t| t & 1 == 1);
+        if !reduced {
+            pages.push(index);
+        }
+        if !decoder.more_images() {
+            break;
+        }
+        index += 1;
+        decoder
+            .next_image()
+            .map_err(|e| tiff_error(Location::page(path, index), e))?;
+    }
+    decoder
+        .seek_to_image(0)
+        .map_err(|e| tiff_error(Location::page(path, 0), e))?;
+    Ok(pages)
+}
+
+fn pixel_size_from_tags<R: Read + Seek>(
+    decoder: &mut Decoder<R>,
+    description: Option<&str>,
+    imagej: &Option<ImageJDescription>,
+    notes: &mut Vec<String>,
+) -> Option<PixelSize> {
+    if let Some((x_m, y_m)) = description.and_then(metadata::parse_ome_pixel_size) {
+        return Some(PixelSize {
+            x_m,
+            y_m,
+            source: PixelSizeSource::OmeXml,
+        });
+    }
+    let x_res = rational(decoder.find_tag(Tag::XResolution).ok().flatten());
+    let y_res = rational(decoder.find_tag(Tag::YResolution).ok().flatten()).or(x_res);
+    let unit = decoder
+        .find_tag_unsigned::<u16>(Tag::ResolutionUnit)
+        .ok()
+        .flatten()
+        .unwrap_or(2);
+    let (x_res, y_res) = (x_res?, y_res?);
+    if let Some(meta) = imagej {
+        return match meta.unit_m {
+            Some(unit_m) => Some(PixelSize {
+                x_m: unit_m / x_res,
+                y_m: unit_m / y_res,
+                source: PixelSizeSource::ImageJ,
+            }),
+            None => {
+                notes.push(format!(
+                    "ImageJ unit '{}' is not a length: no pixel size",
+                    meta.unit_text.as_deref().unwrap_or("")
+                ));
+                None
+            }
+        };
+    }
+    let unit_m = match unit {
+        3 => 0.01,
+        2 if metadata::is_display_dpi(x_res) => {
+            notes.push(format!(
+                "XResolution {x_res} pixels/inch looks like a display default: ignored"
+            ));
+            return None;
+        }
+        2 => 0.0254,
+        _ => return None,
+    };
+    let size = PixelSize {
+        x_m: unit_m / x_res,
+        y_m: unit_m / y_res,
+        source: PixelSizeSource::ResolutionTags,
+    };
+    if size.x_m > 100e-6 {
+        notes.push(format!(
+            "resolution tags give {:.1} µm pixels, implausibly large for a microscope; check the file or use --pixel-size",
+            size.x_m * 1e6
+        ));
+    }
+    Some(size)
+}

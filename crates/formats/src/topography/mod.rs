@@ -1,0 +1,452 @@
+//! Height maps from files, as [`HeightMap`]s in metres with heights positive towards the
+//! counter-surface (stored values are kept as they are: an AFM map of a sphere's top already has
+//! its apex as the maximum).
+//!
+//! | extension | format | pixel size | height unit |
+//! |---|---|---|---|
+//! | `.npy` | NumPy array, float32/float64, 2-D, C or Fortran order, either byte order | argument (required) | argument (default m) |
+//! | `.tif`, `.tiff` | float32/float64 TIFF, first page ([`crate::tiff`]) | metadata, or the argument | argument (default m) |
+//! | `.gsf` | Gwyddion Simple Field | `XReal`/`YReal`, or the argument | `ZUnits` (default m) |
+//! | `.txt`, `.csv`, `.dat` | text matrix, one row per line, `#` comments | argument (required) | argument (default m) |
+//! | `.top` | WSxM (Nanotec) image | header | header |
+//! | `.di`, `.spm`, `.001`… | Bruker/Veeco Nanoscope, first channel with a length unit | header | header |
+//!
+//! Arrays are row-major `(y, x)` as a NumPy image: rows are y, columns x. (SurfaceTopography
+//! keeps `(x, y)`: transpose its arrays before saving them.) A pixel size given as an argument
+//! overrides the file's. A height unit may only be given for formats that do not state one;
+//! for the others it is an error, because two units for one number is a contradiction.
+//! Every error names the file.
+//!
+//! ## Vendor AFM and profilometer formats
+//!
+//! Recognised from their content (magic bytes) before the extension table above is consulted,
+//! and read into a [`HeightMap`]: heights in metres, positive towards the counter-surface as
+//! stored by the instrument, pixel size in metres, row-major `(y, x)` in the order the file
+//! stores its lines ([`read`], [`detect_file`]).
+//!
+//! | format | module | magic | heights | pixel size | invalid points |
+//! |---|---|---|---|---|---|
+//! | Igor binary wave (Asylum) `.ibw` | [`ibw`] | version 5 header | wave data × data units | `sfA` (dimension deltas) | NaN |
+//! | Nanosurf `.nid` | [`nid`] | `[DataSet]` | `Dim2Min + Dim2Range·(raw + 2^(b−1))/2^b` | `Dim0Range/Points` | none |
+//! | Molecular Imaging / Agilent `.mi` | [`mi`] | `fileType      Image` | `raw·bufferRange/2^(b−1)` in `bufferUnit` | `xLength/xPixels` | none |
+//! | Park Systems TIFF | [`park`] | TIFF + tag 50432 = `0x0E031301` | `(raw + offset/scale)·scale·gain` in the header's unit | scan size / pixels | none |
+//! | Gwyddion `.gwy` | [`gwy`] | `GWYP` | data field in `si_unit_z` | `xreal/xres` | mask field → NaN |
+//! | ISO 25178-72 `.x3p` | [`x3p`] | zip with `main.xml` | `CZ` data × increment (m) | `CX/CY` increments | NaN or `valid.bin` |
+//! | ISO 25178-71 `.sdf` (ASCII) | [`sdf`] | `aISO-1.0` | value × `Zscale` (m) | `Xscale`, `Yscale` | `BAD` / non-numbers |
+//! | Wyko `.opd` | [`opd`] | `Directory` at byte 2 | `raw·λ/Mult` (λ in nm) | `Pixel_size` (mm), `Aspect` | ≥ 32766 / ≥ 1e38 |
+//! | Sensofar `.plu` | [`plu`] | (none: size check of the 2012 layout) | µm | `micrometers_per_pixel` | 1000001 |
+//! | Digital Surf `.sur` | [`sur`] | `DIGITAL SURF` | `raw·scale` in `delta_data_unit` | grid spacing | `zmin − 2` when flagged |
+//! | FRT MicroProf `.frt` | [`frt`] | `FRTM_GLIDERV1.0` | `raw·scale` (m) | block 0x67 size / pixels | raw = 1 |
+//!
+//! **Invalid points** are stored as NaN in [`HeightMap::heights`] and counted in
+//! [`HeightMap::invalid_points`]; [`HeightMap::into_topography`] refuses a map with invalid
+//! points (a contact calculation needs every height), naming the count.
+//!
+//! **Channels**: [`read`] takes an optional channel name. An exact (case-insensitive) match wins,
+//! else the first channel whose name contains the request; without one, the first channel whose
+//! values are heights (a length unit, or a name with "height", "topograph" or "z-axis"). When no
+//! channel matches, the error lists them all.
+
+pub mod frt;
+pub mod gwy;
+pub mod ibw;
+pub mod mi;
+pub mod nid;
+pub mod opd;
+pub mod park;
+pub mod plu;
+pub mod sdf;
+pub mod sur;
+mod vendor;
+pub mod x3p;
+
+mod gsf;
+mod nanoscope;
+mod npy;
+mod text;
+mod wsxm;
+
+use std::path::Path;
+
+use ndarray::Array2;
+
+use crate::error::{Error, Location, Result};
+use crate::image::{SampleType, Samples};
+use crate::ranges::Quantity;
+use crate::tiff::metadata::length_unit_factor;
+use crate::tiff::TiffReader;
+
+pub use gsf::{encode_gsf, read_gsf};
+pub use nanoscope::read_nanoscope;
+pub use npy::{encode_npy, read_npy};
+pub use text::read_text;
+pub use vendor::MAX_FILE_BYTES;
+pub(crate) use vendor::{
+    choose, count, grid_bytes, height_like, height_map, length_factor, length_scale, positive,
+    ChannelEntry,
+};
+pub use vendor::{detect, detect_file, read, HeightMap, TopographyFormat};
+pub use wsxm::read_wsxm;
+
+/// Extensions [`read_topography`] knows (Nanoscope files also use three-digit extensions).
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "npy", "tif", "tiff", "gsf", "txt", "csv", "dat", "top", "di", "spm", "001",
+];
+
+/// How to read a height-map file: overrides for what the file does not say (or says wrongly).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReadOptions {
+    /// Pixel size (x, y), m, overriding the file's.
+    pub pixel_size_m: Option<(f64, f64)>,
+    /// Metres per stored height unit, for formats that state none (default: metres).
+    pub height_unit_m: Option<f64>,
+    /// Channel of a multi-channel vendor file, by name (default: its height channel).
+    pub channel: Option<String>,
+}
+
+/// Read a height map of any format: a vendor format recognised by its content ([`read`]: heights
+/// as stored, invalid points NaN and counted, the pixel size overridden when given; a height
+/// unit is refused, every vendor format states its own), else by extension
+/// ([`read_topography`]: every point valid, pixel size and heights within their plausible
+/// ranges). Nothing is detrended or filled here.
+pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> {
+    if matches!(detect_file(path), Ok(Some(_))) {
+        let mut map = read(path, options.channel.as_deref())?;
+        if options.height_unit_m.is_some() {
+            return Err(bad(
+                path,
+                format!(
+                    "the {} file states its height unit; do not give another one",
+                    map.format.name()
+                ),
+            ));
+        }
+        if let Some((dx, dy)) = options.pixel_size_m {
+            map.dx_m = dx;
+            map.dy_m = dy;
+        }
+        return Ok(map);
+    }
+    if let Some(channel) = &options.channel {
+        return Err(bad(
+            path,
+            format!("channel '{channel}' asked for, but this format holds one height map"),
+        ));
+    }
+    read_topography(path, options.pixel_size_m, options.height_unit_m)
+}
+
+impl HeightMap {
+    /// Whether the map can be used for a contact calculation as it is: every point valid, the
+    /// pixel size and the heights within their plausible ranges. The error names the file.
+    pub fn check_usable(&self, path: &Path) -> Result<()> {
+        if self.invalid_points > 0 {
+            return Err(bad(
+                path,
+                format!(
+                    "{} of {} points of channel '{}' are invalid (not measured); a contact \
+                     calculation needs every height",
+                    self.invalid_points,
+                    self.heights.len(),
+                    self.channel
+                ),
+            ));
+        }
+        let at = Location::file(path);
+        Quantity::PixelSize.check_at(self.dx_m, &at)?;
+        Quantity::PixelSize.check_at(self.dy_m, &at)?;
+        plausible_heights(path, &self.heights)
+    }
+}
+
+/// The name of the extension reader [`read_topography`] uses for `path` (`npy`, `tiff`, `gsf`,
+/// `text`, `wsxm`, `nanoscope`), for summaries; `None` for an unknown extension.
+pub fn extension_format(path: &Path) -> Option<&'static str> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    Some(match ext.as_str() {
+        "npy" => "npy",
+        "tif" | "tiff" => "tiff",
+        "gsf" => "gsf",
+        "txt" | "csv" | "dat" => "text",
+        "top" => "wsxm",
+        "di" | "spm" => "nanoscope",
+        e if e.len() == 3 && e.bytes().all(|b| b.is_ascii_digit()) => "nanoscope",
+        _ => return None,
+    })
+}
+
+/// Read a height map by the file extension (the first table in the module docs); the vendor
+/// formats are read by [`read_height_map`].
+/// `pixel_size_m` = (x, y) in metres overrides the file's; `height_unit_m` gives metres per
+/// stored unit for formats without a unit (default 1: metres).
+pub fn read_topography(
+    path: &Path,
+    pixel_size_m: Option<(f64, f64)>,
+    height_unit_m: Option<f64>,
+) -> Result<HeightMap> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "npy" => read_npy(path, pixel_size_m, height_unit_m),
+        "tif" | "tiff" => read_tiff(path, pixel_size_m, height_unit_m),
+        "gsf" => read_gsf(path, pixel_size_m, height_unit_m),
+        "txt" | "csv" | "dat" => read_text(path, pixel_size_m, height_unit_m),
+        "top" => read_wsxm(path, pixel_size_m, height_unit_m),
+        "di" | "spm" => read_nanoscope(path, pixel_size_m, height_unit_m),
+        e if e.len() == 3 && e.bytes().all(|b| b.is_ascii_digit()) => {
+            read_nanoscope(path, pixel_size_m, height_unit_m)
+        }
+        _ => Err(Error::Unsupported {
+            at: Location::file(path),
+            reason: format!(
+                "unknown height-map extension '{}'; supported: .{} (Nanoscope also .002, .003, …)",
+                ext,
+                SUPPORTED_EXTENSIONS.join(", .")
+            ),
+        }),
+    }
+}
+
+/// Read the first page of a float32/float64 TIFF. Pixel size: `pixel_size_m`, else the file's
+/// calibration (`docs/conventions.md`, "Pixel size"), else an error. Heights are multiplied by
+/// `height_unit_m` (default 1: the file holds metres).
+pub fn read_tiff(
+    path: &Path,
+    pixel_size_m: Option<(f64, f64)>,
+    height_unit_m: Option<f64>,
+) -> Result<HeightMap> {
+    let scale = unitless_scale(height_unit_m)?;
+    let mut reader = TiffReader::open(path)?;
+    let info = reader.info().clone();
+    let (dx, dy) = match (pixel_size_m, info.pixel_size) {
+        (Some(p), _) => p,
+        (None, Some(p)) => (p.x_m, p.y_m),
+        (None, None) => {
+            return Err(bad(
+                path,
+                "the TIFF has no pixel-size calibration; give the pixel size",
+            ))
+        }
+    };
+    let page = *info
+        .pages
+        .first()
+        .ok_or_else(|| bad(path, "the TIFF has no pages"))?;
+    let plane = reader.read_page(page, 0)?;
+    let values = match (&plane.samples, plane.sample_type) {
+        (Samples::Float(v), SampleType::F32 | SampleType::F64) => v,
+        _ => {
+            return Err(Error::Unsupported {
+                at: Location::page(path, page),
+                reason: format!(
+                    "{} TIFF: a height map must be float32 or float64 (integer data carries no \
+                     height scale)",
+                    plane.sample_type.name()
+                ),
+            })
+        }
+    };
+    let convert = to_metres(scale);
+    let heights: Vec<f64> = values.iter().map(|&v| convert(f64::from(v))).collect();
+    topography(
+        path,
+        TopographyFormat::Tiff,
+        (plane.height, plane.width),
+        heights,
+        (dx, dy),
+    )
+}
+
+pub(crate) use crate::binary::bad;
+
+/// Read a whole file.
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    crate::inputs::note_input(path);
+    std::fs::read(path).map_err(|e| Error::io(path, e))
+}
+
+/// `height_unit_m` for a format without a height unit: default 1 (metres), must be positive.
+pub(crate) fn unitless_scale(height_unit_m: Option<f64>) -> Result<f64> {
+    match height_unit_m {
+        None => Ok(1.0),
+        Some(u) if u.is_finite() && u > 0.0 => Ok(u),
+        Some(u) => Err(Error::InvalidArgument(format!(
+            "height unit must be positive and finite (got {u} m)"
+        ))),
+    }
+}
+
+/// Conversion of stored heights to metres. For sub-metre units that are an exact power of ten
+/// (nm, µm) it divides by the integer `1/unit`, so that `6` nm gives exactly the literal `6e-9`
+/// (multiplying by the inexact `1e-9` would not; as in [`crate::units`]).
+pub(crate) fn to_metres(unit_m: f64) -> impl Fn(f64) -> f64 {
+    let inverse = (1.0 / unit_m).round();
+    let divide = unit_m < 1.0 && inverse * unit_m == 1.0;
+    move |v| if divide { v / inverse } else { v * unit_m }
+}
+
+/// Refuse a height unit argument for a format that states its own.
+pub(crate) fn refuse_height_unit(
+    path: &Path,
+    height_unit_m: Option<f64>,
+    file_unit: &str,
+) -> Result<()> {
+    match height_unit_m {
+        None => Ok(()),
+        Some(_) => Err(bad(
+            path,
+            format!("the file states its height unit ({file_unit}); do not give another one"),
+        )),
+    }
+}
+
+/// The pixel size argument, required for formats without one.
+pub(crate) fn required_pixel_size(
+    path: &Path,
+    pixel_size_m: Option<(f64, f64)>,
+    format: &str,
+) -> Result<(f64, f64)> {
+    pixel_size_m.ok_or_else(|| {
+        bad(
+            path,
+            format!("{format} files carry no pixel size; give the pixel size"),
+        )
+    })
+}
+
+/// Metres per unit of a length unit as microscope software writes it; DI files write `~m` for
+/// µm.
+pub(crate) fn length_unit(path: &Path, unit: &str, what: &str) -> Result<f64> {
+    let unit = unit.trim();
+    let normalised = match unit.strip_prefix('~') {
+        Some(rest) => format!("µ{rest}"),
+        None => unit.to_string(),
+    };
+    length_unit_factor(&normalised)
+        .ok_or_else(|| bad(path, format!("{what} unit '{unit}' is not a length unit")))
+}
+
+/// Latin-1 bytes as text (every byte is one char).
+pub(crate) fn latin1(bytes: &[u8]) -> String {
+    bytes.iter().map(|&b| char::from(b)).collect()
+}
+
+/// Bytes `offset..offset + len` of `data`, or a "truncated" error.
+pub(crate) fn slice<'a>(
+    path: &Path,
+    data: &'a [u8],
+    offset: usize,
+    len: usize,
+) -> Result<&'a [u8]> {
+    crate::binary::slice(path, data, offset, len, "the data")
+}
+
+/// Largest height magnitude of a height map read from a file, m: no rough surface reaches it,
+/// and a map that does was almost always stored in another unit than the one assumed.
+pub const MAX_FILE_HEIGHT_M: f64 = 1.0;
+
+/// An error naming the file when a height lies beyond ±[`MAX_FILE_HEIGHT_M`].
+pub(crate) fn plausible_heights(path: &Path, heights: &Array2<f64>) -> Result<()> {
+    let nx = heights.ncols().max(1);
+    match heights.iter().position(|h| h.abs() > MAX_FILE_HEIGHT_M) {
+        None => Ok(()),
+        Some(k) => Err(bad(
+            path,
+            format!(
+                "height at row {}, column {} is {:e} m, beyond ±{MAX_FILE_HEIGHT_M} m (heights \
+                 in another unit? see --height-unit)",
+                k / nx,
+                k % nx,
+                heights.iter().nth(k).copied().unwrap_or(f64::NAN)
+            ),
+        )),
+    }
+}
+
+/// Build the [`HeightMap`] of a format read by extension (one channel, "height"): the data must
+/// fill the grid, every height must be finite and within ±[`MAX_FILE_HEIGHT_M`], the pixel size
+/// within its plausible range; each error names the file.
+pub(crate) fn topography(
+    path: &Path,
+    format: TopographyFormat,
+    shape: (usize, usize),
+    heights: Vec<f64>,
+    pixel_size_m: (f64, f64),
+) -> Result<HeightMap> {
+    let array = Array2::from_shape_vec(shape, heights).map_err(|e| {
+        bad(
+            path,
+            format!("data do not fill a {}×{} grid: {e}", shape.0, shape.1),
+        )
+    })?;
+    let at = Location::file(path);
+    Quantity::PixelSize.check_at(pixel_size_m.0, &at)?;
+    Quantity::PixelSize.check_at(pixel_size_m.1, &at)?;
+    plausible_heights(path, &array)?;
+    if array.is_empty() {
+        return Err(bad(path, "topography has no pixels"));
+    }
+    if let Some(k) = array.iter().position(|h| !h.is_finite()) {
+        let nx = array.ncols();
+        return Err(bad(
+            path,
+            format!(
+                "height at row {}, column {} is not finite (NaN or ∞)",
+                k / nx,
+                k % nx
+            ),
+        ));
+    }
+    Ok(HeightMap {
+        format,
+        channel: "height".into(),
+        channels: vec!["height".into()],
+        heights: array,
+        dx_m: pixel_size_m.0,
+        dy_m: pixel_size_m.1,
+        invalid_points: 0,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_extension_lists_the_supported_ones() {
+        let err = read_topography(Path::new("map.xyz"), None, None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("map.xyz") && err.contains(".gsf") && err.contains(".npy"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn missing_file_names_it() {
+        let err = read_topography(Path::new("/nonexistent/a.gsf"), None, None)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("/nonexistent/a.gsf"), "{err}");
+    }
+
+    #[test]
+    fn units() {
+        let p = Path::new("x");
+        assert_eq!(length_unit(p, "nm", "z").unwrap(), 1e-9);
+        assert_eq!(length_unit(p, "~m", "z").unwrap(), 1e-6);
+        assert_eq!(length_unit(p, "µm", "z").unwrap(), 1e-6);
+        assert!(length_unit(p, "V", "z").is_err());
+        assert!(unitless_scale(Some(0.0)).is_err());
+        assert_eq!(unitless_scale(None).unwrap(), 1.0);
+        assert_eq!(to_metres(1e-9)(6.0), 6e-9);
+        assert_eq!(to_metres(1e-6)(0.3), 0.3e-6);
+        assert_eq!(to_metres(2.0)(0.5), 1.0);
+    }
+}

@@ -1,0 +1,426 @@
+//! The vendor AFM/profilometer formats of this folder, recognised by their content: the
+//! [`HeightMap`] they read into, format detection, channel choice and the checks their readers
+//! share. The table of formats is in the [parent module](super).
+
+use std::path::Path;
+
+use super::{frt, gwy, ibw, mi, nid, opd, park, plu, sdf, sur, x3p};
+
+use ndarray::Array2;
+use serde::Serialize;
+
+use crate::binary::{bad, unsupported, FileSource};
+use crate::error::Result;
+
+/// Largest height-map file read whole into memory (bytes).
+pub const MAX_FILE_BYTES: u64 = 2 << 30;
+
+/// The AFM/profilometer formats of this module.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TopographyFormat {
+    /// Igor binary wave (Asylum Research).
+    Ibw,
+    /// Nanosurf NID.
+    Nid,
+    /// Molecular Imaging / Agilent PicoView.
+    Mi,
+    /// Park Systems TIFF.
+    ParkTiff,
+    /// Gwyddion native.
+    Gwy,
+    /// ISO 25178-72 XML 3D surface profile.
+    X3p,
+    /// ISO 25178-71 surface data file (ASCII).
+    Sdf,
+    /// Wyko OPD.
+    Opd,
+    /// Sensofar PLU.
+    Plu,
+    /// Digital Surf SUR.
+    Sur,
+    /// FRT MicroProf.
+    Frt,
+    /// NumPy `.npy` array (by extension).
+    Npy,
+    /// float32/float64 TIFF (by extension).
+    Tiff,
+    /// Gwyddion Simple Field `.gsf` (by extension).
+    Gsf,
+    /// Text matrix `.txt`, `.csv`, `.dat` (by extension).
+    Text,
+    /// WSxM `.top` (by extension).
+    Wsxm,
+    /// Bruker/Veeco Nanoscope (by extension).
+    Nanoscope,
+}
+
+impl TopographyFormat {
+    /// Short name, as `topography --json` prints it.
+    pub fn name(self) -> &'static str {
+        match self {
+            TopographyFormat::Ibw => "ibw",
+            TopographyFormat::Nid => "nid",
+            TopographyFormat::Mi => "mi",
+            TopographyFormat::ParkTiff => "park-tiff",
+            TopographyFormat::Gwy => "gwy",
+            TopographyFormat::X3p => "x3p",
+            TopographyFormat::Sdf => "sdf",
+            TopographyFormat::Opd => "opd",
+            TopographyFormat::Plu => "plu",
+            TopographyFormat::Sur => "sur",
+            TopographyFormat::Frt => "frt",
+            TopographyFormat::Npy => "npy",
+            TopographyFormat::Tiff => "tiff",
+            TopographyFormat::Gsf => "gsf",
+            TopographyFormat::Text => "text",
+            TopographyFormat::Wsxm => "wsxm",
+            TopographyFormat::Nanoscope => "nanoscope",
+        }
+    }
+}
+
+/// A height map read from a file, with the channel it came from and its invalid points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeightMap {
+    /// The file's format.
+    pub format: TopographyFormat,
+    /// The channel read.
+    pub channel: String,
+    /// Every channel of the file.
+    pub channels: Vec<String>,
+    /// Heights in metres, shape `(ny, nx)`; NaN where the instrument marked no valid point.
+    pub heights: Array2<f64>,
+    /// Pixel size along x (columns), m.
+    pub dx_m: f64,
+    /// Pixel size along y (rows), m.
+    pub dy_m: f64,
+    /// Number of NaN heights.
+    pub invalid_points: usize,
+}
+
+impl HeightMap {
+    /// Columns.
+    pub fn nx(&self) -> usize {
+        self.heights.ncols()
+    }
+
+    /// Rows.
+    pub fn ny(&self) -> usize {
+        self.heights.nrows()
+    }
+
+    /// Points with a height.
+    pub fn valid_points(&self) -> usize {
+        self.heights.len() - self.invalid_points
+    }
+}
+
+/// The format of a file from its first bytes (at least 64; Park TIFFs need the whole first IFD,
+/// see [`detect_file`]), or `None`.
+pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
+    let starts = |m: &[u8]| head.starts_with(m);
+    if starts(b"GWYP") {
+        Some(TopographyFormat::Gwy)
+    } else if starts(b"DIGITAL SURF") {
+        Some(TopographyFormat::Sur)
+    } else if starts(b"FRTM_GLIDERV") {
+        Some(TopographyFormat::Frt)
+    } else if starts(b"aISO-1.0") {
+        Some(TopographyFormat::Sdf)
+    } else if starts(b"[DataSet]") {
+        Some(TopographyFormat::Nid)
+    } else if starts(b"fileType      Image") {
+        Some(TopographyFormat::Mi)
+    } else if head.get(2..11) == Some(b"Directory") {
+        Some(TopographyFormat::Opd)
+    } else if starts(b"PK\x03\x04") {
+        Some(TopographyFormat::X3p)
+    } else if ibw::is_ibw(head) {
+        Some(TopographyFormat::Ibw)
+    } else {
+        None
+    }
+}
+
+/// The format of a file from its content: [`detect`], then Park TIFF (a TIFF whose first IFD
+/// has tag 50432 = `0x0E031301`), then Sensofar PLU (whose layout has no magic: recognised when
+/// its header's sizes account for the file).
+pub fn detect_file(path: &Path) -> Result<Option<TopographyFormat>> {
+    let mut source = FileSource::open(path)?;
+    let head = source.read_up_to(0, 64)?;
+    if let Some(f) = detect(&head) {
+        return Ok(Some(f));
+    }
+    if (head.starts_with(b"II*\0") || head.starts_with(b"MM\0*")) && park::is_park(&mut source)? {
+        return Ok(Some(TopographyFormat::ParkTiff));
+    }
+    if plu::is_plu(&mut source)? {
+        return Ok(Some(TopographyFormat::Plu));
+    }
+    Ok(None)
+}
+
+/// Read a height map, detecting the format from the content; `channel` selects a channel by
+/// name (module docs).
+pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
+    let format = detect_file(path)?.ok_or_else(|| {
+        unsupported(
+            path,
+            "not a height-map format contactscope recognises from its content (ibw, nid, mi, \
+             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt)",
+        )
+    })?;
+    match format {
+        TopographyFormat::X3p => x3p::read(path, channel),
+        other => {
+            let bytes = read_whole(path)?;
+            match other {
+                TopographyFormat::Ibw => ibw::read(path, &bytes, channel),
+                TopographyFormat::Nid => nid::read(path, &bytes, channel),
+                TopographyFormat::Mi => mi::read(path, &bytes, channel),
+                TopographyFormat::ParkTiff => park::read(path, &bytes, channel),
+                TopographyFormat::Gwy => gwy::read(path, &bytes, channel),
+                TopographyFormat::Sdf => sdf::read(path, &bytes, channel),
+                TopographyFormat::Opd => opd::read(path, &bytes, channel),
+                TopographyFormat::Plu => plu::read(path, &bytes, channel),
+                TopographyFormat::Sur => sur::read(path, &bytes, channel),
+                TopographyFormat::Frt => frt::read(path, &bytes, channel),
+                TopographyFormat::X3p
+                | TopographyFormat::Npy
+                | TopographyFormat::Tiff
+                | TopographyFormat::Gsf
+                | TopographyFormat::Text
+                | TopographyFormat::Wsxm
+                | TopographyFormat::Nanoscope => unreachable!("not detected by content"),
+            }
+        }
+    }
+}
+
+/// The whole file, refused above [`MAX_FILE_BYTES`].
+fn read_whole(path: &Path) -> Result<Vec<u8>> {
+    let mut source = FileSource::open(path)?;
+    if source.len > MAX_FILE_BYTES {
+        return Err(unsupported(
+            path,
+            format!(
+                "file of {} bytes is larger than the {} GiB limit",
+                source.len,
+                MAX_FILE_BYTES >> 30
+            ),
+        ));
+    }
+    source.read_at(0, source.len as usize, "the file")
+}
+
+/// One channel as a reader lists it.
+#[derive(Debug, Clone)]
+pub(crate) struct ChannelEntry {
+    /// Name shown to the user.
+    pub name: String,
+    /// Whether its values are heights (a length unit, or a height-like name).
+    pub height: bool,
+}
+
+/// Pick a channel (module docs); the error lists every channel.
+pub(crate) fn choose(
+    path: &Path,
+    channels: &[ChannelEntry],
+    request: Option<&str>,
+) -> Result<usize> {
+    let list = || {
+        channels
+            .iter()
+            .map(|c| format!("'{}'", c.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if channels.is_empty() {
+        return Err(bad(path, "the file holds no data channel"));
+    }
+    match request {
+        Some(want) => {
+            let want_l = want.to_lowercase();
+            channels
+                .iter()
+                .position(|c| c.name.to_lowercase() == want_l)
+                .or_else(|| {
+                    channels
+                        .iter()
+                        .position(|c| c.name.to_lowercase().contains(&want_l))
+                })
+                .ok_or_else(|| {
+                    bad(
+                        path,
+                        format!("no channel '{want}'; the file has {}", list()),
+                    )
+                })
+        }
+        None => channels.iter().position(|c| c.height).ok_or_else(|| {
+            bad(
+                path,
+                format!(
+                    "no height channel; the file has {} (choose one by name)",
+                    list()
+                ),
+            )
+        }),
+    }
+}
+
+/// Whether a channel name looks like heights.
+pub(crate) fn height_like(name: &str) -> bool {
+    let n = name.to_lowercase();
+    ["height", "topograph", "z-axis", "zsensor", "z sensor"]
+        .iter()
+        .any(|k| n.contains(k))
+}
+
+/// Metres per unit of a length unit string, or `None` (accepts `µm`, `um`, `\u{e6}m`, `~m`).
+pub(crate) fn length_factor(unit: &str) -> Option<f64> {
+    let u = unit.trim().trim_end_matches('\0').trim();
+    let u = match u {
+        "\u{e6}m" | "~m" | "um" => "µm",
+        other => other,
+    };
+    crate::tiff::metadata::length_unit_factor(u)
+}
+
+/// Metres per unit of the chosen channel's unit, or an error naming the channel: a channel in
+/// volts, degrees or newtons is refused rather than scaled as metres.
+pub(crate) fn length_scale(path: &Path, channel: &ChannelEntry, unit: &str) -> Result<f64> {
+    length_factor(unit).ok_or_else(|| {
+        bad(
+            path,
+            format!("channel '{}' is in '{unit}', not a length", channel.name),
+        )
+    })
+}
+
+/// Build a [`HeightMap`] from row-major values (NaN = invalid), checking the size.
+pub(crate) fn height_map(
+    path: &Path,
+    format: TopographyFormat,
+    (channels, index): (&[ChannelEntry], usize),
+    (ny, nx): (usize, usize),
+    heights: Vec<f64>,
+    (dx_m, dy_m): (f64, f64),
+) -> Result<HeightMap> {
+    if nx == 0 || ny == 0 {
+        return Err(bad(path, format!("empty {nx}×{ny} height map")));
+    }
+    if !(dx_m.is_finite() && dy_m.is_finite() && dx_m > 0.0 && dy_m > 0.0) {
+        return Err(bad(
+            path,
+            format!("pixel size {dx_m} × {dy_m} m is not positive"),
+        ));
+    }
+    let heights = Array2::from_shape_vec((ny, nx), heights)
+        .map_err(|_| bad(path, format!("data do not fill a {ny}×{nx} grid")))?;
+    let invalid_points = heights.iter().filter(|h| !h.is_finite()).count();
+    let heights = heights.mapv(|h| if h.is_finite() { h } else { f64::NAN });
+    Ok(HeightMap {
+        format,
+        channel: channels[index].name.clone(),
+        channels: channels.iter().map(|c| c.name.clone()).collect(),
+        heights,
+        dx_m,
+        dy_m,
+        invalid_points,
+    })
+}
+
+/// `nx·ny` samples of `width` bytes: checks the size limit first.
+pub(crate) fn grid_bytes(path: &Path, nx: usize, ny: usize, width: usize) -> Result<usize> {
+    crate::limits::Limits::DEFAULT
+        .plane_bytes(nx, ny, width)
+        .map_err(|reason| unsupported(path, format!("height map: {reason} (header corrupt?)")))
+}
+
+/// Positive finite size or an error naming it.
+pub(crate) fn positive(path: &Path, what: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(bad(path, format!("{what} is {v}; it must be positive")))
+    }
+}
+
+/// A count read from a header, as usize, checked to be positive and below 2^28.
+pub(crate) fn count(path: &Path, what: &str, v: f64) -> Result<usize> {
+    if v.is_finite() && v >= 1.0 && v < f64::from(1u32 << 28) {
+        Ok(v as usize)
+    } else {
+        Err(bad(path, format!("{what} is {v}")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entries(names: &[(&str, bool)]) -> Vec<ChannelEntry> {
+        names
+            .iter()
+            .map(|(n, h)| ChannelEntry {
+                name: n.to_string(),
+                height: *h,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn channel_choice() {
+        let p = Path::new("a.ibw");
+        let c = entries(&[
+            ("Amplitude", false),
+            ("HeightTrace", true),
+            ("HeightRetrace", true),
+        ]);
+        assert_eq!(choose(p, &c, None).unwrap(), 1);
+        assert_eq!(choose(p, &c, Some("heightretrace")).unwrap(), 2);
+        assert_eq!(choose(p, &c, Some("Height")).unwrap(), 1);
+        let err = choose(p, &c, Some("Phase")).unwrap_err().to_string();
+        assert!(
+            err.contains("'Amplitude', 'HeightTrace', 'HeightRetrace'"),
+            "{err}"
+        );
+        assert!(choose(p, &entries(&[("Phase", false)]), None).is_err());
+    }
+
+    #[test]
+    fn detection_by_magic() {
+        assert_eq!(detect(b"GWYPGwyContainer"), Some(TopographyFormat::Gwy));
+        assert_eq!(detect(b"\x01\x00Directory"), Some(TopographyFormat::Opd));
+        assert_eq!(detect(b"FRTM_GLIDERV1.00"), Some(TopographyFormat::Frt));
+        assert_eq!(detect(b"%PDF-1.4"), None);
+        assert_eq!(length_factor("\u{e6}m"), Some(1e-6));
+        assert_eq!(length_factor("V"), None);
+    }
+
+    #[test]
+    fn invalid_points_are_counted() {
+        let c = entries(&[("h", true)]);
+        let p = Path::new("m.sur");
+        let m = height_map(
+            p,
+            TopographyFormat::Sur,
+            (&c, 0),
+            (2, 2),
+            vec![1.0, f64::NAN, 2.0, f64::INFINITY],
+            (1e-6, 1e-6),
+        )
+        .unwrap();
+        assert_eq!((m.invalid_points, m.valid_points()), (2, 2));
+        assert!(height_map(
+            p,
+            TopographyFormat::Sur,
+            (&c, 0),
+            (2, 2),
+            vec![0.0; 3],
+            (1e-6, 1e-6)
+        )
+        .is_err());
+    }
+}

@@ -1,0 +1,274 @@
+//! A height map as `simulate`, `fit-hardening` and `topography` take it: a file read by
+//! `contactscope_formats::topography`, its invalid points filled on request
+//! (`contactscope::surface::fill`) and the map detrended (`contactscope::surface`), with notes
+//! for the user. Every front-end reads height maps through [`TopographySource`], so the defaults
+//! and refusals are the same everywhere.
+
+use std::path::PathBuf;
+
+use contactscope::surface::fill::{fill_invalid, FillInvalid};
+use contactscope::surface::{Detrend, Topography};
+use contactscope_formats::param::Param;
+use contactscope_formats::ranges::Quantity;
+use contactscope_formats::topography::{read_height_map, HeightMap, ReadOptions};
+use serde::Serialize;
+
+use crate::error::{Error, Location, Result};
+
+/// A height map as a request carries it: a file to read (the command line; Python given a
+/// path), or heights already in memory (Python given an array). Either way it is detrended by
+/// the request's rule, so that both give the same numbers on the same heights.
+#[derive(Debug, Clone, PartialEq)]
+pub enum HeightInput {
+    /// A file, with how to read and level it.
+    File(TopographySource),
+    /// Heights in memory (m, rows = y) with their pixel size.
+    Memory {
+        /// The heights and pixel size.
+        topography: Topography,
+        /// Detrending applied before use.
+        detrend: Detrend,
+        /// What to call them in outputs and messages.
+        label: String,
+    },
+}
+
+impl HeightInput {
+    /// Heights in memory with the default detrending ([`Detrend::Plane`], as for a file).
+    pub fn memory(topography: Topography, label: impl Into<String>) -> Self {
+        HeightInput::Memory {
+            topography,
+            detrend: Detrend::Plane,
+            label: label.into(),
+        }
+    }
+
+    /// The file, or the label of the heights in memory.
+    pub fn label(&self) -> String {
+        match self {
+            HeightInput::File(s) => s.path.display().to_string(),
+            HeightInput::Memory { label, .. } => label.clone(),
+        }
+    }
+
+    /// The detrending.
+    pub fn detrend(&self) -> Detrend {
+        match self {
+            HeightInput::File(s) => s.detrend,
+            HeightInput::Memory { detrend, .. } => *detrend,
+        }
+    }
+
+    /// Range checks of what the caller gave: pixel sizes and the height unit.
+    pub fn check(&self) -> Result<()> {
+        let pixel = match self {
+            HeightInput::File(s) => {
+                if let Some(u) = s.height_unit_m {
+                    Quantity::Height.check(u, Param::HeightUnit)?;
+                }
+                s.pixel_size_m
+            }
+            HeightInput::Memory { topography, .. } => Some((topography.dx_m, topography.dy_m)),
+        };
+        if let Some((x, y)) = pixel {
+            Quantity::PixelSize.check(x, Param::PixelSize)?;
+            Quantity::PixelSize.check(y, Param::PixelSize)?;
+        }
+        Ok(())
+    }
+
+    /// The heights, filled and detrended, with notes for the user.
+    pub fn read_with_notes(&self) -> Result<(Topography, Vec<String>)> {
+        match self {
+            HeightInput::File(s) => s.read_with_notes(),
+            HeightInput::Memory {
+                topography,
+                detrend,
+                ..
+            } => {
+                let mut t = topography.clone();
+                t.detrend(*detrend);
+                Ok((t, Vec::new()))
+            }
+        }
+    }
+
+    /// What the outputs record of the input.
+    pub fn facts(&self) -> (Option<String>, Option<FillInvalid>) {
+        match self {
+            HeightInput::File(s) => (s.channel.clone(), s.fill_invalid),
+            HeightInput::Memory { .. } => (None, None),
+        }
+    }
+}
+
+/// What a summary records of the height map a simulation ran on (`summary.json` of
+/// `simulate`: `topography`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HeightFacts {
+    /// The file (or the label of heights given in memory).
+    pub path: String,
+    /// Columns.
+    pub nx: usize,
+    /// Rows.
+    pub ny: usize,
+    /// Pixel size along x, m.
+    #[serde(rename = "pixel_size_x_nm", serialize_with = "crate::lab::m_as_nm")]
+    pub pixel_size_x_m: f64,
+    /// Pixel size along y, m.
+    #[serde(rename = "pixel_size_y_nm", serialize_with = "crate::lab::m_as_nm")]
+    pub pixel_size_y_m: f64,
+    /// Detrending applied.
+    pub detrend: &'static str,
+    /// Channel read (vendor files).
+    pub channel: Option<String>,
+    /// How invalid points were filled.
+    pub fill_invalid: Option<FillInvalid>,
+    /// rms height after detrending, m.
+    #[serde(rename = "h_rms_nm", serialize_with = "crate::lab::m_as_nm")]
+    pub h_rms_m: f64,
+    /// rms slope (central differences).
+    pub h_prime_rms: f64,
+    /// rms full Laplacian (5-point), 1/m.
+    #[serde(
+        rename = "h_double_prime_rms_per_um",
+        serialize_with = "crate::lab::per_m_as_per_um"
+    )]
+    pub h_double_prime_rms_per_m: f64,
+    /// Sphere radius added, m.
+    #[serde(
+        rename = "sphere_radius_um",
+        serialize_with = "crate::lab::opt_m_as_um"
+    )]
+    pub sphere_radius_m: Option<f64>,
+}
+
+/// A height-map file with how to read and level it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopographySource {
+    /// The file.
+    pub path: PathBuf,
+    /// Pixel size override (x, y), m.
+    pub pixel_size_m: Option<(f64, f64)>,
+    /// Height unit override, m per stored unit.
+    pub height_unit_m: Option<f64>,
+    /// Detrending applied after reading.
+    pub detrend: Detrend,
+    /// Channel of a multi-channel vendor file, by name (default: its height channel).
+    pub channel: Option<String>,
+    /// Fill a vendor map's invalid points this way (default: refuse such a map).
+    pub fill_invalid: Option<FillInvalid>,
+}
+
+impl TopographySource {
+    /// A file with the default channel, no filling and no detrending.
+    pub fn new(path: PathBuf) -> Self {
+        TopographySource {
+            path,
+            pixel_size_m: None,
+            height_unit_m: None,
+            detrend: Detrend::None,
+            channel: None,
+            fill_invalid: None,
+        }
+    }
+
+    /// The map as stored (no filling, no detrending), with every override applied.
+    pub fn read_raw(&self) -> Result<HeightMap> {
+        Ok(read_height_map(
+            &self.path,
+            &ReadOptions {
+                pixel_size_m: self.pixel_size_m,
+                height_unit_m: self.height_unit_m,
+                channel: self.channel.clone(),
+            },
+        )?)
+    }
+
+    /// Read the file, fill and detrend it.
+    pub fn read(&self) -> Result<Topography> {
+        Ok(self.read_with_notes()?.0)
+    }
+
+    /// [`Self::read`], with notes for the user (how many invalid points were filled).
+    pub fn read_with_notes(&self) -> Result<(Topography, Vec<String>)> {
+        let mut map = self.read_raw()?;
+        let mut notes = Vec::new();
+        match self.fill_invalid {
+            Some(how) => {
+                let filled = fill_invalid(&mut map, how);
+                if filled > 0 {
+                    notes.push(format!(
+                        "{}: {filled} invalid point(s) filled with the {} valid height",
+                        self.path.display(),
+                        how.name()
+                    ));
+                }
+            }
+            None if map.invalid_points > 0 && map.valid_points() > 0 => {
+                return Err(Error::bad_input(
+                    Location::file(&self.path),
+                    format!(
+                        "{} of {} points of channel '{}' are invalid (not measured); a contact \
+                         calculation needs every height: give --fill-invalid mean|nearest to \
+                         fill them",
+                        map.invalid_points,
+                        map.heights.len(),
+                        map.channel
+                    ),
+                ));
+            }
+            None => {}
+        }
+        let mut topography = usable(&self.path, map)?;
+        topography.detrend(self.detrend);
+        Ok((topography, notes))
+    }
+}
+
+/// The map as a [`Topography`] for a contact calculation, or an error naming the file (invalid
+/// points, an implausible pixel size or height).
+pub fn usable(path: &std::path::Path, map: HeightMap) -> Result<Topography> {
+    map.check_usable(path)?;
+    Topography::from_height_map(map).map_err(|e| match e {
+        contactscope::Error::InvalidArgument(reason) => {
+            Error::bad_input(Location::file(path), reason)
+        }
+        other => other.into(),
+    })
+}
+
+/// A height map of any format as a [`Topography`], as stored (no channel choice, no filling, no
+/// detrending): `pixel_size_m` (x, y) overrides the file's, `height_unit_m` gives metres per
+/// stored unit for formats without a unit. A map with invalid points is refused.
+pub fn read_topography(
+    path: &std::path::Path,
+    pixel_size_m: Option<(f64, f64)>,
+    height_unit_m: Option<f64>,
+) -> Result<Topography> {
+    TopographySource {
+        pixel_size_m,
+        height_unit_m,
+        ..TopographySource::new(path.to_path_buf())
+    }
+    .read()
+}
+
+/// Write the heights (m) as a `.npy` file, atomically (the pixel size is not stored).
+pub fn write_npy(path: &std::path::Path, topography: &Topography) -> Result<()> {
+    crate::staging::write_atomic(
+        path,
+        &contactscope_formats::topography::encode_npy(&topography.heights),
+    )
+}
+
+/// Write the heights and pixel size (m) as a `.gsf` file (float32), atomically.
+pub fn write_gsf(path: &std::path::Path, topography: &Topography) -> Result<()> {
+    crate::staging::write_atomic(
+        path,
+        &contactscope_formats::topography::encode_gsf(
+            &topography.heights,
+            (topography.dx_m, topography.dy_m),
+        ),
+    )
+}

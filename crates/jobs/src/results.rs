@@ -1,0 +1,133 @@
+//! What one command wrote, read back as the input of another: `analyze`'s `areas.csv`
+//! ([`read_areas_csv`], for `friction` and `fit-hardening`), a `simulate` output folder's contact
+//! maps ([`simulated_maps`], for `compare`) and the FWHM in `psf`'s `psf.json`
+//! ([`fwhm_from_psf_json`]).
+
+use std::path::Path;
+
+use serde_json::Value;
+
+use super::table::Table;
+use crate::error::{Error, Location, Result};
+use contactscope::compare::SimulatedMap;
+use contactscope::optics::blur::Grid;
+use contactscope_formats::ranges::Quantity;
+use contactscope_formats::tiff::read_image;
+
+/// (force N, area m²) rows of an `analyze` areas.csv (columns `force_mN`, `area_um2`); a table
+/// in pixels is refused with a hint, as is one without rows.
+pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
+    let table = Table::read(path)?;
+    for column in ["force_mN", "area_um2"] {
+        if !table.header().iter().any(|h| h == column) {
+            let hint = if column == "area_um2" && table.header().iter().any(|h| h == "area_px") {
+                " (areas are in pixels: run analyze with --pixel-size)"
+            } else {
+                ""
+            };
+            return Err(Error::bad_input(
+                table.location(),
+                format!("no {column} column{hint}; columns found: {}", table.found()),
+            ));
+        }
+    }
+    let forces = table.numbers("force_mN", 1e-3)?;
+    let areas = table.numbers("area_um2", 1e-12)?;
+    if forces.is_empty() {
+        return Err(Error::bad_input(table.location(), "no rows"));
+    }
+    for (k, (&force, &area)) in forces.iter().zip(&areas).enumerate() {
+        let at = Location::file(format!("{}:{}", path.display(), table.line(k)));
+        Quantity::Force.check_at(force, &at)?;
+        // A load without contact gives an infinite stress (friction) and no size to fit.
+        if !(area > 0.0 && area <= 1.0) {
+            return Err(Error::bad_input(
+                at,
+                format!(
+                    "area_um2 = {:e} µm²: an area must be positive and at most 1 m² (remove a \
+                     row without contact)",
+                    area * 1e12
+                ),
+            ));
+        }
+    }
+    Ok(forces.into_iter().zip(areas).collect())
+}
+
+/// The loads of a `simulate` output folder: `areas.csv` rows and `load_NNN_contact.tif`.
+pub fn simulated_maps(dir: &Path) -> Result<Vec<SimulatedMap>> {
+    let table = dir.join("areas.csv");
+    let at = Location::file(&table);
+    crate::staging::note_input(&table);
+    let text = std::fs::read_to_string(&table).map_err(|e| {
+        Error::bad_input(
+            Location::file(dir),
+            format!("not a `contactscope simulate` output folder (areas.csv: {e})"),
+        )
+    })?;
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let headers = reader
+        .headers()
+        .map_err(|e| Error::bad_input(at.clone(), format!("bad CSV header: {e}")))?
+        .clone();
+    let col = headers
+        .iter()
+        .position(|h| h == "force_mN")
+        .ok_or_else(|| Error::bad_input(at.clone(), "no force_mN column"))?;
+    let mut loads = Vec::new();
+    for (i, record) in reader.records().enumerate() {
+        let record =
+            record.map_err(|e| Error::bad_input(at.clone(), format!("row {}: {e}", i + 1)))?;
+        let force_mn: f64 = record
+            .get(col)
+            .and_then(|v| v.trim().parse().ok())
+            .ok_or_else(|| {
+                Error::bad_input(
+                    at.clone(),
+                    format!("row {}: force_mN is not a number", i + 1),
+                )
+            })?;
+        let line = Location::file(format!("{}:{}", table.display(), i + 2));
+        Quantity::Force.check_at(force_mn * 1e-3, &line)?;
+        let map = dir.join(format!("load_{:03}_contact.tif", i + 1));
+        if !map.is_file() {
+            return Err(Error::bad_input(
+                Location::file(&map),
+                "contact map listed in areas.csv is missing",
+            ));
+        }
+        loads.push(read_map(&map, force_mn * 1e-3)?);
+    }
+    Ok(loads)
+}
+
+fn read_map(path: &Path, force_n: f64) -> Result<SimulatedMap> {
+    let image = read_image(path, None, None)?;
+    let px = image.require_pixel_size()?;
+    let at = Location::file(path);
+    Quantity::PixelSize.check_at(px.x_m, &at)?;
+    Quantity::PixelSize.check_at(px.y_m, &at)?;
+    let map = Grid::new(image.values, image.width, image.height, px.x_m, px.y_m)
+        .map_err(|e| Error::bad_input(Location::file(path), e.to_string()))?;
+    Ok(SimulatedMap {
+        force_n,
+        map,
+        source: path.display().to_string(),
+    })
+}
+
+/// The PSF FWHM (m) recorded by `contactscope psf` in its `psf.json` (`fwhm_nm_mean`).
+pub fn fwhm_from_psf_json(path: &Path) -> Result<f64> {
+    let at = Location::file(path);
+    crate::staging::note_input(path);
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let value: Value = serde_json::from_str(&text)
+        .map_err(|e| Error::bad_input(at.clone(), format!("not JSON: {e}")))?;
+    match value.get("fwhm_nm_mean").and_then(Value::as_f64) {
+        Some(nm) => Ok(Quantity::Fwhm.check_at(nm * 1e-9, &at)?),
+        None => Err(Error::bad_input(
+            at,
+            "no number fwhm_nm_mean (expected the psf.json written by `contactscope psf`)",
+        )),
+    }
+}

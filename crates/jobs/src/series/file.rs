@@ -1,0 +1,137 @@
+//! Header facts of one file of a load series, whatever its format: a TIFF (its pages) or a
+//! CZI, ND2 or LIF file (the planes a [`Selection`] names, along an optional [`LoadAxis`]).
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Location, Result};
+use contactscope::image::{PixelSize, SampleType};
+use contactscope_formats::microscopy::select::{
+    series_pixel_size, LoadAxis, SelectedPlane, Selection,
+};
+use contactscope_formats::microscopy::{MicroscopyFile, MicroscopyFormat, SeriesInfo};
+use contactscope_formats::tiff::TiffInfo;
+
+/// Header facts of one file of a series, whatever its format.
+#[derive(Debug, Clone)]
+pub struct SeriesFile {
+    /// The file.
+    pub path: PathBuf,
+    /// Its format (by content).
+    pub format: MicroscopyFormat,
+    /// Plane width in pixels.
+    pub width: usize,
+    /// Plane height in pixels.
+    pub height: usize,
+    /// Sample type of a plane.
+    pub sample_type: SampleType,
+    /// Compression of the first page (TIFF); for CZI, ND2 and LIF "compressed" when any
+    /// plane is (CZI zstd, ND2 lossless), else "none".
+    pub compression: String,
+    /// Channels (of the selected series for CZI, ND2 and LIF).
+    pub channels: usize,
+    /// Pixel size from the file's metadata, if any.
+    pub pixel_size: Option<PixelSize>,
+    /// Notes about ignored or doubtful metadata.
+    pub notes: Vec<String>,
+    /// The TIFF header facts (TIFF files only).
+    pub tiff: Option<TiffInfo>,
+    /// The selected planes (CZI, ND2 and LIF files only), in load order.
+    pub planes: Vec<SelectedPlane>,
+}
+
+impl SeriesFile {
+    pub(super) fn from_tiff(info: TiffInfo) -> Self {
+        SeriesFile {
+            path: info.path.clone(),
+            format: MicroscopyFormat::Tiff,
+            width: info.width,
+            height: info.height,
+            sample_type: info.sample_type,
+            compression: info.compression.clone(),
+            channels: info.channels,
+            pixel_size: info.pixel_size,
+            notes: info.notes.clone(),
+            tiff: Some(info),
+            planes: Vec::new(),
+        }
+    }
+
+    /// Open a CZI, ND2 or LIF file and resolve the selection: every selected series must have
+    /// one plane size, sample type and pixel size.
+    pub(super) fn from_vendor(
+        path: &Path,
+        selection: &Selection,
+        along: Option<LoadAxis>,
+    ) -> Result<Self> {
+        let file = MicroscopyFile::open(path)?;
+        let planes = selection.planes(&file, along)?;
+        let first = &file.series[planes[0].series];
+        let describe = |s: &SeriesInfo| format!("{}×{} {}", s.axes.x, s.axes.y, s.dtype.name());
+        let pixel_size = series_pixel_size(file.format, first);
+        for p in &planes[1..] {
+            let other = &file.series[p.series];
+            if describe(other) != describe(first) {
+                return Err(Error::SeriesMismatch {
+                    at: Location::file(path),
+                    reason: format!("series {} is {}", other.index, describe(other)),
+                    expected: describe(first),
+                });
+            }
+            let same = match (pixel_size, series_pixel_size(file.format, other)) {
+                (Some(a), Some(b)) => a.same_size(&b),
+                (a, b) => a.is_none() && b.is_none(),
+            };
+            if !same {
+                return Err(Error::SeriesMismatch {
+                    at: Location::file(path),
+                    reason: format!("series {} has another pixel size", other.index),
+                    expected: format!("the pixel size of series {}", first.index),
+                });
+            }
+        }
+        Ok(SeriesFile {
+            path: path.to_path_buf(),
+            format: file.format,
+            width: first.axes.x,
+            height: first.axes.y,
+            sample_type: first.dtype,
+            compression: if file.compressed() {
+                "compressed".into()
+            } else {
+                "none".into()
+            },
+            channels: first.axes.c,
+            pixel_size,
+            notes: Vec::new(),
+            tiff: None,
+            planes,
+        })
+    }
+
+    pub(super) fn describe(&self) -> String {
+        format!(
+            "{}×{} {} with {} channel(s)",
+            self.width,
+            self.height,
+            self.sample_type.name(),
+            self.channels
+        )
+    }
+
+    /// (page, plane) of every image this file gives to a series built from files: every page
+    /// of the channel for a TIFF, the selected planes otherwise.
+    pub(super) fn images(&self, channel: usize) -> Vec<(usize, Option<SelectedPlane>)> {
+        match &self.tiff {
+            Some(info) => info
+                .pages_of_channel(channel)
+                .into_iter()
+                .map(|p| (p, None))
+                .collect(),
+            None => self
+                .planes
+                .iter()
+                .map(|p| (p.load_index, Some(p.clone())))
+                .collect(),
+        }
+    }
+}

@@ -1,0 +1,717 @@
+//! A load series: which page of which file is which load step, and its normal force.
+//!
+//! Inputs are one multi-page TIFF, several files, a directory of TIFFs (natural sort order, so
+//! `img2` comes before `img10`) or a manifest CSV with columns `file`, optional `page`,
+//! `force_mN` and optional `friction_mN`, paths relative to the manifest's folder.
+//! Pages are zero-based TIFF page (IFD) indices, as tifffile numbers them.
+//!
+//! Zeiss CZI, Nikon ND2 and Leica LIF files ([`contactscope_formats::microscopy`]) are accepted as well,
+//! detected by content: each gives the planes a [`Selection`] names (`--series`, `--channel`,
+//! `--z`, `--t`): one plane per file, or, with a [`LoadAxis`] (`--load-axis t|z|series`), every
+//! plane along that axis in order. For these files the "page" of an image (and a manifest's
+//! `page` column) is its position along the load axis.
+//!
+//! [`SeriesPlanes`] is the file-backed plane source the series analysis
+//! ([`contactscope::analysis::analyze`]) reads through, and [`pixel_size`] the series' pixel size from
+//! the files' metadata or an override.
+
+use std::cmp::Ordering;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+mod file;
+
+pub use file::SeriesFile;
+
+use crate::error::{Error, Location, Result};
+use contactscope::analysis::PlaneSource;
+use contactscope::image::{PixelSize, PixelSizeSource, Plane, SampleType};
+use contactscope_formats::microscopy::select::{LoadAxis, SelectedPlane, Selection};
+use contactscope_formats::microscopy::MicroscopyFile;
+use contactscope_formats::ranges::Quantity;
+use contactscope_formats::tiff::{TiffInfo, TiffReader};
+
+/// One image of a series.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ImageRef {
+    /// File holding the image.
+    pub path: PathBuf,
+    /// Zero-based page (IFD index) in a TIFF; for CZI, ND2 and LIF files the position along
+    /// the load axis (0 without one).
+    pub page: usize,
+    /// The plane of a CZI, ND2 or LIF file (`None` for TIFF pages).
+    pub plane: Option<SelectedPlane>,
+    /// Normal force in newtons, when known.
+    pub force_n: Option<f64>,
+    /// Friction force in newtons, when the manifest gives it.
+    pub friction_n: Option<f64>,
+}
+
+/// The images of a series with the header facts of each distinct file.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Images in load order.
+    pub images: Vec<ImageRef>,
+    /// Header facts per distinct file, in first-use order.
+    pub files: Vec<SeriesFile>,
+    /// Selected channel.
+    pub channel: usize,
+    /// The manifest the series came from, if any.
+    pub manifest: Option<PathBuf>,
+    /// The selection flags the series was built with.
+    pub selection: Selection,
+    /// The axis of CZI, ND2 or LIF files holding the loads, if any.
+    pub load_axis: Option<LoadAxis>,
+}
+
+impl Series {
+    /// Header facts of the file holding image `i`.
+    pub fn info_of(&self, path: &Path) -> Option<&SeriesFile> {
+        self.files.iter().find(|f| f.path == path)
+    }
+}
+
+/// Compare names so that digit runs compare by value: `img2` < `img10`.
+pub fn natural_cmp(a: &str, b: &str) -> Ordering {
+    let (mut a, mut b) = (a, b);
+    loop {
+        match (a.chars().next(), b.chars().next()) {
+            (None, None) => return Ordering::Equal,
+            (None, Some(_)) => return Ordering::Less,
+            (Some(_), None) => return Ordering::Greater,
+            (Some(x), Some(y)) if x.is_ascii_digit() && y.is_ascii_digit() => {
+                let (da, ra) = split_digits(a);
+                let (db, rb) = split_digits(b);
+                let (ta, tb) = (da.trim_start_matches('0'), db.trim_start_matches('0'));
+                let ord = ta
+                    .len()
+                    .cmp(&tb.len())
+                    .then(ta.cmp(tb))
+                    .then(da.len().cmp(&db.len()));
+                if ord != Ordering::Equal {
+                    return ord;
+                }
+                (a, b) = (ra, rb);
+            }
+            (Some(x), Some(y)) => {
+                if x != y {
+                    return x.cmp(&y);
+                }
+                (a, b) = (&a[x.len_utf8()..], &b[y.len_utf8()..]);
+            }
+        }
+    }
+}
+
+fn split_digits(s: &str) -> (&str, &str) {
+    let end = s.find(|c: char| !c.is_ascii_digit()).unwrap_or(s.len());
+    s.split_at(end)
+}
+
+fn is_image_name(path: &Path) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        ["tif", "tiff", "czi", "nd2", "lif"]
+            .iter()
+            .any(|x| e.eq_ignore_ascii_case(x))
+    })
+}
+
+/// Expand inputs into files: directories give their image files (.tif, .tiff, .czi, .nd2,
+/// .lif) in natural order, files are kept in the order given.
+pub fn collect_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    if inputs.is_empty() {
+        return Err(Error::InvalidArgument("no input files given".into()));
+    }
+    let mut files = Vec::new();
+    for input in inputs {
+        let meta = std::fs::metadata(input).map_err(|e| Error::io(input, e))?;
+        if !meta.is_dir() {
+            files.push(input.clone());
+            continue;
+        }
+        let mut found: Vec<PathBuf> = std::fs::read_dir(input)
+            .map_err(|e| Error::io(input, e))?
+            .filter_map(|entry| entry.ok().map(|e| e.path()))
+            .filter(|p| p.is_file() && is_image_name(p))
+            .collect();
+        if found.is_empty() {
+            return Err(Error::bad_input(
+                Location::file(input),
+                "directory holds no .tif, .tiff, .czi, .nd2 or .lif files",
+            ));
+        }
+        found.sort_by(|a, b| natural_cmp(&a.to_string_lossy(), &b.to_string_lossy()));
+        files.extend(found);
+    }
+    Ok(files)
+}
+
+/// Check that a file's planes agree with the series' first file (size and sample type; the
+/// channel count too between TIFF files).
+fn check_file(file: &SeriesFile, first: Option<&SeriesFile>) -> Result<()> {
+    let Some(first) = first else {
+        return Ok(());
+    };
+    let both_tiff = file.tiff.is_some() && first.tiff.is_some();
+    if (file.width, file.height, file.sample_type) != (first.width, first.height, first.sample_type)
+        || (both_tiff && file.channels != first.channels)
+    {
+        let at = match &file.tiff {
+            Some(info) => Location::page(&file.path, info.pages.first().copied().unwrap_or(0)),
+            None => Location::file(&file.path),
+        };
+        return Err(Error::SeriesMismatch {
+            at,
+            reason: format!("image is {}", file.describe()),
+            expected: first.describe(),
+        });
+    }
+    Ok(())
+}
+
+/// Resolve the channel of a TIFF file.
+fn tiff_channel(info: &TiffInfo, channel: Option<usize>) -> Result<usize> {
+    match channel {
+        None if info.channels > 1 => Err(Error::bad_input(
+            Location::file(&info.path),
+            format!(
+                "file has {} channels ({}); choose one with --channel 0..{}",
+                info.channels,
+                info.channel_layout.describe(),
+                info.channels - 1
+            ),
+        )),
+        Some(c) if c >= info.channels => Err(Error::bad_input(
+            Location::file(&info.path),
+            format!(
+                "channel {c} requested but the file has {} channel(s) (0..{})",
+                info.channels,
+                info.channels - 1
+            ),
+        )),
+        c => Ok(c.unwrap_or(0)),
+    }
+}
+
+/// Header facts of several files, opened once each, in first-use order.
+struct FileTable {
+    files: Vec<SeriesFile>,
+    index: HashMap<PathBuf, usize>,
+    selection: Selection,
+    load_axis: Option<LoadAxis>,
+}
+
+impl FileTable {
+    fn new(selection: Selection, load_axis: Option<LoadAxis>) -> Self {
+        FileTable {
+            files: Vec::new(),
+            index: HashMap::new(),
+            selection,
+            load_axis,
+        }
+    }
+
+    fn get(&mut self, path: &Path) -> Result<&SeriesFile> {
+        if let Some(&i) = self.index.get(path) {
+            return Ok(&self.files[i]);
+        }
+        let file = if contactscope_formats::microscopy::select::is_tiff(path) {
+            self.selection.check_tiff(path)?;
+            let info = TiffReader::open(path)?.info().clone();
+            tiff_channel(&info, self.selection.channel)?;
+            SeriesFile::from_tiff(info)
+        } else {
+            SeriesFile::from_vendor(path, &self.selection, self.load_axis)?
+        };
+        check_file(&file, self.files.first())?;
+        self.index.insert(path.to_path_buf(), self.files.len());
+        self.files.push(file);
+        Ok(self.files.last().expect("just pushed"))
+    }
+
+    fn channel(&self) -> usize {
+        self.selection.channel.unwrap_or(0)
+    }
+
+    fn into_series(self, images: Vec<ImageRef>, manifest: Option<PathBuf>) -> Series {
+        Series {
+            images,
+            channel: self.channel(),
+            files: self.files,
+            manifest,
+            selection: self.selection,
+            load_axis: self.load_axis,
+        }
+    }
+}
+
+/// Every page of the selected channel of every file, in order.
+pub fn from_files(inputs: &[PathBuf], channel: Option<usize>) -> Result<Series> {
+    from_files_selected(inputs, &Selection::channel(channel), None)
+}
+
+/// The images of every file in order: every page of the channel of a TIFF; the planes the
+/// selection names in a CZI, ND2 or LIF file (one plane, or every plane along `load_axis`).
+pub fn from_files_selected(
+    inputs: &[PathBuf],
+    selection: &Selection,
+    load_axis: Option<LoadAxis>,
+) -> Result<Series> {
+    let mut table = FileTable::new(selection.clone(), load_axis);
+    let mut images = Vec::new();
+    for path in collect_files(inputs)? {
+        let channel = table.channel();
+        let planes = table.get(&path)?.images(channel);
+        images.extend(planes.into_iter().map(|(page, plane)| ImageRef {
+            path: path.clone(),
+            page,
+            plane,
+            force_n: None,
+            friction_n: None,
+        }));
+    }
+    Ok(table.into_series(images, None))
+}
+
+/// Give each image its force (newtons); the counts must agree.
+pub fn assign_forces(series: &mut Series, forces_n: &[f64]) -> Result<()> {
+    if forces_n.len() != series.images.len() {
+        let along = series.load_axis.map_or(String::new(), |a| {
+            format!(" (the planes along --load-axis {})", a.name())
+        });
+        return Err(Error::InvalidArgument(format!(
+            "{} force(s) given for {} image(s){along}; give one force per image",
+            forces_n.len(),
+            series.images.len()
+        )));
+    }
+    if let Some(bad) = forces_n.iter().find(|f| !f.is_finite() || **f < 0.0) {
+        return Err(Error::InvalidArgument(format!(
+            "force {} N is negative or not finite",
+            bad
+        )));
+    }
+    for (image, &f) in series.images.iter_mut().zip(forces_n) {
+        image.force_n = Some(f);
+    }
+    Ok(())
+}
+
+fn manifest_number(
+    row: &csv::StringRecord,
+    column: Option<usize>,
+    name: &str,
+    at: &Location,
+) -> Result<Option<f64>> {
+    let Some(text) = column.and_then(|c| row.get(c)).map(str::trim) else {
+        return Ok(None);
+    };
+    if text.is_empty() {
+        return Ok(None);
+    }
+    let value: f64 = text
+        .parse()
+        .map_err(|_| Error::bad_input(at.clone(), format!("{name} '{text}' is not a number")))?;
+    if !value.is_finite() || value < 0.0 {
+        return Err(Error::bad_input(
+            at.clone(),
+            format!("{name} {text} must be a finite, non-negative number"),
+        ));
+    }
+    Ok(Some(value))
+}
+
+/// Read a manifest CSV (`file`, optional `page`, `force_mN`, optional `friction_mN`).
+pub fn from_manifest(manifest: &Path, channel: Option<usize>) -> Result<Series> {
+    from_manifest_selected(manifest, &Selection::channel(channel), None)
+}
+
+/// A manifest whose files may be CZI, ND2 or LIF files too: their `page` is the position along
+/// `load_axis` (empty when the selection names one plane).
+pub fn from_manifest_selected(
+    manifest: &Path,
+    selection: &Selection,
+    load_axis: Option<LoadAxis>,
+) -> Result<Series> {
+    let at_manifest = Location::file(manifest);
+    crate::staging::note_input(manifest);
+    let text = std::fs::read_to_string(manifest).map_err(|e| Error::io(manifest, e))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let headers = reader
+        .headers()
+        .map_err(|e| Error::bad_input(at_manifest.clone(), format!("bad CSV header: {e}")))?
+        .clone();
+    let column = |name: &str| headers.iter().position(|h| h == name);
+    let (Some(file_col), Some(force_col)) = (column("file"), column("force_mN")) else {
+        return Err(Error::bad_input(
+            at_manifest,
+            format!(
+                "manifest needs columns 'file' and 'force_mN' (found: {})",
+                headers.iter().collect::<Vec<_>>().join(", ")
+            ),
+        ));
+    };
+    let (page_col, friction_col) = (column("page"), column("friction_mN"));
+    let base = manifest.parent().unwrap_or(Path::new("."));
+    let mut table = FileTable::new(selection.clone(), load_axis);
+    let mut images = Vec::new();
+    for (i, row) in reader.records().enumerate() {
+        let line = i + 2;
+        let at = Location::file(format!("{}:{line}", manifest.display()));
+        let row = row.map_err(|e| Error::bad_input(at.clone(), format!("bad CSV row: {e}")))?;
+        let file = row.get(file_col).unwrap_or("").trim();
+        if file.is_empty() {
+            return Err(Error::bad_input(at, "empty 'file'"));
+        }
+        let path = base.join(file);
+        let force = manifest_number(&row, Some(force_col), "force_mN", &at)?
+            .ok_or_else(|| Error::bad_input(at.clone(), "missing force_mN"))?;
+        Quantity::Force.check_at(force * 1e-3, &at)?;
+        let friction = manifest_number(&row, friction_col, "friction_mN", &at)?;
+        if let Some(f) = friction {
+            Quantity::Force.check_at(f * 1e-3, &at)?;
+        }
+        let (page, plane) = resolve_page(&mut table, &path, &row, page_col, &at)?;
+        images.push(ImageRef {
+            path,
+            page,
+            plane,
+            force_n: Some(force * 1e-3),
+            friction_n: friction.map(|f| f * 1e-3),
+        });
+    }
+    if images.is_empty() {
+        return Err(Error::bad_input(
+            Location::file(manifest),
+            "manifest lists no images",
+        ));
+    }
+    Ok(table.into_series(images, Some(manifest.to_path_buf())))
+}
+
+fn resolve_page(
+    table: &mut FileTable,
+    path: &Path,
+    row: &csv::StringRecord,
+    page_col: Option<usize>,
+    at: &Location,
+) -> Result<(usize, Option<SelectedPlane>)> {
+    let channel = table.channel();
+    let images = table.get(path)?.images(channel);
+    let pages: Vec<usize> = images.iter().map(|(p, _)| *p).collect();
+    let text = page_col.and_then(|c| row.get(c)).unwrap_or("").trim();
+    if text.is_empty() {
+        return match images.as_slice() {
+            [only] => Ok(only.clone()),
+            _ => Err(Error::bad_input(
+                at.clone(),
+                format!(
+                    "{} has {} pages; give the page (0-based) in a 'page' column",
+                    path.display(),
+                    pages.len()
+                ),
+            )),
+        };
+    }
+    let page: usize = text.parse().map_err(|_| {
+        Error::bad_input(
+            at.clone(),
+            format!("page '{text}' is not a non-negative integer"),
+        )
+    })?;
+    let Some(found) = images.into_iter().find(|(p, _)| *p == page) else {
+        return Err(Error::bad_input(
+            at.clone(),
+            format!(
+                "page {page} is not in {} (its pages for channel {channel}: {})",
+                path.display(),
+                page_list(&pages)
+            ),
+        ));
+    };
+    Ok(found)
+}
+
+fn page_list(pages: &[usize]) -> String {
+    match pages {
+        [] => "none".into(),
+        [a] => a.to_string(),
+        _ if pages.windows(2).all(|w| w[1] == w[0] + 1) => {
+            format!("{}..{}", pages[0], pages[pages.len() - 1])
+        }
+        _ => pages
+            .iter()
+            .map(usize::to_string)
+            .collect::<Vec<_>>()
+            .join(","),
+    }
+}
+
+/// Default budget for decoded planes of compressed files kept between the two passes of the
+/// analysis.
+pub const DEFAULT_MEMORY_BUDGET: usize = 128 << 20;
+
+impl Series {
+    /// The file-backed plane source of the series for [`contactscope::analysis`] (see
+    /// [`SeriesPlanes`]).
+    pub fn planes(&self, memory_budget: usize) -> SeriesPlanes<'_> {
+        SeriesPlanes::new(self, memory_budget)
+    }
+}
+
+/// The pixel size for the whole series: the override, or the files' metadata if they agree.
+///
+/// Notes from the files' metadata, and the lack of any pixel size, are added to `warnings`.
+pub fn pixel_size(
+    series: &Series,
+    override_m: Option<(f64, f64)>,
+    warnings: &mut Vec<String>,
+) -> Result<Option<PixelSize>> {
+    if let Some((x_m, y_m)) = override_m {
+        return Ok(Some(PixelSize {
+            x_m,
+            y_m,
+            source: PixelSizeSource::CommandLine,
+        }));
+    }
+    let first = &series.files[0];
+    for other in &series.files[1..] {
+        let agree = match (&first.pixel_size, &other.pixel_size) {
+            (Some(a), Some(b)) => a.same_size(b),
+            (None, None) => true,
+            _ => false,
+        };
+        if !agree {
+            let show = |p: &Option<PixelSize>| {
+                p.map_or("no pixel size".to_string(), |p| {
+                    format!("{:.6}×{:.6} µm", p.x_m * 1e6, p.y_m * 1e6)
+                })
+            };
+            return Err(Error::SeriesMismatch {
+                at: Location::file(&other.path),
+                reason: format!("pixel size is {}", show(&other.pixel_size)),
+                expected: format!("{}; give --pixel-size to override", show(&first.pixel_size)),
+            });
+        }
+    }
+    for f in &series.files {
+        warnings.extend(f.notes.iter().map(|n| format!("{}: {n}", f.path.display())));
+    }
+    if let Some(p) = &first.pixel_size {
+        let at = Location::file(&first.path);
+        Quantity::PixelSize.check_at(p.x_m, &at)?;
+        Quantity::PixelSize.check_at(p.y_m, &at)?;
+    }
+    if first.pixel_size.is_none() {
+        warnings.push(
+            "no pixel size in the files' metadata and no --pixel-size: areas are in pixels".into(),
+        );
+    }
+    Ok(first.pixel_size)
+}
+
+/// The file-backed [`PlaneSource`] of a series: pages decoded on demand, each run of images of one
+/// file with its own decoder, decoded planes of compressed files kept between the analysis'
+/// passes up to a memory budget (re-reading an uncompressed page costs less than keeping it).
+pub struct SeriesPlanes<'a> {
+    series: &'a Series,
+    cache: Mutex<Vec<Option<Arc<Plane>>>>,
+    cacheable: Vec<bool>,
+    budget_left: Mutex<usize>,
+}
+
+impl<'a> SeriesPlanes<'a> {
+    /// The planes of `series`, keeping up to `budget` bytes of decoded compressed planes.
+    pub fn new(series: &'a Series, budget: usize) -> Self {
+        let compressed = |path: &Path| {
+            series
+                .info_of(path)
+                .is_some_and(|info| info.compression != "none")
+        };
+        SeriesPlanes {
+            series,
+            cache: Mutex::new(vec![None; series.images.len()]),
+            cacheable: series.images.iter().map(|i| compressed(&i.path)).collect(),
+            budget_left: Mutex::new(budget),
+        }
+    }
+
+    fn plane(&self, reader: &mut Option<Reader>, i: usize) -> Result<Arc<Plane>> {
+        if let Some(p) = self.cache.lock().expect("lock")[i].clone() {
+            return Ok(p);
+        }
+        let plane = Arc::new(self.read(reader, &self.series.images[i])?);
+        let mut left = self.budget_left.lock().expect("lock");
+        if self.cacheable[i] && plane.heap_bytes() <= *left {
+            *left -= plane.heap_bytes();
+            self.cache.lock().expect("lock")[i] = Some(plane.clone());
+        }
+        Ok(plane)
+    }
+
+    fn read(&self, reader: &mut Option<Reader>, image: &ImageRef) -> Result<Plane> {
+        if reader.as_ref().is_none_or(|r| r.path() != image.path) {
+            *reader = Some(match image.plane {
+                None => Reader::Tiff(Box::new(TiffReader::open(&image.path)?)),
+                Some(_) => Reader::Vendor(Box::new(MicroscopyFile::open(&image.path)?)),
+            });
+        }
+        let plane = match (reader.as_mut().expect("just opened"), &image.plane) {
+            (Reader::Tiff(r), None) => r.read_page(image.page, self.series.channel)?,
+            (Reader::Vendor(f), Some(p)) => f.read_plane(p.series, &p.index)?,
+            _ => {
+                return Err(Error::InvalidArgument(format!(
+                    "{}: file changed its format during the analysis",
+                    image.path.display()
+                )))
+            }
+        };
+        check_plane(&plane, self.series, image)?;
+        Ok(plane)
+    }
+}
+
+/// An open file of a series.
+enum Reader {
+    Tiff(Box<TiffReader>),
+    Vendor(Box<MicroscopyFile>),
+}
+
+impl Reader {
+    fn path(&self) -> &Path {
+        match self {
+            Reader::Tiff(r) => &r.info().path,
+            Reader::Vendor(f) => &f.path,
+        }
+    }
+}
+
+/// Where an image is, for messages: `file (page 3)` or `file.czi (series 0, t 2, z 0, c 1)`.
+pub fn image_location(image: &ImageRef) -> Location {
+    match &image.plane {
+        None => Location::page(&image.path, image.page),
+        Some(p) => Location::file(format!("{} ({})", image.path.display(), p.describe())),
+    }
+}
+
+impl PlaneSource for SeriesPlanes<'_> {
+    fn len(&self) -> usize {
+        self.series.images.len()
+    }
+
+    fn sample_type(&self) -> SampleType {
+        self.series.files[0].sample_type
+    }
+
+    fn label(&self, index: usize) -> String {
+        image_location(&self.series.images[index]).to_string()
+    }
+
+    /// In parallel over runs of images of one file.
+    fn scan<T: Send, F: Fn(usize, &Plane) -> contactscope::Result<T> + Sync>(
+        &self,
+        f: F,
+    ) -> contactscope::Result<Vec<T>> {
+        let groups = work_units(&self.series.images, rayon::current_num_threads());
+        let results: Vec<Vec<(usize, contactscope::Result<T>)>> = groups
+            .par_iter()
+            .map(|indices| {
+                let mut reader = None;
+                let mut out = Vec::with_capacity(indices.len());
+                for &i in indices {
+                    let r = self
+                        .plane(&mut reader, i)
+                        .map_err(contactscope::Error::from)
+                        .and_then(|p| f(i, &p));
+                    let failed = r.is_err();
+                    out.push((i, r));
+                    if failed {
+                        break;
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut flat: Vec<(usize, contactscope::Result<T>)> =
+            results.into_iter().flatten().collect();
+        flat.sort_by_key(|(i, _)| *i);
+        if let Some(pos) = flat.iter().position(|(_, r)| r.is_err()) {
+            return Err(flat.swap_remove(pos).1.err().expect("is an error"));
+        }
+        Ok(flat.into_iter().map(|(_, r)| r.expect("checked")).collect())
+    }
+}
+
+fn check_plane(plane: &Plane, series: &Series, image: &ImageRef) -> Result<()> {
+    let first = &series.files[0];
+    if (plane.width, plane.height, plane.sample_type)
+        != (first.width, first.height, first.sample_type)
+    {
+        return Err(Error::SeriesMismatch {
+            at: image_location(image),
+            reason: format!(
+                "plane is {}×{} {}",
+                plane.width,
+                plane.height,
+                plane.sample_type.name()
+            ),
+            expected: format!(
+                "{}×{} {}",
+                first.width,
+                first.height,
+                first.sample_type.name()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Units of parallel work: the image indices of each file (files in first-use order), split into
+/// runs short enough that a single multi-page file keeps every thread busy. Each unit opens its
+/// own decoder.
+fn work_units(images: &[ImageRef], threads: usize) -> Vec<Vec<usize>> {
+    let mut by_file: HashMap<&Path, usize> = HashMap::new();
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (i, image) in images.iter().enumerate() {
+        let g = *by_file.entry(&image.path).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(i);
+    }
+    let run = images.len().div_ceil(4 * threads.max(1)).max(1);
+    groups
+        .iter()
+        .flat_map(|g| g.chunks(run).map(<[usize]>::to_vec))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn natural_order() {
+        let mut names = vec!["img10.tif", "img2.tif", "img1.tif", "img02.tif", "a.tif"];
+        names.sort_by(|a, b| natural_cmp(a, b));
+        assert_eq!(
+            names,
+            ["a.tif", "img1.tif", "img2.tif", "img02.tif", "img10.tif"]
+        );
+        assert_eq!(natural_cmp("T00009", "T00010"), Ordering::Less);
+        assert_eq!(natural_cmp("x", "x"), Ordering::Equal);
+    }
+
+    #[test]
+    fn page_lists_read_well() {
+        assert_eq!(page_list(&[0, 1, 2, 3]), "0..3");
+        assert_eq!(page_list(&[1, 3, 5]), "1,3,5");
+        assert_eq!(page_list(&[4]), "4");
+    }
+}

@@ -1,0 +1,555 @@
+//! The `simulate` job: a load ramp with one contact model on a rough body, in memory. Every
+//! front-end builds a [`SimulateRequest`] (the command line from its flags, Python from its
+//! keywords), [`SimulateRequest::check`] applies the same range checks to both, [`run`] solves
+//! and returns a [`SimulateOutcome`], whose serialisation is `summary.json` (lab units) and the
+//! Python result (SI units, [`crate::lab`]). Per-load maps reach the caller's [`LoadObserver`]
+//! as they come (the command line writes them as TIFFs, [`files`]; Python keeps them as arrays).
+
+pub mod files;
+
+use serde::ser::SerializeMap;
+use serde::{Serialize, Serializer};
+
+use contactscope::analysis::fit::fit_power_law;
+use contactscope::measure::patches::count_patches;
+use contactscope::solver::cg::{Monitor, SolverOptions};
+use contactscope::solver::gt::{gt_bearing_area, gt_profile, GtParams};
+use contactscope::solver::halfspace::Boundary;
+use contactscope::solver::simulate::{separation, sweep_each, LoadStep, Model, Setup};
+use contactscope::surface::stats::SurfaceStats;
+use contactscope::surface::Topography;
+use contactscope_formats::param::Param;
+use contactscope_formats::ranges::Quantity;
+
+use crate::error::{Error, Result};
+use crate::heights::{HeightFacts, HeightInput};
+use crate::lab;
+
+/// Which model to run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ModelChoice {
+    /// One of the half-space models.
+    HalfSpace(Model),
+    /// Greenwood–Tripp with the bearing-area map (needs the sphere radius).
+    GreenwoodTripp,
+}
+
+impl ModelChoice {
+    /// Name used in outputs.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ModelChoice::HalfSpace(m) => m.name(),
+            ModelChoice::GreenwoodTripp => "gt",
+        }
+    }
+}
+
+/// The model as `summary.json` records it (`model`).
+impl Serialize for ModelChoice {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(None)?;
+        m.serialize_entry("name", self.name())?;
+        match *self {
+            ModelChoice::GreenwoodTripp => {
+                m.serialize_entry("eta_h_rms_beta", &GtParams::DEFAULT_ETA_H_BETA)?;
+                m.serialize_entry("sigma", "h_rms")?;
+            }
+            ModelChoice::HalfSpace(Model::Elastic) => {}
+            ModelChoice::HalfSpace(Model::Hardness {
+                hardness_pa,
+                volume_conserving,
+            }) => {
+                m.serialize_entry("hardness_MPa", &Pa(hardness_pa))?;
+                m.serialize_entry(
+                    "plastic_increment",
+                    if volume_conserving.is_some() {
+                        "volume-conserving (Eq. 5)"
+                    } else {
+                        "local (Eq. 4)"
+                    },
+                )?;
+                m.serialize_entry("relaxation_alpha", &volume_conserving)?;
+            }
+            ModelChoice::HalfSpace(Model::Hardening {
+                modulus_pa_per_m,
+                initial_pa,
+            }) => {
+                m.serialize_entry("hardening_MPa_per_nm", &PaPerM(modulus_pa_per_m))?;
+                m.serialize_entry("initial_hardness_MPa", &Pa(initial_pa))?;
+                m.serialize_entry(
+                    "solve",
+                    "implicit series compliance per load step (docs/methods.md §3.4)",
+                )?;
+            }
+        }
+        m.end()
+    }
+}
+
+/// A pressure (Pa) written in MPa.
+struct Pa(f64);
+impl Serialize for Pa {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        lab::pa_as_mpa(&self.0, s)
+    }
+}
+
+/// A hardening coefficient (Pa/m) written in MPa/nm.
+struct PaPerM(f64);
+impl Serialize for PaPerM {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        lab::pa_per_m_as_mpa_per_nm(&self.0, s)
+    }
+}
+
+/// Everything `simulate` needs. SI units.
+#[derive(Debug, Clone)]
+pub struct SimulateRequest {
+    /// The rough body's heights.
+    pub heights: HeightInput,
+    /// Sphere radius to add to a flattened map (and the GT sphere), m.
+    pub radius_m: Option<f64>,
+    /// Contact modulus E*, Pa.
+    pub e_star_pa: f64,
+    /// The model.
+    pub model: ModelChoice,
+    /// Periodic boundaries (free otherwise).
+    pub periodic: bool,
+    /// Normal forces, N, in order (the plastic state carries from load to load).
+    pub loads_n: Vec<f64>,
+    /// Relative CG tolerance.
+    pub tolerance: f64,
+    /// Most CG iterations per load.
+    pub max_iterations: usize,
+}
+
+impl SimulateRequest {
+    /// Default relative CG tolerance.
+    pub const TOLERANCE: f64 = 1e-8;
+    /// Default iteration limit per load.
+    pub const MAX_ITERATIONS: usize = 5000;
+
+    /// A request with the defaults: no sphere, free boundaries, the default solver limits.
+    pub fn new(
+        heights: HeightInput,
+        e_star_pa: f64,
+        model: ModelChoice,
+        loads_n: Vec<f64>,
+    ) -> Self {
+        SimulateRequest {
+            heights,
+            radius_m: None,
+            e_star_pa,
+            model,
+            periodic: false,
+            loads_n,
+            tolerance: Self::TOLERANCE,
+            max_iterations: Self::MAX_ITERATIONS,
+        }
+    }
+
+    /// Every range check, the same for every front-end; each refusal names the parameter.
+    pub fn check(&self) -> Result<()> {
+        self.heights.check()?;
+        if let Some(r) = self.radius_m {
+            Quantity::Radius.check(r, Param::Radius)?;
+        }
+        Quantity::Modulus.check(self.e_star_pa, Param::Modulus)?;
+        check_loads(&self.loads_n, Param::Loads)?;
+        check_model(&self.model)?;
+        check_solver(self.tolerance, self.max_iterations)?;
+        if self.model == ModelChoice::GreenwoodTripp && self.radius_m.is_none() {
+            return Err(Error::InvalidArgument(format!(
+                "the Greenwood–Tripp model needs the sphere radius ({})",
+                Param::Radius
+            )));
+        }
+        Ok(())
+    }
+
+    fn solver_options(&self) -> SolverOptions<'static> {
+        SolverOptions {
+            tolerance: self.tolerance,
+            max_iterations: self.max_iterations,
+            monitor: None,
+            ..SolverOptions::default()
+        }
+    }
+}
+
+/// Loads (or forces) of a ramp: at least one, each within the force range.
+pub fn check_loads(loads_n: &[f64], param: Param) -> Result<()> {
+    if loads_n.is_empty() {
+        return Err(Error::InvalidArgument(format!("{param}: no loads given")));
+    }
+    for &f in loads_n {
+        Quantity::Force.check(f, param)?;
+    }
+    Ok(())
+}
+
+/// The model's own parameters within their ranges.
+pub fn check_model(model: &ModelChoice) -> Result<()> {
+    match *model {
+        ModelChoice::HalfSpace(Model::Hardness {
+            hardness_pa,
+            volume_conserving,
+        }) => {
+            Quantity::Hardness.check(hardness_pa, Param::Hardness)?;
+            if let Some(alpha) = volume_conserving {
+                if !(alpha > 0.0 && alpha <= 1.0) {
+                    return Err(Error::InvalidArgument(format!(
+                        "{}: the relaxation α = {alpha} must lie in (0, 1]",
+                        Param::VolumeConserving
+                    )));
+                }
+            }
+        }
+        ModelChoice::HalfSpace(Model::Hardening {
+            modulus_pa_per_m,
+            initial_pa,
+        }) => {
+            Quantity::Hardening.check(modulus_pa_per_m, Param::Hardening)?;
+            if initial_pa != 0.0 {
+                Quantity::Hardness.check(initial_pa, Param::InitialHardness)?;
+            }
+        }
+        ModelChoice::HalfSpace(Model::Elastic) | ModelChoice::GreenwoodTripp => {}
+    }
+    Ok(())
+}
+
+/// The solver's stopping rule: a tolerance in (0, 0.1] and at least one iteration.
+pub fn check_solver(tolerance: f64, max_iterations: usize) -> Result<()> {
+    if !(tolerance > 0.0 && tolerance <= 0.1) {
+        return Err(Error::InvalidArgument(format!(
+            "{}: the relative tolerance {tolerance:e} must lie in (0, 0.1]",
+            Param::Tolerance
+        )));
+    }
+    if max_iterations == 0 {
+        return Err(Error::InvalidArgument(format!(
+            "{}: at least one iteration",
+            Param::MaxIterations
+        )));
+    }
+    Ok(())
+}
+
+/// One row of the simulated area–load table (`areas.csv`, `summary.json` `loads`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SimulatedLoad {
+    /// Normal force, N.
+    #[serde(rename = "force_mN", serialize_with = "lab::n_as_mn")]
+    pub force_n: f64,
+    /// Contact area, m².
+    #[serde(rename = "area_um2", serialize_with = "lab::m2_as_um2")]
+    pub area_m2: f64,
+    /// Contact fraction of the map.
+    pub contact_fraction: f64,
+    /// Force / area, Pa; NaN where the area is zero (a Greenwood–Tripp load whose bearing
+    /// area covers no pixel): an empty cell in `areas.csv`, `null` in `summary.json`.
+    #[serde(rename = "mean_pressure_MPa", serialize_with = "lab::pa_as_mpa")]
+    pub mean_pressure_pa: f64,
+    /// Largest pressure, Pa.
+    #[serde(rename = "max_pressure_MPa", serialize_with = "lab::pa_as_mpa")]
+    pub max_pressure_pa: f64,
+    /// Rigid approach, m.
+    #[serde(rename = "approach_um", serialize_with = "lab::m_as_um")]
+    pub approach_m: f64,
+    /// 8-connected contact patches.
+    pub patches: u64,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// Final relative residual.
+    pub residual: f64,
+    /// Plastic volume, m³.
+    #[serde(rename = "plastic_volume_um3", serialize_with = "lab::m3_as_um3")]
+    pub plastic_volume_m3: f64,
+    /// Contact reaches the border of a free map.
+    pub edge_contact: bool,
+}
+
+/// The solver settings a summary records.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SolverFacts {
+    /// The algorithm.
+    pub method: &'static str,
+    /// Relative tolerance.
+    pub tolerance: f64,
+    /// Iteration limit per load.
+    pub max_iterations: usize,
+}
+
+/// The power law A = c·N^β through the simulated areas (N in mN, A in µm²).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PowerLaw {
+    /// β.
+    pub exponent: f64,
+    /// Standard error of β.
+    pub exponent_se: Option<f64>,
+    /// c in µm²·mN^(−β).
+    pub prefactor_um2: f64,
+    /// R² of the log–log regression.
+    pub r_squared: f64,
+}
+
+impl Serialize for PowerLaw {
+    /// In SI units ([`lab::in_si`]) the prefactor is c in m²·N^(−β).
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(4))?;
+        m.serialize_entry("exponent", &self.exponent)?;
+        m.serialize_entry("exponent_se", &self.exponent_se)?;
+        let prefactor = if lab::si() {
+            self.prefactor_um2 * 1e-12 * 1e3f64.powf(self.exponent)
+        } else {
+            self.prefactor_um2
+        };
+        m.serialize_entry("prefactor_um2_per_mN_pow_exponent", &prefactor)?;
+        m.serialize_entry("r_squared", &self.r_squared)?;
+        m.end()
+    }
+}
+
+/// What `simulate` found: `summary.json` without the command line.
+#[derive(Debug, Clone, Serialize)]
+pub struct SimulateOutcome {
+    /// The height map and its roughness.
+    pub topography: HeightFacts,
+    /// Contact modulus E*, Pa.
+    #[serde(rename = "contact_modulus_GPa", serialize_with = "lab::pa_as_gpa")]
+    pub contact_modulus_pa: f64,
+    /// The model.
+    pub model: ModelChoice,
+    /// The boundary conditions, in words.
+    pub boundary: &'static str,
+    /// The solver's settings.
+    pub solver: SolverFacts,
+    /// One row per load.
+    pub loads: Vec<SimulatedLoad>,
+    /// A = c·N^β through the loads with contact.
+    pub power_law: Option<PowerLaw>,
+    /// Warnings (notes on the input, edge contact, empty contacts).
+    pub warnings: Vec<String>,
+    /// Statistics of the roughness (after detrending, before adding a sphere).
+    #[serde(skip)]
+    pub stats: SurfaceStats,
+}
+
+/// The maps of one solved load, as they come.
+pub enum LoadMaps<'a> {
+    /// A half-space model: the body (sphere included), its undeformed separation, the solution.
+    HalfSpace {
+        /// The rough body, sphere included.
+        body: &'a Topography,
+        /// Undeformed separation max(h) − h, m.
+        base: &'a [f64],
+        /// The load's solution: pressure, gap, plastic displacement.
+        step: LoadStep,
+    },
+    /// Greenwood–Tripp: the bearing-area contact mask only.
+    BearingArea {
+        /// The roughness (no sphere).
+        roughness: &'a Topography,
+        /// 1 = contact, row-major.
+        mask: Vec<u8>,
+    },
+}
+
+/// What a caller hears of each load while `simulate` runs.
+pub trait LoadObserver {
+    /// Load `index` (of `total`) is solved; its maps are the caller's to keep or drop (they are
+    /// dropped before the next load is solved unless kept).
+    fn load(&mut self, _index: usize, _total: usize, _maps: LoadMaps<'_>) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// An observer that keeps nothing.
+pub struct NoMaps;
+impl LoadObserver for NoMaps {}
+
+/// Run `simulate` in memory: check the request, read and prepare the heights, solve every load.
+/// `observer` receives each load's maps, `monitor` every CG iteration (for progress displays).
+pub fn run(
+    request: &SimulateRequest,
+    observer: &mut dyn LoadObserver,
+    monitor: Option<Monitor>,
+) -> Result<SimulateOutcome> {
+    request.check()?;
+    let (roughness, notes) = request.heights.read_with_notes()?;
+    let stats = SurfaceStats::finite_differences(&roughness)?;
+    let (loads, mut warnings) = match request.model {
+        ModelChoice::GreenwoodTripp => run_gt(request, &roughness, &stats, observer)?,
+        ModelChoice::HalfSpace(model) => {
+            let mut body = roughness.clone();
+            if let Some(r) = request.radius_m {
+                body.add_sphere(r)?;
+            }
+            run_halfspace(request, model, &body, stats.h_rms_m, observer, monitor)?
+        }
+    };
+    warnings.splice(0..0, notes);
+    for l in loads.iter().filter(|l| l.area_m2 <= 0.0) {
+        warnings.push(format!(
+            "{:.6} mN: no pixel in contact (the contact is smaller than a pixel); mean pressure left empty",
+            l.force_n * 1e3
+        ));
+    }
+    let (f, a): (Vec<f64>, Vec<f64>) = loads
+        .iter()
+        .map(|l| (l.force_n * 1e3, l.area_m2 * 1e12))
+        .unzip();
+    let (channel, fill_invalid) = request.heights.facts();
+    Ok(SimulateOutcome {
+        topography: HeightFacts {
+            path: request.heights.label(),
+            nx: roughness.nx(),
+            ny: roughness.ny(),
+            pixel_size_x_m: roughness.dx_m,
+            pixel_size_y_m: roughness.dy_m,
+            detrend: request.heights.detrend().name(),
+            channel,
+            fill_invalid,
+            h_rms_m: stats.h_rms_m,
+            h_prime_rms: stats.h_prime_rms,
+            h_double_prime_rms_per_m: stats.h_double_prime_rms_per_m,
+            sphere_radius_m: request.radius_m,
+        },
+        contact_modulus_pa: request.e_star_pa,
+        model: request.model,
+        boundary: if request.periodic {
+            "periodic (q = 0 mode zero: mean pressure imposed, approach is the multiplier)"
+        } else {
+            "free (2N zero padding, Love pixel kernel)"
+        },
+        solver: SolverFacts {
+            method: "Polonsky–Keer constrained conjugate gradients, f64",
+            tolerance: request.tolerance,
+            max_iterations: request.max_iterations,
+        },
+        power_law: fit_power_law(&f, &a).map(|fit| PowerLaw {
+            exponent: fit.exponent,
+            exponent_se: fit.exponent_se,
+            prefactor_um2: fit.prefactor,
+            r_squared: fit.r_squared,
+        }),
+        loads,
+        warnings,
+        stats,
+    })
+}
+
+type Rows = (Vec<SimulatedLoad>, Vec<String>);
+
+fn run_halfspace(
+    request: &SimulateRequest,
+    model: Model,
+    body: &Topography,
+    h_rms_m: f64,
+    observer: &mut dyn LoadObserver,
+    monitor: Option<Monitor>,
+) -> Result<Rows> {
+    let options = SolverOptions {
+        monitor,
+        // Gap residuals relative to the roughness (SolverOptions::gap_scale_m).
+        gap_scale_m: Some(h_rms_m),
+        ..request.solver_options()
+    };
+    let setup = Setup {
+        topography: body,
+        e_star_pa: request.e_star_pa,
+        boundary: if request.periodic {
+            Boundary::Periodic
+        } else {
+            Boundary::Free
+        },
+        model,
+        options,
+    };
+    let base = separation(body);
+    let total = request.loads_n.len();
+    let mut warnings = Vec::new();
+    let mut rows = Vec::with_capacity(total);
+    // Each load's maps go to the observer and its fields are dropped before the next load is
+    // solved (unless the observer keeps them).
+    sweep_each(&setup, &request.loads_n, &mut |i, step| {
+        if step.edge_contact {
+            warnings.push(format!(
+                "at {:.4} mN the contact reaches the border of the map: the free-boundary result is not valid; use a larger map or smaller loads",
+                step.force_n * 1e3
+            ));
+        }
+        rows.push(row_of(body, &step));
+        let maps = LoadMaps::HalfSpace {
+            body,
+            base: &base,
+            step,
+        };
+        Ok(observer.load(i, total, maps)?)
+    })?;
+    Ok((rows, warnings))
+}
+
+fn row_of(body: &Topography, s: &LoadStep) -> SimulatedLoad {
+    SimulatedLoad {
+        force_n: s.force_n,
+        area_m2: s.area_m2,
+        contact_fraction: s.contact_fraction,
+        mean_pressure_pa: s.mean_pressure_pa,
+        max_pressure_pa: s.max_pressure_pa,
+        approach_m: s.solution.approach,
+        patches: s.patches,
+        iterations: s.solution.iterations,
+        residual: s.solution.gap_residual.max(s.solution.pressure_change),
+        plastic_volume_m3: s.plastic_m.iter().sum::<f64>() * body.dx_m * body.dy_m,
+        edge_contact: s.edge_contact,
+    }
+}
+
+fn run_gt(
+    request: &SimulateRequest,
+    roughness: &Topography,
+    stats: &SurfaceStats,
+    observer: &mut dyn LoadObserver,
+) -> Result<Rows> {
+    let radius = request.radius_m.ok_or_else(|| {
+        Error::InvalidArgument(format!(
+            "the Greenwood–Tripp model needs the sphere radius ({})",
+            Param::Radius
+        ))
+    })?;
+    let params = GtParams::new(
+        radius,
+        request.e_star_pa,
+        stats.h_rms_m,
+        stats.h_double_prime_rms_per_m,
+    );
+    params.validate()?;
+    let total = request.loads_n.len();
+    let mut rows = Vec::new();
+    for (i, &force) in request.loads_n.iter().enumerate() {
+        let profile = gt_profile(&params, force)?;
+        let map = gt_bearing_area(roughness, &profile, None)?;
+        let mask: Vec<u8> = map.mask.iter().map(|m| u8::from(*m)).collect();
+        rows.push(SimulatedLoad {
+            force_n: force,
+            area_m2: map.area_m2,
+            contact_fraction: map.contact_fraction,
+            mean_pressure_pa: if map.area_m2 > 0.0 {
+                force / map.area_m2
+            } else {
+                f64::NAN
+            },
+            max_pressure_pa: profile.pressure_pa.first().copied().unwrap_or(f64::NAN),
+            approach_m: profile.approach_m,
+            patches: count_patches(&mask, roughness.nx()).0,
+            iterations: profile.iterations,
+            residual: (profile.load_n - force).abs() / force,
+            plastic_volume_m3: 0.0,
+            edge_contact: false,
+        });
+        observer.load(i, total, LoadMaps::BearingArea { roughness, mask })?;
+    }
+    Ok((rows, Vec::new()))
+}

@@ -1,0 +1,227 @@
+//! Small numeric CSV tables whose column names carry the unit (`force_mN`, `torque_Nm`): the one
+//! reader shared by the mechanics inputs, so that every missing or misspelt column is reported
+//! the same way, naming the file and the columns it does have.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Location, Result};
+
+/// A CSV file read into memory: trimmed header names and raw records.
+pub(crate) struct Table {
+    path: PathBuf,
+    header: Vec<String>,
+    rows: Vec<csv::StringRecord>,
+}
+
+impl Table {
+    /// Read `path`; an unreadable file or a malformed CSV is an error naming the file.
+    pub(crate) fn read(path: &Path) -> Result<Table> {
+        crate::staging::note_input(path);
+        let at = || Location::file(path);
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .comment(Some(b'#'))
+            .from_path(path)
+            .map_err(|e| csv_error(path, e))?;
+        let header = reader
+            .headers()
+            .map_err(|e| csv_error(path, e))?
+            .iter()
+            .map(String::from)
+            .collect();
+        let rows = reader
+            .records()
+            .collect::<std::result::Result<Vec<_>, _>>()
+            .map_err(|e| Error::bad_input(at(), format!("not a readable CSV: {e}")))?;
+        Ok(Table {
+            path: path.to_path_buf(),
+            header,
+            rows,
+        })
+    }
+
+    /// The file, for error messages.
+    pub(crate) fn location(&self) -> Location {
+        Location::file(&self.path)
+    }
+
+    /// Column names as found.
+    pub(crate) fn header(&self) -> &[String] {
+        &self.header
+    }
+
+    /// Number of data rows.
+    pub(crate) fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// The one column among `candidates` that is present, `None` if none is. Two of them at once
+    /// (`friction_mN` and `friction_N`) are ambiguous and an error.
+    pub(crate) fn one_of<'a>(&self, candidates: &[&'a str]) -> Result<Option<&'a str>> {
+        let present: Vec<&'a str> = candidates
+            .iter()
+            .copied()
+            .filter(|c| self.header.iter().any(|h| h == c))
+            .collect();
+        match present.as_slice() {
+            [] => Ok(None),
+            [one] => Ok(Some(one)),
+            many => Err(Error::bad_input(
+                self.location(),
+                format!(
+                    "columns {} say the same thing; keep one",
+                    many.join(" and ")
+                ),
+            )),
+        }
+    }
+
+    /// The error for a required column that is not there.
+    pub(crate) fn missing(&self, what: &str, accepted: &[&str]) -> Error {
+        Error::bad_input(
+            self.location(),
+            format!(
+                "no {what} column (accepted: {}); columns found: {}",
+                accepted.join(", "),
+                self.found()
+            ),
+        )
+    }
+
+    /// The header as a readable list.
+    pub(crate) fn found(&self) -> String {
+        if self.header.is_empty() {
+            "none".into()
+        } else {
+            self.header.join(", ")
+        }
+    }
+
+    /// Column `name` as finite numbers times `factor`; an empty or non-numeric cell is an error
+    /// naming its line (the header is line 1).
+    pub(crate) fn numbers(&self, name: &str, factor: f64) -> Result<Vec<f64>> {
+        let i = self
+            .header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| self.missing(name, &[name]))?;
+        self.rows
+            .iter()
+            .enumerate()
+            .map(|(k, row)| {
+                let cell = row.get(i).unwrap_or("");
+                match cell.parse::<f64>() {
+                    Ok(v) if v.is_finite() => Ok(v * factor),
+                    _ => Err(Error::bad_input(
+                        self.location(),
+                        format!(
+                            "line {}, column {name}: {cell:?} is not a finite number",
+                            line_of(row, k)
+                        ),
+                    )),
+                }
+            })
+            .collect()
+    }
+
+    /// File line of data row `k` (for messages).
+    /// [`Self::numbers`], each also within ±`max_abs` (SI, after `factor`): a plausibility
+    /// bound that keeps absurd values (1e308 mN) from overflowing what is computed from them.
+    pub(crate) fn numbers_within(&self, name: &str, factor: f64, max_abs: f64) -> Result<Vec<f64>> {
+        let values = self.numbers(name, factor)?;
+        if let Some(k) = values.iter().position(|v| v.abs() > max_abs) {
+            return Err(Error::bad_input(
+                self.location(),
+                format!(
+                    "line {}, column {name}: {:e} is beyond ±{:e} (a wrong unit?)",
+                    self.line(k),
+                    values[k] / factor,
+                    max_abs / factor
+                ),
+            ));
+        }
+        Ok(values)
+    }
+
+    pub(crate) fn line(&self, k: usize) -> u64 {
+        self.rows.get(k).map_or(k as u64 + 2, |r| line_of(r, k))
+    }
+}
+
+fn line_of(row: &csv::StringRecord, k: usize) -> u64 {
+    row.position().map_or(k as u64 + 2, |p| p.line())
+}
+
+fn csv_error(path: &Path, e: csv::Error) -> Error {
+    match e.into_kind() {
+        csv::ErrorKind::Io(source) => Error::io(path, source),
+        other => Error::bad_input(
+            Location::file(path),
+            format!("not a readable CSV: {other:?}"),
+        ),
+    }
+}
+
+/// A number as the tables write it: Rust's shortest round-trip form (`4`, `0.0125`, `1e-7`), as
+/// `f64::to_string`; an empty cell for `null` (an undefined number).
+fn cell(value: &serde_json::Value) -> String {
+    match value {
+        serde_json::Value::Null => String::new(),
+        serde_json::Value::String(s) => s.clone(),
+        serde_json::Value::Number(n) => match (n.as_u64(), n.as_i64(), n.as_f64()) {
+            (Some(u), _, _) => u.to_string(),
+            (None, Some(i), _) => i.to_string(),
+            (None, None, Some(f)) => f.to_string(),
+            _ => n.to_string(),
+        },
+        other => other.to_string(),
+    }
+}
+
+/// A column's own cell format.
+pub type CellFormat = fn(&serde_json::Value) -> String;
+
+/// A CSV of `rows`, one per item, whose columns are the item's serialised fields in order (the
+/// same names and units as in the JSON outputs: one declaration serves both). `formats` gives a
+/// column its own cell format (e.g. three significant digits for a residual). The header comes
+/// from the first row; an empty table is an error.
+pub fn rows_csv<T: serde::Serialize>(
+    rows: &[T],
+    formats: &[(&str, CellFormat)],
+) -> Result<Vec<u8>> {
+    let values: Vec<serde_json::Value> = rows
+        .iter()
+        .map(serde_json::to_value)
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
+    let header: Vec<String> = match values.first() {
+        Some(serde_json::Value::Object(first)) => first.keys().cloned().collect(),
+        _ => return Err(Error::InvalidArgument("CSV: no rows to write".into())),
+    };
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    let csv_err = |e: csv::Error| Error::InvalidArgument(format!("CSV: {e}"));
+    writer.write_record(&header).map_err(csv_err)?;
+    for row in &values {
+        let record: Vec<String> = header
+            .iter()
+            .map(|k| {
+                let v = row.get(k).unwrap_or(&serde_json::Value::Null);
+                match formats.iter().find(|(name, _)| name == k) {
+                    Some((_, f)) if !v.is_null() => f(v),
+                    _ => cell(v),
+                }
+            })
+            .collect();
+        writer.write_record(&record).map_err(csv_err)?;
+    }
+    writer
+        .into_inner()
+        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
+}
+
+/// A number in scientific notation with three significant digits (`1.234e-9`), for residuals.
+pub fn sci3(value: &serde_json::Value) -> String {
+    value
+        .as_f64()
+        .map_or_else(String::new, |v| format!("{v:.3e}"))
+}

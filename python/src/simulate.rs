@@ -1,0 +1,180 @@
+//! `simulate`: the job `contactscope_jobs::simulate` from Python. The request is built from the
+//! keywords (SI units) with the job's own defaults and range checks; the result is the job's
+//! outcome (SI keys) and, with `maps`, the per-load maps as numpy stacks.
+
+use ndarray::Array3;
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use contactscope::solver::simulate::Model;
+use contactscope_formats::param::Param;
+use contactscope_jobs::simulate::{run, LoadMaps, LoadObserver, ModelChoice, SimulateRequest};
+
+use crate::convert::outcome_dict;
+use crate::heights::{height_input, HeightsArg};
+use crate::{bad, compute, PixelArg};
+
+/// The model from its name and parameters (SI).
+pub(crate) fn model_of(
+    model: &str,
+    hardness: Option<f64>,
+    k: Option<f64>,
+    initial_hardness: Option<f64>,
+    alpha: Option<f64>,
+) -> PyResult<ModelChoice> {
+    let unused = |what: Param, value: Option<f64>, applies: &str| match value {
+        Some(_) => Err(bad(format!("{what} applies to model=\"{applies}\" only"))),
+        None => Ok(()),
+    };
+    if model != "hardness" {
+        unused(Param::Hardness, hardness, "hardness")?;
+        unused(Param::VolumeConserving, alpha, "hardness")?;
+    }
+    if model != "hardening" {
+        unused(Param::Hardening, k, "hardening")?;
+        unused(Param::InitialHardness, initial_hardness, "hardening")?;
+    }
+    Ok(match model {
+        "elastic" => ModelChoice::HalfSpace(Model::Elastic),
+        "gt" => ModelChoice::GreenwoodTripp,
+        "hardness" => ModelChoice::HalfSpace(Model::Hardness {
+            hardness_pa: hardness.ok_or_else(|| {
+                bad(format!(
+                    "model=\"hardness\" needs {} (Pa, e.g. 3.7e8)",
+                    Param::Hardness
+                ))
+            })?,
+            volume_conserving: alpha,
+        }),
+        "hardening" => ModelChoice::HalfSpace(Model::Hardening {
+            modulus_pa_per_m: k.ok_or_else(|| {
+                bad(format!(
+                    "model=\"hardening\" needs {} (Pa/m, e.g. 4e15 for 4 MPa/nm)",
+                    Param::Hardening
+                ))
+            })?,
+            initial_pa: initial_hardness.unwrap_or(0.0),
+        }),
+        other => {
+            return Err(bad(format!(
+                "{}\"{other}\" is not one of elastic, hardness, hardening, gt",
+                Param::Model
+            )))
+        }
+    })
+}
+
+/// Keeps each load's maps: pressure (Pa), gap (m), plastic displacement (m), contact.
+#[derive(Default)]
+struct KeepMaps {
+    pressure: Vec<f64>,
+    gap: Vec<f64>,
+    plastic: Vec<f64>,
+    contact: Vec<bool>,
+    shape: (usize, usize),
+}
+
+impl LoadObserver for KeepMaps {
+    fn load(
+        &mut self,
+        _index: usize,
+        _total: usize,
+        maps: LoadMaps<'_>,
+    ) -> contactscope_jobs::Result<()> {
+        match maps {
+            LoadMaps::HalfSpace { body, step, .. } => {
+                self.shape = (body.ny(), body.nx());
+                self.contact
+                    .extend(step.solution.pressure.iter().map(|p| *p > 0.0));
+                // The step is ours: its fields move into the stacks.
+                self.pressure.extend(step.solution.pressure);
+                self.gap.extend(step.solution.gap);
+                self.plastic.extend(step.plastic_m);
+            }
+            LoadMaps::BearingArea { roughness, mask } => {
+                // Greenwood–Tripp gives the bearing-area contact only: no pressure, gap or
+                // plastic fields.
+                let n = mask.len();
+                self.shape = (roughness.ny(), roughness.nx());
+                self.contact.extend(mask.iter().map(|m| *m > 0));
+                self.pressure.extend(std::iter::repeat_n(f64::NAN, n));
+                self.gap.extend(std::iter::repeat_n(f64::NAN, n));
+                self.plastic.extend(std::iter::repeat_n(0.0, n));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A load ramp with one contact model (the command line's `simulate`); see the package's
+/// docstring. Returns the outcome (SI) and, with `maps`, the stacks (loads, ny, nx).
+#[pyfunction]
+#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=true, detrend="plane", height_unit=None, channel=None, fill_invalid=None))]
+#[allow(clippy::too_many_arguments)]
+fn simulate<'py>(
+    py: Python<'py>,
+    heights: HeightsArg<'py>,
+    pixel_size: Option<PixelArg>,
+    modulus: f64,
+    loads: Vec<f64>,
+    model: &str,
+    hardness: Option<f64>,
+    k: Option<f64>,
+    initial_hardness: Option<f64>,
+    alpha: Option<f64>,
+    radius: Option<f64>,
+    periodic: bool,
+    tolerance: Option<f64>,
+    max_iterations: Option<usize>,
+    maps: bool,
+    detrend: &str,
+    height_unit: Option<f64>,
+    channel: Option<String>,
+    fill_invalid: Option<&str>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let input = height_input(
+        heights,
+        pixel_size,
+        detrend,
+        height_unit,
+        channel,
+        fill_invalid,
+    )?;
+    let model = model_of(model, hardness, k, initial_hardness, alpha)?;
+    let mut request = SimulateRequest::new(input, modulus, model, loads);
+    request.radius_m = radius;
+    request.periodic = periodic;
+    request.tolerance = tolerance.unwrap_or(request.tolerance);
+    request.max_iterations = max_iterations.unwrap_or(request.max_iterations);
+    let (outcome, kept) = compute(py, move || {
+        let mut kept = KeepMaps::default();
+        let outcome = if maps {
+            run(&request, &mut kept, None)?
+        } else {
+            run(&request, &mut contactscope_jobs::simulate::NoMaps, None)?
+        };
+        Ok::<_, contactscope_jobs::Error>((outcome, kept))
+    })?;
+    let d = outcome_dict(py, &outcome)?;
+    if maps {
+        let shape = (outcome.loads.len(), kept.shape.0, kept.shape.1);
+        let err = |e: ndarray::ShapeError| bad(format!("maps: {e}"));
+        for (name, values) in [
+            ("pressure", kept.pressure),
+            ("gap", kept.gap),
+            ("plastic", kept.plastic),
+        ] {
+            let a = Array3::from_shape_vec(shape, values).map_err(err)?;
+            d.set_item(name, a.into_pyarray(py))?;
+        }
+        let a = Array3::from_shape_vec(shape, kept.contact).map_err(err)?;
+        d.set_item("contact", a.into_pyarray(py))?;
+    }
+    Ok(d)
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    Ok(())
+}

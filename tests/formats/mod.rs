@@ -1,0 +1,9 @@
+//! The readers: every format against the numbers of trusted readers, `info` and `topography`
+//! on real and generated files, and vendor files in the optics commands.
+
+mod commands;
+mod files;
+mod real;
+mod synthetic;
+mod topography;
+mod vendor_optics;

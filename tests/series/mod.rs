@@ -1,0 +1,7 @@
+//! Load series: one global Otsu threshold, contact areas, patches and fits, against ground
+//! truth, on real TIFFs, and along the load axes of CZI, ND2 and LIF files.
+
+mod analysis;
+mod ground_truth;
+mod real_tiff;
+mod vendor;
