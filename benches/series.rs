@@ -31,10 +31,9 @@ use contactscope::threshold::{Binning, Histogram, Threshold};
 use contactscope_formats::tiff::write::{encode_u16_stack_compressed, Compression};
 use contactscope_formats::tiff::TiffReader;
 use contactscope_formats::units::{self, Dimension};
-use contactscope_jobs::analyze::report::Report;
-use contactscope_jobs::analyze::{analyze_series, AnalyzeOptions};
-use contactscope_jobs::series::DEFAULT_MEMORY_BUDGET;
-use contactscope_jobs::series::{self, Series};
+use contactscope_jobs::analyze::files::areas_csv;
+use contactscope_jobs::analyze::{run, AnalyzeRequest};
+use contactscope_jobs::series::{Micrographs, SeriesSpec, DEFAULT_MEMORY_BUDGET};
 
 const SIZE: usize = 1024;
 const IMAGES: usize = 40;
@@ -149,34 +148,34 @@ fn generate() -> Data {
     }
 }
 
-/// The whole job: series, forces, analysis, report, areas.csv (in memory).
-fn whole_job(dir: &Path, forces_n: &[f64], memory_budget: usize) -> (Series, Vec<u8>, f64, u64) {
-    let mut series = series::from_files(&[dir.to_path_buf()], None).expect("series");
-    series::assign_forces(&mut series, forces_n).expect("forces");
-    let options = AnalyzeOptions {
+/// The whole job: series, forces, analysis, rows, areas.csv (in memory).
+fn whole_job(dir: &Path, forces_n: &[f64], memory_budget: usize) -> (usize, Vec<u8>, f64, u64) {
+    let request = AnalyzeRequest {
         memory_budget,
-        ..AnalyzeOptions::default()
+        ..AnalyzeRequest::new(Micrographs::Files(SeriesSpec {
+            inputs: vec![dir.to_path_buf()],
+            forces_n: Some(forces_n.to_vec()),
+            ..SeriesSpec::default()
+        }))
     };
-    let analysis =
-        analyze_series(&series, &options, &|_, _, _| {}, &|_, _, _| Ok(())).expect("analysis");
-    let report = Report::new(&series, &analysis, None);
-    let csv = report.areas_csv().expect("csv");
+    let outcome = run(&request, &|_, _, _| {}, &|_, _, _| Ok(())).expect("analysis");
+    let csv = areas_csv(&outcome).expect("csv");
+    let analysis = &outcome.analysis;
     let threshold = analysis.series_threshold.expect("global").value;
     let contact = analysis
         .images
         .iter()
         .map(|r| r.measurement.contact_pixels)
         .sum();
-    (series, csv, threshold, contact)
+    (outcome.rows.rows.len(), csv, threshold, contact)
 }
 
 fn series_benches(c: &mut Criterion) {
     let data = generate();
     for (name, dir) in &data.layouts {
-        let (series, csv, t, contact) = whole_job(dir, &data.forces_n, DEFAULT_MEMORY_BUDGET);
+        let (images, csv, t, contact) = whole_job(dir, &data.forces_n, DEFAULT_MEMORY_BUDGET);
         eprintln!(
-            "{name:>14}: {} images, threshold {t}, contact pixels {contact}, areas.csv {} bytes",
-            series.images.len(),
+            "{name:>14}: {images} images, threshold {t}, contact pixels {contact}, areas.csv {} bytes",
             csv.len()
         );
     }

@@ -50,7 +50,8 @@ def main() -> None:
     table["true_area_m2"] = synth.true_area_m2
     table.to_csv(out / "areas.csv", index=False)
     areas = list(table["area_m2"])
-    print(f"threshold {analysis.threshold:.0f}; β = {analysis.power_law['exponent']:.3f}")
+    print(f"threshold {analysis.threshold['value']:.0f}; "
+          f"β = {analysis.fits['power_law']['exponent']:.3f}")
 
     # 2. The rough sphere and the fit of k on Dask (each grid point and each Brent step is one
     #    load ramp; the height map is scattered to the workers once).
@@ -90,8 +91,8 @@ def main() -> None:
     fig.savefig(out / "paper_workflow.png", dpi=110)
 
     summary = {
-        "threshold": analysis.threshold,
-        "power_law_exponent": analysis.power_law["exponent"],
+        "threshold": analysis.threshold["value"],
+        "power_law_exponent": analysis.fits["power_law"]["exponent"],
         "k_MPa_per_nm": k * 1e-15,
         "k_se_MPa_per_nm": None if fit.parameter_se is None else fit.parameter_se * 1e-15,
         "misfit": fit.misfit,

@@ -8,10 +8,9 @@ use anyhow::{bail, Context, Result};
 use contactscope::analysis::Pass;
 use contactscope::threshold::Method;
 use contactscope_formats::units::{self, Dimension};
-use contactscope_jobs::analyze::{
-    run_analyze, AnalyzeOptions, AnalyzeOutcome, AnalyzeRequest, AreaUnit, HertzParams,
-};
-use contactscope_jobs::series::{self, Series, DEFAULT_MEMORY_BUDGET};
+use contactscope_jobs::analyze::files::{run_to_folder, ImageOutputs};
+use contactscope_jobs::analyze::{AnalyzeOutcome, AnalyzeRequest, AreaUnit, HertzParams};
+use contactscope_jobs::series::{Micrographs, SeriesSpec, DEFAULT_MEMORY_BUDGET};
 
 use super::args::{default_out, LoadAxisArg, OutputFolder, PixelSizeArg, Quiet, SelectionArgs};
 use super::common::{command_line, progress_bar};
@@ -60,77 +59,71 @@ pub struct Args {
     quiet: Quiet,
 }
 
-fn build_series(args: &Args) -> Result<Series> {
-    let selection = args.select.selection();
-    let load_axis = args.load_axis.map(LoadAxisArg::axis);
-    let mut series = match &args.manifest {
-        Some(manifest) => series::from_manifest_selected(manifest, &selection, load_axis)?,
-        None => {
-            if args.inputs.is_empty() {
-                bail!("give image files or directories, or --manifest");
-            }
-            series::from_files_selected(&args.inputs, &selection, load_axis)?
-        }
-    };
-    if let Some(text) = &args.forces {
-        let forces = units::parse_quantity_list(text, Dimension::Force)
-            .with_context(|| format!("--forces {text}"))?;
-        series::assign_forces(&mut series, &forces)?;
+fn micrographs(args: &Args) -> Result<Micrographs> {
+    if args.manifest.is_none() && args.inputs.is_empty() {
+        bail!("give image files or directories, or --manifest");
     }
-    Ok(series)
+    let forces_n = match &args.forces {
+        Some(text) => Some(
+            units::parse_quantity_list(text, Dimension::Force)
+                .with_context(|| format!("--forces {text}"))?,
+        ),
+        None => None,
+    };
+    Ok(Micrographs::Files(SeriesSpec {
+        inputs: args.inputs.clone(),
+        manifest: args.manifest.clone(),
+        selection: args.select.selection(),
+        load_axis: args.load_axis.map(LoadAxisArg::axis),
+        forces_n,
+    }))
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let series = build_series(&args)?;
     let hertz = match (&args.radius, &args.modulus) {
         (Some(r), Some(e)) => Some(HertzParams {
-            radius_m: contactscope_formats::ranges::Quantity::Radius.check_text(
-                units::parse_positive(r, Dimension::Length).context("--radius")?,
-                "--radius",
-            )?,
-            modulus_pa: contactscope_formats::ranges::Quantity::Modulus.check_text(
-                units::parse_positive(e, Dimension::Pressure).context("--modulus")?,
-                "--modulus",
-            )?,
+            radius_m: units::parse_positive(r, Dimension::Length).context("--radius")?,
+            modulus_pa: units::parse_positive(e, Dimension::Pressure).context("--modulus")?,
         }),
         _ => None,
     };
-    let options = AnalyzeOptions {
+    let request = AnalyzeRequest {
         method: Method::parse(&args.threshold)?,
-        pixel_size_override: args.pixel_size.metres()?,
+        pixel_size_m: args.pixel_size.metres()?,
         hertz,
         memory_budget: args.memory_mib << 20,
+        ..AnalyzeRequest::new(micrographs(&args)?)
     };
-    let request = AnalyzeRequest {
-        series,
-        options,
-        out_dir: args.out.out.clone(),
+    let images = ImageOutputs {
         overlays: args.overlays,
-        save_masks: args.save_masks,
-        command_line: command_line(),
+        masks: args.save_masks,
     };
-    let outcome = run_with_progress(&request, args.quiet.quiet)?;
-    print_outcome(&outcome, &args.out.out);
-    Ok(())
-}
-
-fn run_with_progress(request: &AnalyzeRequest, quiet: bool) -> Result<AnalyzeOutcome> {
-    let bar = progress_bar(request.series.images.len(), 4, quiet);
-    let progress = |pass: Pass, done: usize, _total: usize| {
+    let bar = progress_bar(
+        match &request.micrographs {
+            Micrographs::Files(spec) => spec.forces_n.as_ref().map_or(0, Vec::len).max(4),
+            Micrographs::Memory(m) => m.planes.len(),
+        },
+        4,
+        args.quiet.quiet,
+    );
+    let progress = |pass: Pass, done: usize, total: usize| {
+        bar.set_length(total as u64);
         bar.set_message(match pass {
             Pass::Histogram => "histogram",
             Pass::Measure => "measure",
         });
         bar.set_position(done as u64);
     };
-    let outcome = run_analyze(request, &progress);
+    let outcome = run_to_folder(&request, &args.out.out, &command_line(), images, &progress);
     bar.finish_and_clear();
-    Ok(outcome?)
+    let (outcome, written) = outcome?;
+    print_outcome(&outcome, &written, &args.out.out);
+    Ok(())
 }
 
-fn print_outcome(outcome: &AnalyzeOutcome, out: &Path) {
+fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
     let a = &outcome.analysis;
-    let r = &outcome.report;
+    let r = &outcome.rows;
     super::common::print_warnings(&a.warnings);
     match a.series_threshold {
         Some(t) => println!(
@@ -168,7 +161,7 @@ fn print_outcome(outcome: &AnalyzeOutcome, out: &Path) {
             .map_or("-".into(), |p| format!("{p:.1}"));
         println!("{f:>10} {:>12.2} {:>8} {p:>10}", row.area, row.patches);
     }
-    if let Some(fit) = r.power_law {
+    if let Some(fit) = outcome.fits.power_law {
         let se = fit
             .exponent_se
             .map_or(String::new(), |s| format!(" ± {s:.3}"));
@@ -177,18 +170,14 @@ fn print_outcome(outcome: &AnalyzeOutcome, out: &Path) {
             fit.exponent, fit.r_squared
         );
     }
-    if let Some((p, _)) = r.proportional_mpa {
+    if let Some((p, _)) = outcome.fits.proportional_mpa {
         println!("proportional fit: A = N/p, p = {p:.1} MPa");
     }
-    println!(
-        "wrote {} files to {}:",
-        outcome.written.len(),
-        out.display()
-    );
-    for path in outcome.written.iter().filter(|p| !is_per_image(p)) {
+    println!("wrote {} files to {}:", written.len(), out.display());
+    for path in written.iter().filter(|p| !is_per_image(p)) {
         println!("  {}", path.display());
     }
-    let per_image = outcome.written.iter().filter(|p| is_per_image(p)).count();
+    let per_image = written.iter().filter(|p| is_per_image(p)).count();
     if per_image > 0 {
         println!("  … and {per_image} overlay/mask files");
     }

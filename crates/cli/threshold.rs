@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
-use contactscope_jobs::threshold::{run_threshold, ThresholdRequest};
+use contactscope_jobs::series::{Micrographs, SeriesSpec};
+use contactscope_jobs::threshold::ThresholdRequest;
 
 use super::args::{LoadAxisArg, SelectionArgs};
 
@@ -24,26 +25,26 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let outcome = run_threshold(&ThresholdRequest {
-        inputs: args.inputs,
-        selection: args.select.selection(),
-        load_axis: args.load_axis.map(LoadAxisArg::axis),
+    let outcome = contactscope_jobs::threshold::run(&ThresholdRequest {
+        micrographs: Micrographs::Files(SeriesSpec {
+            inputs: args.inputs,
+            selection: args.select.selection(),
+            load_axis: args.load_axis.map(LoadAxisArg::axis),
+            ..SeriesSpec::default()
+        }),
     })?;
     super::common::print_warnings(&outcome.warnings);
     if args.json {
-        let value = serde_json::json!({
-            "threshold": outcome.threshold.value,
-            "method": "otsu-global",
-            "contact_rule": "value > threshold",
-            "pixels": outcome.pixels,
-            "images": outcome.images,
-            "files": outcome.files,
-        });
+        // The warnings went to stderr.
+        let mut value = serde_json::to_value(&outcome)?;
+        if let Some(fields) = value.as_object_mut() {
+            fields.shift_remove("warnings");
+        }
         println!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         println!(
             "{} (global Otsu over {} pixels in {} images; contact is value > threshold)",
-            outcome.threshold.value, outcome.pixels, outcome.images
+            outcome.threshold, outcome.pixels, outcome.images
         );
     }
     Ok(())

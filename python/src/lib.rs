@@ -21,6 +21,7 @@ mod convert;
 mod heights;
 mod images;
 mod mechanics;
+mod series;
 mod simulate;
 mod synth;
 
@@ -181,6 +182,7 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
     images::register(m)?;
     mechanics::register(m)?;
+    series::register(m)?;
     simulate::register(m)?;
     synth::register(m)?;
     Ok(())

@@ -8,8 +8,8 @@ use contactscope::analysis::Analysis;
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::Method;
 use contactscope_formats::tiff::write::{encode_u16_stack_compressed, Compression};
-use contactscope_jobs::analyze::{analyze_series, AnalyzeOptions};
-use contactscope_jobs::series;
+use contactscope_jobs::analyze::AnalyzeRequest;
+use contactscope_jobs::series::{Micrographs, SeriesSpec, DEFAULT_MEMORY_BUDGET};
 use tiff::encoder::{colortype, TiffEncoder};
 
 fn params() -> SynthParams {
@@ -29,9 +29,19 @@ fn write_deflate(path: &Path, pages: &[Vec<u16>], width: usize, height: usize) {
     std::fs::write(path, bytes).unwrap();
 }
 
-fn run(paths: &[std::path::PathBuf], options: &AnalyzeOptions) -> Analysis {
-    let s = series::from_files(paths, None).unwrap();
-    analyze_series(&s, options, &|_, _, _| {}, &|_, _, _| Ok(())).unwrap()
+/// The analysis of `analyze` on the files, with `method` and a memory budget.
+fn run(paths: &[std::path::PathBuf], method: Method, memory_budget: usize) -> Analysis {
+    let request = AnalyzeRequest {
+        method,
+        memory_budget,
+        ..AnalyzeRequest::new(Micrographs::Files(SeriesSpec {
+            inputs: paths.to_vec(),
+            ..SeriesSpec::default()
+        }))
+    };
+    contactscope_jobs::analyze::run(&request, &|_, _, _| {}, &|_, _, _| Ok(()))
+        .unwrap()
+        .analysis
 }
 
 fn pixels(a: &Analysis) -> Vec<(u64, u64, u64)> {
@@ -58,22 +68,18 @@ fn results_do_not_depend_on_cache_or_layout() {
         write_deflate(&path, std::slice::from_ref(page), p.width, p.height);
         singles.push(path);
     }
-    let cached = run(std::slice::from_ref(&stack), &AnalyzeOptions::default());
-    let uncached = run(
+    let cached = run(
         std::slice::from_ref(&stack),
-        &AnalyzeOptions {
-            memory_budget: 0,
-            ..AnalyzeOptions::default()
-        },
+        Method::GlobalOtsu,
+        DEFAULT_MEMORY_BUDGET,
     );
+    let uncached = run(std::slice::from_ref(&stack), Method::GlobalOtsu, 0);
     let tiny_cache = run(
         std::slice::from_ref(&stack),
-        &AnalyzeOptions {
-            memory_budget: 3 * p.width * p.height * 2,
-            ..AnalyzeOptions::default()
-        },
+        Method::GlobalOtsu,
+        3 * p.width * p.height * 2,
     );
-    let files = run(&singles, &AnalyzeOptions::default());
+    let files = run(&singles, Method::GlobalOtsu, DEFAULT_MEMORY_BUDGET);
     assert_eq!(pixels(&cached), pixels(&uncached));
     assert_eq!(pixels(&cached), pixels(&tiny_cache));
     assert_eq!(pixels(&cached), pixels(&files));
@@ -100,7 +106,11 @@ fn float_data_threshold_and_per_image_method() {
         }
     }
     std::fs::write(&path, bytes.into_inner()).unwrap();
-    let float = run(std::slice::from_ref(&path), &AnalyzeOptions::default());
+    let float = run(
+        std::slice::from_ref(&path),
+        Method::GlobalOtsu,
+        DEFAULT_MEMORY_BUDGET,
+    );
     assert!(
         float.warnings.iter().any(|w| w.contains("NaN")),
         "{:?}",
@@ -115,7 +125,11 @@ fn float_data_threshold_and_per_image_method() {
     let ints: Vec<Vec<u16>> = images.iter().map(|i| i.codes.clone()).collect();
     let int_path = dir.path().join("int.tif");
     write_deflate(&int_path, &ints, p.width, p.height);
-    let int = run(std::slice::from_ref(&int_path), &AnalyzeOptions::default());
+    let int = run(
+        std::slice::from_ref(&int_path),
+        Method::GlobalOtsu,
+        DEFAULT_MEMORY_BUDGET,
+    );
     for (f, i) in float.images.iter().zip(&int.images) {
         let (a, b) = (
             f.measurement.contact_pixels as f64,
@@ -125,10 +139,8 @@ fn float_data_threshold_and_per_image_method() {
     }
     let per_image = run(
         std::slice::from_ref(&path),
-        &AnalyzeOptions {
-            method: Method::PerImageOtsu,
-            ..AnalyzeOptions::default()
-        },
+        Method::PerImageOtsu,
+        DEFAULT_MEMORY_BUDGET,
     );
     assert!(per_image.series_threshold.is_none());
     let t: Vec<f64> = per_image.images.iter().map(|r| r.threshold.value).collect();

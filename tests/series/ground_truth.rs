@@ -4,9 +4,8 @@ use contactscope::image::Plane;
 use contactscope::measure::measure;
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::{Binning, Histogram, Threshold};
-use contactscope_jobs::analyze::report::Report;
-use contactscope_jobs::analyze::{analyze_series, AnalyzeOptions};
-use contactscope_jobs::series;
+use contactscope_jobs::analyze::AnalyzeRequest;
+use contactscope_jobs::series::{Micrographs, SeriesSpec};
 use contactscope_jobs::synth_series::{read_truth, write_series, Layout};
 
 #[test]
@@ -26,12 +25,13 @@ fn bundled_fixture_is_what_the_generator_makes() {
 #[test]
 fn bundled_series_areas_match_the_truth() {
     let manifest = crate::common::fixture_series().join("manifest.csv");
-    let s = series::from_manifest(&manifest, None).unwrap();
-    let analysis = analyze_series(&s, &AnalyzeOptions::default(), &|_, _, _| {}, &|_, _, _| {
-        Ok(())
-    })
-    .unwrap();
-    let report = Report::new(&s, &analysis, None);
+    let request = AnalyzeRequest::new(Micrographs::Files(SeriesSpec {
+        manifest: Some(manifest),
+        ..SeriesSpec::default()
+    }));
+    let outcome =
+        contactscope_jobs::analyze::run(&request, &|_, _, _| {}, &|_, _, _| Ok(())).unwrap();
+    let (analysis, report) = (&outcome.analysis, &outcome.rows);
     let truth = read_truth(&crate::common::fixture_series().join("truth.csv")).unwrap();
     assert_eq!(report.rows.len(), truth.len());
     for (row, true_area) in report.rows.iter().zip(&truth) {
@@ -46,7 +46,7 @@ fn bundled_series_areas_match_the_truth() {
             row.area
         );
     }
-    let fit = report.power_law.unwrap();
+    let fit = outcome.fits.power_law.unwrap();
     assert!((fit.exponent - 0.85).abs() < 0.03, "β = {}", fit.exponent);
     let t = analysis.series_threshold.unwrap().value;
     assert!(

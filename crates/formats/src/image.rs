@@ -121,7 +121,7 @@ impl Plane {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PixelSizeSource {
-    /// `--pixel-size` on the command line.
+    /// Given by the caller: `--pixel-size` on the command line, `pixel_size=` in Python.
     CommandLine,
     /// OME-XML `PhysicalSizeX`/`PhysicalSizeY` in the ImageDescription.
     OmeXml,
@@ -141,7 +141,11 @@ impl PixelSizeSource {
     /// Human-readable name.
     pub fn describe(self) -> &'static str {
         match self {
-            PixelSizeSource::CommandLine => "command line (--pixel-size)",
+            PixelSizeSource::CommandLine => match crate::param::front_end() {
+                crate::param::FrontEnd::Python => "given (pixel_size=)",
+                crate::param::FrontEnd::CommandLine => "command line (--pixel-size)",
+                crate::param::FrontEnd::Library => "given by the caller",
+            },
             PixelSizeSource::OmeXml => "OME-XML PhysicalSizeX/Y",
             PixelSizeSource::ImageJ => "ImageJ unit + X/YResolution",
             PixelSizeSource::ResolutionTags => "TIFF ResolutionUnit + X/YResolution",
@@ -209,7 +213,10 @@ impl Image {
         self.pixel_size.ok_or_else(|| {
             Error::bad_input(
                 Location::file(&self.path),
-                "no pixel size in the file's metadata; give one with --pixel-size (e.g. 200nm)",
+                format!(
+                    "no pixel size in the file's metadata; give one with {} (e.g. 200nm)",
+                    crate::param::Param::PixelSize
+                ),
             )
         })
     }

@@ -51,51 +51,136 @@ fn scaled(v: f64, lab: f64, si_factor: f64) -> f64 {
     }
 }
 
+/// How a quantity is stored and written: the factor from the stored value to the written one,
+/// and to the SI one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    /// Stored in N, written in mN.
+    NAsMn,
+    /// Stored and written in mN.
+    Mn,
+    /// Stored in m, written in µm.
+    MAsUm,
+    /// Stored and written in µm.
+    Um,
+    /// Stored in m, written in nm.
+    MAsNm,
+    /// Stored and written in nm.
+    Nm,
+    /// Stored in m², written in µm².
+    M2AsUm2,
+    /// Stored and written in µm².
+    Um2,
+    /// Stored in m³, written in µm³.
+    M3AsUm3,
+    /// Stored in Pa, written in MPa.
+    PaAsMpa,
+    /// Stored and written in MPa.
+    Mpa,
+    /// Stored in Pa, written in GPa.
+    PaAsGpa,
+    /// Stored in Pa/m, written in MPa/nm.
+    PaPerMAsMpaPerNm,
+    /// Stored in 1/m, written in 1/µm.
+    PerMAsPerUm,
+    /// A count or a ratio: no unit.
+    None,
+}
+
+impl Unit {
+    /// (stored → written, stored → SI).
+    fn factors(self) -> (f64, f64) {
+        match self {
+            Unit::NAsMn => (1e3, 1.0),
+            Unit::Mn => (1.0, 1e-3),
+            Unit::MAsUm => (1e6, 1.0),
+            Unit::Um => (1.0, 1e-6),
+            Unit::MAsNm => (1e9, 1.0),
+            Unit::Nm => (1.0, 1e-9),
+            Unit::M2AsUm2 => (1e12, 1.0),
+            Unit::Um2 => (1.0, 1e-12),
+            Unit::M3AsUm3 => (1e18, 1.0),
+            Unit::PaAsMpa => (1e-6, 1.0),
+            Unit::Mpa => (1.0, 1e6),
+            Unit::PaAsGpa => (1e-9, 1.0),
+            Unit::PaPerMAsMpaPerNm => (1e-15, 1.0),
+            Unit::PerMAsPerUm => (1e-6, 1.0),
+            Unit::None => (1.0, 1.0),
+        }
+    }
+
+    /// The value as written (or, inside [`in_si`], in SI units).
+    pub fn apply(self, v: f64) -> f64 {
+        let (lab, si) = self.factors();
+        scaled(v, lab, si)
+    }
+}
+
+/// A quantity for hand-written `Serialize` impls: `Q(force_n, Unit::NAsMn)`.
+#[derive(Debug, Clone, Copy)]
+pub struct Q(pub f64, pub Unit);
+
+impl serde::Serialize for Q {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_f64(self.1.apply(self.0))
+    }
+}
+
+/// An optional quantity (`null` when absent).
+#[derive(Debug, Clone, Copy)]
+pub struct OptQ(pub Option<f64>, pub Unit);
+
+impl serde::Serialize for OptQ {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self.0 {
+            Some(v) => s.serialize_some(&self.1.apply(v)),
+            None => s.serialize_none(),
+        }
+    }
+}
+
 macro_rules! quantities {
-    ($($(#[$doc:meta])* $name:ident, $opt:ident: lab $lab:expr, si $si:expr;)*) => {$(
+    ($($(#[$doc:meta])* $name:ident, $opt:ident: $unit:ident;)*) => {$(
         $(#[$doc])*
         pub fn $name<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-            s.serialize_f64(scaled(*v, $lab, $si))
+            s.serialize_f64(Unit::$unit.apply(*v))
         }
         /// The same, for an optional value (`null` when absent).
         pub fn $opt<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
-            match v {
-                Some(v) => s.serialize_some(&scaled(*v, $lab, $si)),
-                None => s.serialize_none(),
-            }
+            serde::Serialize::serialize(&OptQ(*v, Unit::$unit), s)
         }
     )*};
 }
 
 quantities! {
     /// Stored in N, written in mN.
-    n_as_mn, opt_n_as_mn: lab 1e3, si 1.0;
+    n_as_mn, opt_n_as_mn: NAsMn;
     /// Stored and written in mN (SI: N).
-    mn, opt_mn: lab 1.0, si 1e-3;
+    mn, opt_mn: Mn;
     /// Stored in m, written in µm.
-    m_as_um, opt_m_as_um: lab 1e6, si 1.0;
+    m_as_um, opt_m_as_um: MAsUm;
     /// Stored and written in µm (SI: m).
-    um, opt_um: lab 1.0, si 1e-6;
+    um, opt_um: Um;
     /// Stored in m, written in nm.
-    m_as_nm, opt_m_as_nm: lab 1e9, si 1.0;
+    m_as_nm, opt_m_as_nm: MAsNm;
     /// Stored and written in nm (SI: m).
-    nm, opt_nm: lab 1.0, si 1e-9;
+    nm, opt_nm: Nm;
     /// Stored in m², written in µm².
-    m2_as_um2, opt_m2_as_um2: lab 1e12, si 1.0;
+    m2_as_um2, opt_m2_as_um2: M2AsUm2;
     /// Stored and written in µm² (SI: m²).
-    um2, opt_um2: lab 1.0, si 1e-12;
+    um2, opt_um2: Um2;
     /// Stored in m³, written in µm³.
-    m3_as_um3, opt_m3_as_um3: lab 1e18, si 1.0;
+    m3_as_um3, opt_m3_as_um3: M3AsUm3;
     /// Stored in Pa, written in MPa.
-    pa_as_mpa, opt_pa_as_mpa: lab 1e-6, si 1.0;
+    pa_as_mpa, opt_pa_as_mpa: PaAsMpa;
     /// Stored and written in MPa (SI: Pa).
-    mpa, opt_mpa: lab 1.0, si 1e6;
+    mpa, opt_mpa: Mpa;
     /// Stored in Pa, written in GPa.
-    pa_as_gpa, opt_pa_as_gpa: lab 1e-9, si 1.0;
+    pa_as_gpa, opt_pa_as_gpa: PaAsGpa;
     /// Stored in Pa/m, written in MPa/nm.
-    pa_per_m_as_mpa_per_nm, opt_pa_per_m_as_mpa_per_nm: lab 1e-15, si 1.0;
+    pa_per_m_as_mpa_per_nm, opt_pa_per_m_as_mpa_per_nm: PaPerMAsMpaPerNm;
     /// Stored in 1/m, written in 1/µm.
-    per_m_as_per_um, opt_per_m_as_per_um: lab 1e-6, si 1.0;
+    per_m_as_per_um, opt_per_m_as_per_um: PerMAsPerUm;
 }
 
 /// What one unit token of a key means: (the SI token, the factor from SI to the unit).

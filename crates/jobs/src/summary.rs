@@ -8,8 +8,22 @@ use crate::error::{Error, Result};
 
 /// The outcome as pretty JSON bytes, with `contactscope_version` and `command_line` first.
 pub fn summary_json<T: Serialize>(command_line: &[String], outcome: &T) -> Result<Vec<u8>> {
-    let body = serde_json::to_value(outcome)
+    summary_json_without(command_line, outcome, &[])
+}
+
+/// [`summary_json`] without the fields `leave_out` (tables written as CSV beside it).
+pub fn summary_json_without<T: Serialize>(
+    command_line: &[String],
+    outcome: &T,
+    leave_out: &[&str],
+) -> Result<Vec<u8>> {
+    let mut body = serde_json::to_value(outcome)
         .map_err(|e| Error::InvalidArgument(format!("summary: {e}")))?;
+    if let Value::Object(fields) = &mut body {
+        for key in leave_out {
+            fields.shift_remove(*key);
+        }
+    }
     let mut map = Map::new();
     map.insert(
         "contactscope_version".into(),

@@ -181,19 +181,19 @@ fn cell(value: &serde_json::Value) -> String {
 /// A column's own cell format.
 pub type CellFormat = fn(&serde_json::Value) -> String;
 
-/// A CSV of `rows`, one per item, whose columns are the item's serialised fields in order (the
+/// A CSV of `rows` (anything serialised as a list of records), one line per item, whose columns are the item's serialised fields in order (the
 /// same names and units as in the JSON outputs: one declaration serves both). `formats` gives a
 /// column its own cell format (e.g. three significant digits for a residual). The header comes
 /// from the first row; an empty table is an error.
-pub fn rows_csv<T: serde::Serialize>(
-    rows: &[T],
+pub fn rows_csv<T: serde::Serialize + ?Sized>(
+    rows: &T,
     formats: &[(&str, CellFormat)],
 ) -> Result<Vec<u8>> {
-    let values: Vec<serde_json::Value> = rows
-        .iter()
-        .map(serde_json::to_value)
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
+    let values = match serde_json::to_value(rows) {
+        Ok(serde_json::Value::Array(values)) => values,
+        Ok(_) => return Err(Error::InvalidArgument("CSV: not a list of rows".into())),
+        Err(e) => return Err(Error::InvalidArgument(format!("CSV: {e}"))),
+    };
     let header: Vec<String> = match values.first() {
         Some(serde_json::Value::Object(first)) => first.keys().cloned().collect(),
         _ => return Err(Error::InvalidArgument("CSV: no rows to write".into())),

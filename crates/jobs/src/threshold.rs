@@ -1,49 +1,54 @@
-//! The `threshold` job: the global Otsu threshold of all pages of all inputs, without measuring.
+//! The `threshold` job: the global Otsu threshold (Otsu 1979) of every image of a series,
+//! without measuring: the same threshold `analyze` applies. Files or planes in memory
+//! ([`Micrographs`]); the outcome is what `threshold --json` prints and what Python's
+//! `otsu_threshold` returns.
 
-use std::path::PathBuf;
+use serde::Serialize;
+
+use contactscope::analysis::global_threshold;
 
 use crate::error::Result;
-use crate::series;
-use contactscope::analysis::global_threshold;
-use contactscope::threshold::Threshold;
-use contactscope_formats::microscopy::select::{LoadAxis, Selection};
+use crate::series::Micrographs;
 
-/// Which files, already validated.
+/// Which images.
 #[derive(Debug, Clone)]
 pub struct ThresholdRequest {
-    /// TIFF, CZI, ND2 or LIF files, or directories of them.
-    pub inputs: Vec<PathBuf>,
-    /// Which planes of confocal files (and the channel of TIFFs).
-    pub selection: Selection,
-    /// Axis of a CZI, ND2 or LIF file whose planes are the series' images.
-    pub load_axis: Option<LoadAxis>,
+    /// Files (folders, manifest, planes along a load axis) or planes in memory.
+    pub micrographs: Micrographs,
 }
 
 /// The threshold and what it was computed from.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThresholdOutcome {
     /// One exact Otsu threshold over the pooled histogram; contact is value > t.
-    pub threshold: Threshold,
+    pub threshold: f64,
+    /// The rule's name.
+    pub method: &'static str,
+    /// Which side of the threshold is contact.
+    pub contact_rule: &'static str,
     /// Pixels in the pooled histogram.
     pub pixels: u64,
     /// Images in the series.
     pub images: usize,
-    /// Distinct files.
+    /// Distinct files (0 for planes in memory).
     pub files: usize,
-    /// Notes for the user.
+    /// Notes for the user (non-finite pixels).
     pub warnings: Vec<String>,
 }
 
-/// Read every page (every image counts once) and pick the series threshold; nothing is written.
-pub fn run_threshold(request: &ThresholdRequest) -> Result<ThresholdOutcome> {
-    let series =
-        series::from_files_selected(&request.inputs, &request.selection, request.load_axis)?;
-    let (threshold, pixels, warnings) = global_threshold(&series.planes(0), &|_, _, _| {})?;
+/// Read every image (every image counts once) and pick the series threshold; nothing is
+/// written.
+pub fn run(request: &ThresholdRequest) -> Result<ThresholdOutcome> {
+    request.micrographs.check()?;
+    let open = request.micrographs.open()?;
+    let (threshold, pixels, warnings) = global_threshold(&open.default_planes(), &|_, _, _| {})?;
     Ok(ThresholdOutcome {
-        threshold,
+        threshold: threshold.value,
+        method: "otsu-global",
+        contact_rule: "value > threshold",
         pixels,
-        images: series.images.len(),
-        files: series.files.len(),
+        images: open.series.images.len(),
+        files: open.series.files.len(),
         warnings,
     })
 }

@@ -111,9 +111,17 @@ def _warn(result: Dict[str, Any]) -> None:
 
 
 class Series(Results):
-    """A load series read from files: ``images`` (n, rows, columns) in the files' own sample type,
-    ``forces_n`` (N, ``None`` where unknown), ``paths``, ``pages``, ``pixel_size_m`` ((x, y) in m
-    or ``None``) and ``warnings``."""
+    """A load series read from files: ``images`` (n, rows, columns) in the files' stored sample
+    type (uint8, uint16, int16 or float32, as tifffile returns them), ``forces_n`` (N, ``None``
+    where unknown), ``paths``, ``pages``, ``pixel_size_m`` ((x, y) in m or ``None``),
+    ``pixel_size_source`` and ``warnings``. :func:`analyze` and :func:`otsu_threshold` given a
+    Series read its files as the command line does (same thresholds, areas and file names)."""
+
+    def __init__(self, *args: Any, spec: Optional[Dict[str, Any]] = None,
+                 pixel_size: Optional[PixelSize] = None, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._spec = spec
+        self._pixel_size = pixel_size
 
     def to_pandas(self):
         import pandas as pd
@@ -155,23 +163,46 @@ def _f64(a: Any, ndim: int, what: str) -> np.ndarray:
     return np.ascontiguousarray(a)
 
 
+def _spec(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
+          forces: Optional[Sequence[float]] = None, channel: Optional[int] = None,
+          series: Optional[int] = None, z: Optional[int] = None, t: Optional[int] = None,
+          axes: Optional[Dict[str, int]] = None,
+          load_axis: Optional[str] = None) -> Dict[str, Any]:
+    """The files of a series as the command line takes them: files and folders, or one
+    manifest (``.csv``), with the selection flags."""
+    if isinstance(paths_or_manifest, (str, os.PathLike)):
+        paths = [os.fspath(paths_or_manifest)]
+    else:
+        paths = [os.fspath(p) for p in paths_or_manifest]
+    manifest = None
+    if len(paths) == 1 and paths[0].lower().endswith(".csv"):
+        manifest, paths = paths[0], []
+    return {"inputs": paths, "manifest": manifest, "series": series, "channel": channel,
+            "z": z, "t": t, "axes": axes, "load_axis": load_axis,
+            "forces": None if forces is None else [float(f) for f in forces]}
+
+
 def read_image(path: PathLike, channel: Optional[int] = None,
                pixel_size: Optional[PixelSize] = None, *, series: Optional[int] = None,
                z: Optional[int] = None, t: Optional[int] = None,
                axes: Optional[Dict[str, int]] = None,
                load_axis: Optional[str] = None) -> Results:
     """Images of a TIFF (every page of one channel) or of a Zeiss CZI, Nikon ND2 or Leica LIF
-    file (found by content).
+    file (found by content), in the file's stored sample type (uint8, uint16, int16 or
+    float32, as tifffile returns them).
 
     A vendor file gives the plane that ``series``, ``channel``, ``z``, ``t`` and ``axes`` (extra
     axes by name, e.g. ``{"H": 3}`` for an Airyscan phase) select, index 0 where not given, or
     every plane along ``load_axis`` ("t", "z" or "series") — as the command line's selection
-    flags. Returns ``images`` (images, rows, columns) as float64 in the file's intensity units,
-    ``pixel_size_m`` ((x, y) in m from the file's metadata or ``pixel_size``, m; ``None`` if
-    unknown) and ``pixel_size_source``.
+    flags. Returns ``images`` (images, rows, columns), ``pixel_size_m`` ((x, y) in m from the
+    file's metadata or ``pixel_size``, m; ``None`` if unknown), ``pixel_size_source``,
+    ``path`` and ``warnings``.
     """
-    return Results(_cs.read_image(os.fspath(path), channel, pixel_size, series, z, t, axes,
-                                  load_axis))
+    spec = _spec(path, None, channel, series, z, t, axes, load_axis)
+    r = _cs.read_series(spec, pixel_size)
+    return Results({"images": r["images"], "pixel_size_m": r["pixel_size_m"],
+                    "pixel_size_source": r["pixel_size_source"], "path": os.fspath(path),
+                    "warnings": r["warnings"]})
 
 
 def read_series(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
@@ -181,27 +212,47 @@ def read_series(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
                 axes: Optional[Dict[str, int]] = None,
                 load_axis: Optional[str] = None) -> Series:
     """A load series: TIFF, CZI, ND2 or LIF files and folders (natural order) or one manifest
-    CSV (``.csv``: columns ``file``, ``page``, ``force``… as for the command line).
+    CSV (``.csv``: columns ``file``, ``page``, ``force_mN``… as for the command line).
 
     ``forces`` (N), one per image, when the files do not come with a manifest; ``pixel_size``
     (m, or (x, y)) overrides the files' metadata. A vendor file contributes the plane its
     selection (``series``, ``channel``, ``z``, ``t``, ``axes``) names, or one image per plane
     along ``load_axis`` ("t", "z" or "series"). Returns a :class:`Series`.
     """
-    if isinstance(paths_or_manifest, (str, os.PathLike)):
-        paths = [os.fspath(paths_or_manifest)]
-    else:
-        paths = [os.fspath(p) for p in paths_or_manifest]
-    manifest = len(paths) == 1 and paths[0].lower().endswith(".csv")
-    forces = None if forces is None else [float(f) for f in forces]
-    return Series(_cs.read_series(paths, channel, forces, pixel_size, manifest, series, z, t,
-                                  axes, load_axis))
+    spec = _spec(paths_or_manifest, forces, channel, series, z, t, axes, load_axis)
+    result = Series(_cs.read_series(spec, pixel_size), spec=spec, pixel_size=pixel_size)
+    _warn(result)
+    return result
+
+
+def _images(images: Any) -> Any:
+    """A :class:`Series` as its file spec (read again as the command line reads it), anything
+    else as a stack in its stored sample type."""
+    if isinstance(images, Series) and images._spec is not None:
+        return images._spec
+    a = _stack(images)
+    if np.issubdtype(a.dtype, np.floating) and a.size:
+        finite = a[np.isfinite(a)]
+        if finite.size and finite.min() != finite.max() and finite.min() >= 0 \
+                and finite.max() <= 65535 and (np.mod(finite, 1) == 0).all():
+            _warnings.warn(
+                "the images are floats holding integer values: a threshold bins floats in "
+                "4096 bins over their range, integers one bin per level; pass them in their "
+                "stored integer type (e.g. images.astype(np.uint16)) for the exact integer "
+                "threshold the command line computes on integer files",
+                ContactscopeWarning, stacklevel=3)
+    return a
 
 
 def otsu_threshold(images: Any) -> float:
     """One exact Otsu (1979) threshold over the pooled histogram of all images (the paper's
-    global rule), in the images' intensity units; contact is value > threshold."""
-    return _cs.otsu_threshold(_stack(images))["threshold"]
+    global rule; the command line's ``threshold``), in the images' intensity units; contact is
+    value > threshold. Integer images (uint8, uint16, int16) get one histogram bin per level,
+    float images 4096 bins over their range, as the command line bins integer and float
+    files."""
+    result = _cs.otsu_threshold(_images(images))
+    _warn(result)
+    return result["threshold"]
 
 
 def measure(image: Any, threshold: float, pixel_size: Optional[PixelSize] = None) -> Results:
@@ -212,24 +263,31 @@ def measure(image: Any, threshold: float, pixel_size: Optional[PixelSize] = None
 
 def analyze(series: Any, forces: Optional[Sequence[float]] = None,
             pixel_size: Optional[PixelSize] = None,
-            method: Union[str, float, None] = None) -> Results:
-    """The paper's series analysis: one global Otsu threshold over all images, then each image
-    measured. ``series``: a :class:`Series` (its forces and pixel size are used unless given) or
-    images (2-D, 3-D stack or list). ``forces`` in N, ``pixel_size`` in m; ``method``: "otsu"
-    (default), "per-image" or a fixed threshold.
+            method: Union[str, float, None] = None, *, radius: Optional[float] = None,
+            modulus: Optional[float] = None, masks: bool = False) -> Results:
+    """The paper's series analysis, the command line's ``analyze``: one global Otsu threshold
+    over all images, then each image measured. ``series``: a :class:`Series` (its files are read
+    as the command line reads them, with its forces and pixel size unless given here) or
+    images (2-D, 3-D stack or list, in their stored sample type). ``forces`` in N,
+    ``pixel_size`` in m; ``method``: "otsu" (default), "per-image" or a fixed threshold; the
+    Hertz reference columns with ``radius`` (m) and ``modulus`` (Pa); ``masks``: also return the
+    contact masks (images, rows, columns) as ``masks``.
 
-    Returns ``rows`` (per image: ``force_n``, ``threshold``, ``contact_pixels``, ``area_m2``,
-    ``mean_pressure_pa``, ``equivalent_radius_m``, intensities, patches), the series
-    ``threshold``, the ``power_law`` fit A = c·N^β (m², N)
-    and ``warnings``; ``to_pandas()`` gives the table.
+    Returns the outcome the command line writes as ``summary.json`` and ``areas.csv``, in SI
+    units: ``rows`` (per image: ``image``, ``page``, ``force_n``, ``threshold``,
+    ``contact_pixels``, ``area_m2`` (``area_px`` without a pixel size), ``mean_intensity``,
+    ``patches``, ``mean_pressure_pa``, ``equivalent_radius_m``, …), ``threshold`` (``value``,
+    ``method``, ``histogram_pixels``, …), ``fits`` (``power_law``, ``proportional``),
+    ``inputs``, ``area_unit`` and ``warnings`` (also issued as :class:`ContactscopeWarning`);
+    ``to_pandas()`` gives the table.
     """
-    if isinstance(series, Series):
-        if forces is None and all(f is not None for f in series["forces_n"]):
-            forces = series["forces_n"]
-        if pixel_size is None:
-            pixel_size = series["pixel_size_m"]
+    if isinstance(series, Series) and pixel_size is None:
+        pixel_size = series._pixel_size
     forces = None if forces is None else [float(f) for f in forces]
-    return Results(_cs.analyze(_stack(series), forces, pixel_size, method))
+    result = Results(_cs.analyze(_images(series), forces, pixel_size, method, radius, modulus,
+                                 masks), table="rows")
+    _warn(result)
+    return result
 
 
 def psf(beads: Any, pixel_size: PixelSize, bead_diameter: Optional[float] = None,

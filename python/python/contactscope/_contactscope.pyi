@@ -4,7 +4,7 @@ The public, documented API is the package :mod:`contactscope`, which wraps these
 """
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -30,38 +30,60 @@ def set_num_threads(n: int) -> None: ...
 def get_num_threads() -> int: ...
 
 # Micrographs
-def read_image(
-    path: Path,
-    channel: Optional[int] = None,
-    pixel_size: Optional[PixelSize] = None,
-    series: Optional[int] = None,
-    z: Optional[int] = None,
-    t: Optional[int] = None,
-    axes: Optional[Dict[str, int]] = None,
-    load_axis: Optional[str] = None,
-) -> Dict[str, Any]: ...
-def read_series(
-    inputs: Sequence[Path],
-    channel: Optional[int] = None,
-    forces: Optional[Sequence[float]] = None,
-    pixel_size: Optional[PixelSize] = None,
-    manifest: bool = False,
-    series: Optional[int] = None,
-    z: Optional[int] = None,
-    t: Optional[int] = None,
-    axes: Optional[Dict[str, int]] = None,
-    load_axis: Optional[str] = None,
-) -> Dict[str, Any]: ...
-def otsu_threshold(images: Stack) -> Dict[str, Any]: ...
+class SeriesSpec(TypedDict):
+    """The files of a series, as the command line's inputs, --manifest and selection flags."""
+
+    inputs: List[str]
+    manifest: Optional[str]
+    series: Optional[int]
+    channel: Optional[int]
+    z: Optional[int]
+    t: Optional[int]
+    axes: Optional[Dict[str, int]]
+    load_axis: Optional[str]
+    forces: Optional[List[float]]
+
+class SeriesResult(TypedDict):
+    images: Stack
+    forces_n: List[Optional[float]]
+    paths: List[str]
+    pages: List[int]
+    pixel_size_m: Optional[Tuple[float, float]]
+    pixel_size_source: Optional[str]
+    warnings: List[str]
+
+class ThresholdResult(TypedDict):
+    threshold: float
+    method: str
+    contact_rule: str
+    pixels: int
+    images: int
+    files: int
+    warnings: List[str]
+
+class AnalyzeResult(TypedDict):
+    inputs: Dict[str, Any]
+    threshold: Dict[str, Any]
+    area_unit: str
+    fits: Dict[str, Any]
+    hertz: Optional[Dict[str, float]]
+    warnings: List[str]
+    rows: List[Dict[str, Any]]
+
+def read_series(spec: SeriesSpec, pixel_size: Optional[PixelSize] = None) -> SeriesResult: ...
+def otsu_threshold(images: Union[Stack, SeriesSpec]) -> ThresholdResult: ...
 def measure(
     image: Stack, threshold: float, pixel_size: Optional[PixelSize] = None
 ) -> Dict[str, Any]: ...
 def analyze(
-    images: Stack,
+    images: Union[Stack, SeriesSpec],
     forces: Optional[Sequence[float]] = None,
     pixel_size: Optional[PixelSize] = None,
     method: Union[str, float, None] = None,
-) -> Dict[str, Any]: ...
+    radius: Optional[float] = None,
+    modulus: Optional[float] = None,
+    masks: bool = False,
+) -> AnalyzeResult: ...
 def psf(
     beads: npt.NDArray[np.float64],
     pixel_size: PixelSize,
@@ -115,22 +137,68 @@ def surface(
     cutoff: Optional[float] = None,
     seed: int = 0,
 ) -> npt.NDArray[np.float64]: ...
+class SimulatedLoad(TypedDict):
+    force_n: float
+    area_m2: float
+    contact_fraction: float
+    mean_pressure_pa: Optional[float]
+    max_pressure_pa: Optional[float]
+    approach_m: float
+    patches: int
+    iterations: int
+    residual: float
+    plastic_volume_m3: float
+    edge_contact: bool
+
+class HeightFacts(TypedDict):
+    path: str
+    nx: int
+    ny: int
+    pixel_size_x_m: float
+    pixel_size_y_m: float
+    detrend: str
+    channel: Optional[str]
+    fill_invalid: Optional[str]
+    h_rms_m: float
+    h_prime_rms: float
+    h_double_prime_rms_per_m: float
+    sphere_radius_m: Optional[float]
+
+class SimulateResult(TypedDict, total=False):
+    topography: HeightFacts
+    contact_modulus_pa: float
+    model: Dict[str, Any]
+    boundary: str
+    solver: Dict[str, Any]
+    loads: List[SimulatedLoad]
+    power_law: Optional[Dict[str, Any]]
+    warnings: List[str]
+    # With maps=True: (loads, ny, nx) stacks.
+    pressure: npt.NDArray[np.float64]
+    gap: npt.NDArray[np.float64]
+    plastic: npt.NDArray[np.float64]
+    contact: npt.NDArray[np.bool_]
+
 def simulate(
-    heights: npt.NDArray[np.float64],
-    pixel_size: PixelSize,
+    heights: Union[Path, npt.NDArray[np.float64]],
+    pixel_size: Optional[PixelSize],
     modulus: float,
     loads: Sequence[float],
     model: str = "elastic",
     hardness: Optional[float] = None,
     k: Optional[float] = None,
-    initial_hardness: float = 0.0,
+    initial_hardness: Optional[float] = None,
     alpha: Optional[float] = None,
     radius: Optional[float] = None,
     periodic: bool = False,
-    tolerance: float = 1e-8,
-    max_iterations: int = 5000,
+    tolerance: Optional[float] = None,
+    max_iterations: Optional[int] = None,
     maps: bool = True,
-) -> Dict[str, Any]: ...
+    detrend: str = "plane",
+    height_unit: Optional[float] = None,
+    channel: Optional[str] = None,
+    fill_invalid: Optional[str] = None,
+) -> SimulateResult: ...
 def ramp(
     heights: npt.NDArray[np.float64],
     pixel_size: PixelSize,

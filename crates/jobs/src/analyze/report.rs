@@ -1,28 +1,34 @@
-//! Turning an [`Analysis`] of a series into the table, the summary and the plot. No computation
-//! beyond unit conversion, the area–load fits ([`contactscope::analysis::fit`]) and the Hertz reference
-//! ([`contactscope::mechanics::hertz`]) lives here.
+//! The outcome of `analyze` as the outputs show it: one [`Row`] per image (`areas.csv`, the
+//! Python result's rows), the fits, and the facts of the inputs and the threshold
+//! (`summary.json`). No computation beyond unit conversion, the area–load fits
+//! ([`contactscope::analysis::fit`]) and the Hertz reference ([`contactscope::mechanics::hertz`])
+//! lives here. Area columns are in µm² with a pixel size and in pixels without one; the column
+//! names say which.
 
-use serde::Serialize;
-use serde_json::{json, Value};
+use serde::ser::{SerializeMap, SerializeSeq};
+use serde::{Serialize, Serializer};
 
-use crate::error::{Error, Result};
-use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
-use crate::series::Series;
 use contactscope::analysis::fit::{fit_power_law, fit_proportional, PowerLawFit};
 use contactscope::analysis::Analysis;
 use contactscope::mechanics::hertz;
+use contactscope_formats::microscopy::select::{LoadAxis, Selection};
+
+use crate::lab::{self, OptQ, Unit, Q};
+use crate::series::Series;
 
 /// Sphere radius and contact modulus for the Hertz reference columns.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct HertzParams {
-    /// Sphere radius, metres.
+    /// Sphere radius, m.
+    #[serde(rename = "sphere_radius_um", serialize_with = "lab::m_as_um")]
     pub radius_m: f64,
-    /// Contact modulus E*, pascals.
+    /// Contact modulus E*, Pa.
+    #[serde(rename = "contact_modulus_GPa", serialize_with = "lab::pa_as_gpa")]
     pub modulus_pa: f64,
 }
 
-/// One row of `areas.csv`, in physical units where a pixel size is known.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// One row of `areas.csv`, in µm² where a pixel size is known (pixels otherwise).
+#[derive(Debug, Clone, PartialEq)]
 pub struct Row {
     /// Image file.
     pub image: String,
@@ -68,7 +74,8 @@ pub enum AreaUnit {
 }
 
 impl AreaUnit {
-    fn area_suffix(self) -> &'static str {
+    /// Suffix of the area columns: `um2` or `px`.
+    pub fn area_suffix(self) -> &'static str {
         match self {
             AreaUnit::SquareMicrometre => "um2",
             AreaUnit::Pixel => "px",
@@ -82,7 +89,22 @@ impl AreaUnit {
         }
     }
 
-    fn axis_label(self) -> &'static str {
+    fn area(self) -> Unit {
+        match self {
+            AreaUnit::SquareMicrometre => Unit::Um2,
+            AreaUnit::Pixel => Unit::None,
+        }
+    }
+
+    fn length(self) -> Unit {
+        match self {
+            AreaUnit::SquareMicrometre => Unit::Um,
+            AreaUnit::Pixel => Unit::None,
+        }
+    }
+
+    /// The label of an area axis.
+    pub fn axis_label(self) -> &'static str {
         match self {
             AreaUnit::SquareMicrometre => "contact area A (µm²)",
             AreaUnit::Pixel => "contact area A (pixels)",
@@ -90,301 +112,393 @@ impl AreaUnit {
     }
 }
 
-/// Rows and fits of an analysis.
-#[derive(Debug, Clone)]
-pub struct Report {
+impl Serialize for AreaUnit {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(match (self, lab::si()) {
+            (AreaUnit::SquareMicrometre, true) => "m2",
+            (unit, _) => unit.area_suffix(),
+        })
+    }
+}
+
+/// The rows with the columns the table has: mean pressure with a pixel size, friction when a
+/// manifest gave any, Hertz columns when asked for.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AreaTable {
+    /// Unit of the area columns.
+    pub unit: AreaUnit,
+    /// Whether any image has a friction force (the column is written).
+    pub has_friction: bool,
+    /// Whether the Hertz columns are written.
+    pub has_hertz: bool,
     /// One row per image, in input order.
     pub rows: Vec<Row>,
-    /// Unit of the area columns.
+}
+
+/// One row with its table's columns.
+struct RowOf<'a>(&'a AreaTable, &'a Row);
+
+impl Serialize for RowOf<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let (t, r) = (self.0, self.1);
+        let (a, l) = (t.unit.area_suffix(), t.unit.length_suffix());
+        let mut m = s.serialize_map(None)?;
+        m.serialize_entry("image", &r.image)?;
+        m.serialize_entry("page", &r.page)?;
+        m.serialize_entry("force_mN", &OptQ(r.force_mn, Unit::Mn))?;
+        m.serialize_entry("threshold", &r.threshold)?;
+        m.serialize_entry("contact_pixels", &r.contact_pixels)?;
+        m.serialize_entry(&format!("area_{a}"), &Q(r.area, t.unit.area()))?;
+        m.serialize_entry("mean_intensity", &r.mean_intensity)?;
+        m.serialize_entry("integrated_intensity", &r.integrated_intensity)?;
+        m.serialize_entry("background_mean", &r.background_mean)?;
+        m.serialize_entry("patches", &r.patches)?;
+        m.serialize_entry(
+            &format!("largest_patch_{a}"),
+            &Q(r.largest_patch, t.unit.area()),
+        )?;
+        if t.unit == AreaUnit::SquareMicrometre {
+            m.serialize_entry("mean_pressure_MPa", &OptQ(r.mean_pressure_mpa, Unit::Mpa))?;
+        }
+        m.serialize_entry(
+            &format!("equivalent_radius_{l}"),
+            &Q(r.equivalent_radius, t.unit.length()),
+        )?;
+        if t.has_friction {
+            m.serialize_entry("friction_mN", &OptQ(r.friction_mn, Unit::Mn))?;
+        }
+        if t.has_hertz {
+            m.serialize_entry("hertz_radius_um", &OptQ(r.hertz_radius_um, Unit::Um))?;
+            m.serialize_entry("hertz_area_um2", &OptQ(r.hertz_area_um2, Unit::Um2))?;
+        }
+        m.end()
+    }
+}
+
+impl Serialize for AreaTable {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut seq = s.serialize_seq(Some(self.rows.len()))?;
+        for r in &self.rows {
+            seq.serialize_element(&RowOf(self, r))?;
+        }
+        seq.end()
+    }
+}
+
+/// The area–load fits over the images with a positive force and area.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fits {
+    /// Unit of the areas.
     pub unit: AreaUnit,
     /// A = c·N^β with N in mN and A in the area unit.
     pub power_law: Option<PowerLawFit>,
     /// p of A = N/p, MPa, with the number of points (only with a pixel size).
     pub proportional_mpa: Option<(f64, usize)>,
-    /// Whether any image has a friction force.
-    pub has_friction: bool,
-    /// Hertz parameters, if given.
-    pub hertz: Option<HertzParams>,
+    /// Smallest and largest mean pressure, MPa.
+    pub pressure_range_mpa: Option<(f64, f64)>,
 }
 
-impl Report {
-    /// Derive rows and fits; `analysis` is the analysis of `series`, image by image.
-    pub fn new(series: &Series, analysis: &Analysis, hertz: Option<HertzParams>) -> Self {
-        let unit = match analysis.pixel_size {
-            Some(_) => AreaUnit::SquareMicrometre,
-            None => AreaUnit::Pixel,
-        };
-        let pixel_area = analysis.pixel_size.map_or(1.0, |p| p.area_um2());
-        let rows: Vec<Row> = series
-            .images
-            .iter()
-            .zip(&analysis.images)
-            .map(|(image, r)| {
-                let m = &r.measurement;
-                let area = m.contact_pixels as f64 * pixel_area;
-                let force_mn = image.force_n.map(|f| f * 1e3);
-                let hertz_radius = match (hertz, image.force_n) {
-                    (Some(h), Some(f)) => Some(hertz::contact_radius(f, h.radius_m, h.modulus_pa)),
-                    _ => None,
-                };
-                Row {
-                    image: image.path.display().to_string(),
-                    page: image.page,
-                    force_mn,
-                    threshold: r.threshold.value,
-                    contact_pixels: m.contact_pixels,
-                    area,
-                    mean_intensity: m.mean_intensity,
-                    integrated_intensity: m.integrated_intensity,
-                    background_mean: m.background_mean,
-                    patches: m.patches,
-                    largest_patch: m.largest_patch_pixels as f64 * pixel_area,
-                    mean_pressure_mpa: match (unit, force_mn) {
-                        (AreaUnit::SquareMicrometre, Some(f)) if area > 0.0 => Some(f / area * 1e3),
-                        _ => None,
-                    },
-                    equivalent_radius: (area / std::f64::consts::PI).sqrt(),
-                    friction_mn: image.friction_n.map(|f| f * 1e3),
-                    hertz_radius_um: hertz_radius.map(|a| a * 1e6),
-                    hertz_area_um2: hertz_radius.map(|a| std::f64::consts::PI * a * a * 1e12),
-                }
-            })
-            .collect();
-        let (forces, areas): (Vec<f64>, Vec<f64>) = rows
-            .iter()
-            .filter_map(|r| r.force_mn.map(|f| (f, r.area)))
-            .filter(|(f, a)| *f > 0.0 && *a > 0.0)
-            .unzip();
-        let proportional_mpa = match unit {
-            AreaUnit::SquareMicrometre => fit_proportional(&forces, &areas)
-                .filter(|(s, _)| *s > 0.0)
-                .map(|(slope, n)| (1e3 / slope, n)),
-            AreaUnit::Pixel => None,
-        };
-        Report {
-            power_law: fit_power_law(&forces, &areas),
-            proportional_mpa,
-            has_friction: rows.iter().any(|r| r.friction_mn.is_some()),
-            hertz,
-            rows,
-            unit,
-        }
+impl Serialize for Fits {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let si = lab::si();
+        let mut m = s.serialize_map(Some(3))?;
+        m.serialize_entry(
+            "power_law",
+            &self.power_law.map(|f| PowerLawOf(self.unit, f, si)),
+        )?;
+        m.serialize_entry(
+            "proportional",
+            &self.proportional_mpa.map(|(p, n)| Proportional(p, n)),
+        )?;
+        m.serialize_entry(
+            "mean_pressure_MPa",
+            &self.pressure_range_mpa.map(|(lo, hi)| MinMax(lo, hi)),
+        )?;
+        m.end()
     }
+}
 
-    /// `areas.csv`: one row per image, every column named with its unit.
-    pub fn areas_csv(&self) -> Result<Vec<u8>> {
-        let (a, l) = (self.unit.area_suffix(), self.unit.length_suffix());
-        let mut header: Vec<String> = [
-            "image",
-            "page",
-            "force_mN",
-            "threshold",
-            "contact_pixels",
-            &format!("area_{a}"),
-            "mean_intensity",
-            "integrated_intensity",
-            "background_mean",
-            "patches",
-            &format!("largest_patch_{a}"),
-        ]
+struct PowerLawOf(AreaUnit, PowerLawFit, bool);
+
+impl Serialize for PowerLawOf {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let (unit, f, si) = (self.0, &self.1, self.2);
+        let a = unit.area_suffix();
+        let mut m = s.serialize_map(Some(6))?;
+        // In SI units (Python): A in m² (or pixels) and N in newtons.
+        let (model, prefactor) = match (si, unit) {
+            (false, _) => (
+                format!("area_{a} = prefactor * force_mN^exponent"),
+                f.prefactor,
+            ),
+            (true, AreaUnit::SquareMicrometre) => (
+                "area_m2 = prefactor * force_n^exponent".to_string(),
+                f.prefactor * 1e-12 * 1e3f64.powf(f.exponent),
+            ),
+            (true, AreaUnit::Pixel) => (
+                "area_px = prefactor * force_n^exponent".to_string(),
+                f.prefactor * 1e3f64.powf(f.exponent),
+            ),
+        };
+        m.serialize_entry("model", &model)?;
+        m.serialize_entry(&format!("prefactor_{a}_per_mN_pow_exponent"), &prefactor)?;
+        m.serialize_entry("exponent", &f.exponent)?;
+        m.serialize_entry("exponent_se", &f.exponent_se)?;
+        m.serialize_entry("r_squared", &f.r_squared)?;
+        m.serialize_entry("points", &f.points)?;
+        m.end()
+    }
+}
+
+struct Proportional(f64, usize);
+
+impl Serialize for Proportional {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(3))?;
+        m.serialize_entry("model", "area = force / pressure")?;
+        m.serialize_entry("pressure_MPa", &Q(self.0, Unit::Mpa))?;
+        m.serialize_entry("points", &self.1)?;
+        m.end()
+    }
+}
+
+struct MinMax(f64, f64);
+
+impl Serialize for MinMax {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(2))?;
+        m.serialize_entry("min", &Q(self.0, Unit::Mpa))?;
+        m.serialize_entry("max", &Q(self.1, Unit::Mpa))?;
+        m.end()
+    }
+}
+
+/// The rows and fits of an analysis of `series`, image by image.
+pub fn table_and_fits(
+    series: &Series,
+    analysis: &Analysis,
+    hertz: Option<HertzParams>,
+) -> (AreaTable, Fits) {
+    let unit = match analysis.pixel_size {
+        Some(_) => AreaUnit::SquareMicrometre,
+        None => AreaUnit::Pixel,
+    };
+    let pixel_area = analysis.pixel_size.map_or(1.0, |p| p.area_um2());
+    let rows: Vec<Row> = series
+        .images
         .iter()
-        .map(|s| s.to_string())
-        .collect();
-        if self.unit == AreaUnit::SquareMicrometre {
-            header.push("mean_pressure_MPa".into());
-        }
-        header.push(format!("equivalent_radius_{l}"));
-        if self.has_friction {
-            header.push("friction_mN".into());
-        }
-        if self.hertz.is_some() {
-            header.extend(["hertz_radius_um".into(), "hertz_area_um2".into()]);
-        }
-        let mut writer = csv::Writer::from_writer(Vec::new());
-        writer.write_record(&header).map_err(csv_error)?;
-        for r in &self.rows {
-            let opt = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
-            let mut record = vec![
-                r.image.clone(),
-                r.page.to_string(),
-                opt(r.force_mn),
-                r.threshold.to_string(),
-                r.contact_pixels.to_string(),
-                r.area.to_string(),
-                opt(r.mean_intensity),
-                r.integrated_intensity.to_string(),
-                opt(r.background_mean),
-                r.patches.to_string(),
-                r.largest_patch.to_string(),
-            ];
-            if self.unit == AreaUnit::SquareMicrometre {
-                record.push(opt(r.mean_pressure_mpa));
+        .zip(&analysis.images)
+        .map(|(image, r)| {
+            let m = &r.measurement;
+            let area = m.contact_pixels as f64 * pixel_area;
+            let force_mn = image.force_n.map(|f| f * 1e3);
+            let hertz_radius = match (hertz, image.force_n) {
+                (Some(h), Some(f)) => Some(hertz::contact_radius(f, h.radius_m, h.modulus_pa)),
+                _ => None,
+            };
+            Row {
+                image: image.path.display().to_string(),
+                page: image.page,
+                force_mn,
+                threshold: r.threshold.value,
+                contact_pixels: m.contact_pixels,
+                area,
+                mean_intensity: m.mean_intensity,
+                integrated_intensity: m.integrated_intensity,
+                background_mean: m.background_mean,
+                patches: m.patches,
+                largest_patch: m.largest_patch_pixels as f64 * pixel_area,
+                mean_pressure_mpa: match (unit, force_mn) {
+                    (AreaUnit::SquareMicrometre, Some(f)) if area > 0.0 => Some(f / area * 1e3),
+                    _ => None,
+                },
+                equivalent_radius: (area / std::f64::consts::PI).sqrt(),
+                friction_mn: image.friction_n.map(|f| f * 1e3),
+                hertz_radius_um: hertz_radius.map(|a| a * 1e6),
+                hertz_area_um2: hertz_radius.map(|a| std::f64::consts::PI * a * a * 1e12),
             }
-            record.push(r.equivalent_radius.to_string());
-            if self.has_friction {
-                record.push(opt(r.friction_mn));
-            }
-            if self.hertz.is_some() {
-                record.extend([opt(r.hertz_radius_um), opt(r.hertz_area_um2)]);
-            }
-            writer.write_record(&record).map_err(csv_error)?;
-        }
-        writer
-            .into_inner()
-            .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
-    }
-
-    /// The fits as a JSON object with units in the field names.
-    pub fn fits_json(&self) -> Value {
-        let a = self.unit.area_suffix();
-        let pressures: Vec<f64> = self
-            .rows
-            .iter()
-            .filter_map(|r| r.mean_pressure_mpa)
-            .collect();
-        let pressure_range = (!pressures.is_empty()).then(|| {
-            json!({
-                "min": pressures.iter().copied().fold(f64::INFINITY, f64::min),
-                "max": pressures.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            })
-        });
-        json!({
-            "power_law": self.power_law.map(|f| json!({
-                "model": format!("area_{a} = prefactor * force_mN^exponent"),
-                format!("prefactor_{a}_per_mN_pow_exponent"): f.prefactor,
-                "exponent": f.exponent,
-                "exponent_se": f.exponent_se,
-                "r_squared": f.r_squared,
-                "points": f.points,
-            })),
-            "proportional": self.proportional_mpa.map(|(p, n)| json!({
-                "model": "area = force / pressure",
-                "pressure_MPa": p,
-                "points": n,
-            })),
-            "mean_pressure_MPa": pressure_range,
         })
-    }
-
-    /// Log–log plot of area against force with both fits (and the Hertz area if known).
-    pub fn area_plot(&self, title: &str) -> Chart {
-        let measured: Vec<(f64, f64)> = self
-            .rows
-            .iter()
-            .filter_map(|r| r.force_mn.map(|f| (f, r.area)))
-            .collect();
-        let forces: Vec<f64> = measured.iter().map(|p| p.0).filter(|f| *f > 0.0).collect();
-        let (lo, hi) = forces
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &f| {
-                (a.min(f), b.max(f))
-            });
-        let grid: Vec<f64> = if lo < hi {
-            (0..=40)
-                .map(|i| lo * (hi / lo).powf(f64::from(i) / 40.0))
-                .collect()
-        } else {
-            forces.clone()
-        };
-        let mut curves = Vec::new();
-        if let Some(f) = self.power_law {
-            curves.push(Curve {
-                label: format!(
-                    "power law A ∝ N^β, β = {:.3}{}",
-                    f.exponent,
-                    f.exponent_se
-                        .map_or(String::new(), |s| format!(" ± {s:.3}"))
-                ),
-                xy: grid.iter().map(|&n| (n, f.eval(n))).collect(),
-            });
-        }
-        if let Some((p, _)) = self.proportional_mpa {
-            curves.push(Curve {
-                label: format!("proportional A = N/p, p = {p:.1} MPa"),
-                xy: grid.iter().map(|&n| (n, n / p * 1e3)).collect(),
-            });
-        }
-        if let (Some(h), AreaUnit::SquareMicrometre) = (self.hertz, self.unit) {
-            curves.push(Curve {
-                label: "Hertz area πa²".into(),
-                xy: grid
-                    .iter()
-                    .map(|&n| {
-                        (
-                            n,
-                            hertz::contact_area(n * 1e-3, h.radius_m, h.modulus_pa) * 1e12,
-                        )
-                    })
-                    .collect(),
-            });
-        }
-        Chart {
-            title: title.to_string(),
-            x_label: "normal force N (mN)".into(),
-            y_label: self.unit.axis_label().into(),
-            axes: Axes::LogLog,
-            legend: Legend::UpperLeft,
-            points: vec![PointSet {
-                label: "measured (Otsu contact pixels × pixel area)".into(),
-                xy: measured,
-            }],
-            curves,
-        }
-    }
-}
-
-fn csv_error(e: csv::Error) -> Error {
-    Error::InvalidArgument(format!("CSV: {e}"))
-}
-
-/// The `inputs` part of `summary.json`.
-pub fn inputs_json(series: &Series, analysis: &Analysis) -> Value {
-    json!({
-        "images": series.images.len(),
-        "manifest": series.manifest.as_ref().map(|m| m.display().to_string()),
-        "channel": series.channel,
-        "selection": series.selection,
-        "load_axis": series.load_axis,
-        "files": series.files.iter().map(|f| json!({
-            "path": f.path.display().to_string(),
-            "format": f.format.name(),
-            "pages_used": series.images.iter().filter(|i| i.path == f.path).count(),
-            "planes_used": (f.tiff.is_none()).then(|| series.images.iter()
-                .filter(|i| i.path == f.path)
-                .filter_map(|i| i.plane.as_ref().map(|p| p.describe()))
-                .collect::<Vec<_>>()),
-            "width_px": f.width,
-            "height_px": f.height,
-            "sample_type": f.sample_type.name(),
-            "compression": f.compression,
-            "channels": f.channels,
-            "pixel_size_x_um": f.pixel_size.map(|p| p.x_m * 1e6),
-            "pixel_size_y_um": f.pixel_size.map(|p| p.y_m * 1e6),
-            "pixel_size_source": f.pixel_size.map(|p| p.source.describe()),
-        })).collect::<Vec<_>>(),
-        "pixel_size_used": analysis.pixel_size.map(|p| json!({
-            "x_um": p.x_m * 1e6,
-            "y_um": p.y_m * 1e6,
-            "pixel_area_um2": p.area_um2(),
-            "source": p.source.describe(),
-        })),
-    })
-}
-
-/// The `threshold` part of `summary.json`.
-pub fn threshold_json(analysis: &Analysis, integer: bool) -> Value {
-    json!({
-        "method": analysis.method.name(),
-        "value": analysis.series_threshold.map(|t| t.value),
-        "per_image": analysis.series_threshold.is_none().then(|| {
-            analysis.images.iter().map(|r| r.threshold.value).collect::<Vec<_>>()
+        .collect();
+    let (forces, areas): (Vec<f64>, Vec<f64>) = rows
+        .iter()
+        .filter_map(|r| r.force_mn.map(|f| (f, r.area)))
+        .filter(|(f, a)| *f > 0.0 && *a > 0.0)
+        .unzip();
+    let proportional_mpa = match unit {
+        AreaUnit::SquareMicrometre => fit_proportional(&forces, &areas)
+            .filter(|(s, _)| *s > 0.0)
+            .map(|(slope, n)| (1e3 / slope, n)),
+        AreaUnit::Pixel => None,
+    };
+    let pressures: Vec<f64> = rows.iter().filter_map(|r| r.mean_pressure_mpa).collect();
+    let fits = Fits {
+        unit,
+        power_law: fit_power_law(&forces, &areas),
+        proportional_mpa,
+        pressure_range_mpa: (!pressures.is_empty()).then(|| {
+            (
+                pressures.iter().copied().fold(f64::INFINITY, f64::min),
+                pressures.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            )
         }),
-        "contact_rule": "value > threshold",
-        "histogram_pixels": analysis.histogram_pixels,
-        "binning": if integer {
-            "one bin per integer level (u64 counts, f64 arithmetic), first maximum wins".to_string()
-        } else {
-            format!("{} equal bins over the series' finite min..max; threshold = upper edge of the highest background bin", contactscope::threshold::FLOAT_BINS)
-        },
-    })
+    };
+    let table = AreaTable {
+        unit,
+        has_friction: rows.iter().any(|r| r.friction_mn.is_some()),
+        has_hertz: hertz.is_some(),
+        rows,
+    };
+    (table, fits)
+}
+
+/// One file of the series as `summary.json` records it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FileFacts {
+    /// The file.
+    pub path: String,
+    /// Its format.
+    pub format: &'static str,
+    /// Images of the series in it.
+    pub pages_used: usize,
+    /// The planes used of a CZI, ND2 or LIF file.
+    pub planes_used: Option<Vec<String>>,
+    /// Plane width.
+    pub width_px: usize,
+    /// Plane height.
+    pub height_px: usize,
+    /// Sample type (numpy's name).
+    pub sample_type: &'static str,
+    /// Compression.
+    pub compression: String,
+    /// Channels.
+    pub channels: usize,
+    /// Pixel size along x from the metadata, m.
+    #[serde(rename = "pixel_size_x_um", serialize_with = "lab::opt_m_as_um")]
+    pub pixel_size_x_m: Option<f64>,
+    /// Pixel size along y from the metadata, m.
+    #[serde(rename = "pixel_size_y_um", serialize_with = "lab::opt_m_as_um")]
+    pub pixel_size_y_m: Option<f64>,
+    /// Where the metadata's pixel size came from.
+    pub pixel_size_source: Option<&'static str>,
+}
+
+/// The pixel size the areas use.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PixelSizeUsed {
+    /// Along x, m.
+    #[serde(rename = "x_um", serialize_with = "lab::m_as_um")]
+    pub x_m: f64,
+    /// Along y, m.
+    #[serde(rename = "y_um", serialize_with = "lab::m_as_um")]
+    pub y_m: f64,
+    /// Pixel area, µm².
+    #[serde(serialize_with = "lab::um2")]
+    pub pixel_area_um2: f64,
+    /// Where it came from.
+    pub source: &'static str,
+}
+
+/// The `inputs` of `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct InputFacts {
+    /// Images in the series.
+    pub images: usize,
+    /// The manifest, if the series came from one.
+    pub manifest: Option<String>,
+    /// The channel read.
+    pub channel: usize,
+    /// The selection flags.
+    pub selection: Selection,
+    /// The load axis of CZI, ND2 or LIF files.
+    pub load_axis: Option<LoadAxis>,
+    /// Each distinct file (none for images handed over in memory).
+    pub files: Vec<FileFacts>,
+    /// The pixel size used, `null` when areas are in pixels.
+    pub pixel_size_used: Option<PixelSizeUsed>,
+}
+
+impl InputFacts {
+    /// The facts of `series` analysed as `analysis`.
+    pub fn of(series: &Series, analysis: &Analysis) -> Self {
+        InputFacts {
+            images: series.images.len(),
+            manifest: series.manifest.as_ref().map(|m| m.display().to_string()),
+            channel: series.channel,
+            selection: series.selection.clone(),
+            load_axis: series.load_axis,
+            files: series
+                .files
+                .iter()
+                .map(|f| FileFacts {
+                    path: f.path.display().to_string(),
+                    format: f.format.name(),
+                    pages_used: series.images.iter().filter(|i| i.path == f.path).count(),
+                    planes_used: f.tiff.is_none().then(|| {
+                        series
+                            .images
+                            .iter()
+                            .filter(|i| i.path == f.path)
+                            .filter_map(|i| i.plane.as_ref().map(|p| p.describe()))
+                            .collect()
+                    }),
+                    width_px: f.width,
+                    height_px: f.height,
+                    sample_type: f.sample_type.name(),
+                    compression: f.compression.clone(),
+                    channels: f.channels,
+                    pixel_size_x_m: f.pixel_size.map(|p| p.x_m),
+                    pixel_size_y_m: f.pixel_size.map(|p| p.y_m),
+                    pixel_size_source: f.pixel_size.map(|p| p.source.describe()),
+                })
+                .collect(),
+            pixel_size_used: analysis.pixel_size.map(|p| PixelSizeUsed {
+                x_m: p.x_m,
+                y_m: p.y_m,
+                pixel_area_um2: p.area_um2(),
+                source: p.source.describe(),
+            }),
+        }
+    }
+}
+
+/// The `threshold` of `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThresholdFacts {
+    /// The method's name.
+    pub method: &'static str,
+    /// The series threshold (contact is value > t); `null` with one threshold per image.
+    pub value: Option<f64>,
+    /// One threshold per image, with `--threshold per-image`.
+    pub per_image: Option<Vec<f64>>,
+    /// Which side of the threshold is contact.
+    pub contact_rule: &'static str,
+    /// Pixels in the histogram.
+    pub histogram_pixels: u64,
+    /// How the histogram was binned.
+    pub binning: String,
+}
+
+impl ThresholdFacts {
+    /// The facts of `analysis` of integer (or float) data.
+    pub fn of(analysis: &Analysis, integer: bool) -> Self {
+        ThresholdFacts {
+            method: analysis.method.name(),
+            value: analysis.series_threshold.map(|t| t.value),
+            per_image: analysis
+                .series_threshold
+                .is_none()
+                .then(|| analysis.images.iter().map(|r| r.threshold.value).collect()),
+            contact_rule: "value > threshold",
+            histogram_pixels: analysis.histogram_pixels,
+            binning: if integer {
+                "one bin per integer level (u64 counts, f64 arithmetic), first maximum wins"
+                    .to_string()
+            } else {
+                format!(
+                    "{} equal bins over the series' finite min..max; threshold = upper edge of the highest background bin",
+                    contactscope::threshold::FLOAT_BINS
+                )
+            },
+        }
+    }
 }

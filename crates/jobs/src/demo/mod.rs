@@ -21,8 +21,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analyze::AnalyzeOptions;
-use crate::analyze::{run_analyze, AnalyzeRequest};
+use crate::analyze::files::{run_to_folder as analyze_to_folder, ImageOutputs};
+use crate::analyze::AnalyzeRequest;
 use crate::compare::{load_micrographs, ExperimentInput};
 use crate::error::{Error, Result};
 use crate::fit_hardening::{run_fit, FitRequest};
@@ -31,7 +31,7 @@ use crate::heights::TopographySource;
 use crate::hertz::{run_hertz, HertzRequest};
 use crate::newton::{run_newton, NewtonRequest};
 use crate::psf::{run_psf, PsfRequest};
-use crate::series;
+use crate::series::{Micrographs, SeriesSpec};
 use crate::staging::write_atomic;
 use contactscope::compare::{compare_maps, CompareSettings, Comparison, SimulatedMap};
 use contactscope::mechanics::friction::{SlipOptions, XAxis};
@@ -47,7 +47,6 @@ use contactscope::synth::beads::{synth_beads, BeadParams};
 use contactscope::synth::rings::{synth_newton, NewtonSynthParams};
 use contactscope::synth::traces::{synthetic_trace, trace_csv, CsvLayout, TraceParams};
 use contactscope::synth::{render_micrograph, MicrographParams};
-use contactscope::threshold::Method;
 use contactscope_formats::tiff::write::encode_u16_stack;
 use contactscope_formats::topography::encode_npy;
 
@@ -407,21 +406,24 @@ fn write_micrographs(p: &DemoParams, maps: &[Grid], data: &Path) -> Result<PathB
 /// Measured (force N, area m²) from `analyze`.
 fn analyze(work: &Path, manifest: &Path) -> Result<Vec<(f64, f64)>> {
     let request = AnalyzeRequest {
-        series: series::from_manifest(manifest, None)?,
-        options: AnalyzeOptions {
-            method: Method::GlobalOtsu,
-            pixel_size_override: None,
-            hertz: None,
-            memory_budget: 64 << 20,
-        },
-        out_dir: work.join("analysis"),
-        overlays: true,
-        save_masks: false,
-        command_line: vec!["contactscope demo".into()],
+        memory_budget: 64 << 20,
+        ..AnalyzeRequest::new(Micrographs::Files(SeriesSpec {
+            manifest: Some(manifest.to_path_buf()),
+            ..SeriesSpec::default()
+        }))
     };
-    let outcome = run_analyze(&request, &|_, _, _| {})?;
+    let (outcome, _) = analyze_to_folder(
+        &request,
+        &work.join("analysis"),
+        &["contactscope demo".into()],
+        ImageOutputs {
+            overlays: true,
+            masks: false,
+        },
+        &|_, _, _| {},
+    )?;
     Ok(outcome
-        .report
+        .rows
         .rows
         .iter()
         .map(|r| (r.force_mn.unwrap_or(f64::NAN) * 1e-3, r.area * 1e-12))

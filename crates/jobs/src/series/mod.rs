@@ -24,14 +24,17 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 mod file;
+mod input;
 
 pub use file::SeriesFile;
+pub use input::{load, LoadedSeries, MemorySeries, Micrographs, OpenSeries, Planes, SeriesSpec};
 
 use crate::error::{Error, Location, Result};
 use contactscope::analysis::PlaneSource;
 use contactscope::image::{PixelSize, PixelSizeSource, Plane, SampleType};
 use contactscope_formats::microscopy::select::{LoadAxis, SelectedPlane, Selection};
 use contactscope_formats::microscopy::MicroscopyFile;
+use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
 use contactscope_formats::tiff::{TiffInfo, TiffReader};
 
@@ -281,7 +284,7 @@ pub fn from_files_selected(
 pub fn assign_forces(series: &mut Series, forces_n: &[f64]) -> Result<()> {
     if forces_n.len() != series.images.len() {
         let along = series.load_axis.map_or(String::new(), |a| {
-            format!(" (the planes along --load-axis {})", a.name())
+            format!(" (the planes along {} {})", Param::LoadAxis, a.name())
         });
         return Err(Error::InvalidArgument(format!(
             "{} force(s) given for {} image(s){along}; give one force per image",
@@ -480,7 +483,14 @@ pub fn pixel_size(
             source: PixelSizeSource::CommandLine,
         }));
     }
-    let first = &series.files[0];
+    let Some(first) = series.files.first() else {
+        // Planes in memory: no metadata.
+        warnings.push(format!(
+            "no pixel size given ({}): areas are in pixels",
+            Param::PixelSize
+        ));
+        return Ok(None);
+    };
     for other in &series.files[1..] {
         let agree = match (&first.pixel_size, &other.pixel_size) {
             (Some(a), Some(b)) => a.same_size(b),
@@ -496,7 +506,11 @@ pub fn pixel_size(
             return Err(Error::SeriesMismatch {
                 at: Location::file(&other.path),
                 reason: format!("pixel size is {}", show(&other.pixel_size)),
-                expected: format!("{}; give --pixel-size to override", show(&first.pixel_size)),
+                expected: format!(
+                    "{}; give {} to override",
+                    show(&first.pixel_size),
+                    Param::PixelSize
+                ),
             });
         }
     }
@@ -509,9 +523,10 @@ pub fn pixel_size(
         Quantity::PixelSize.check_at(p.y_m, &at)?;
     }
     if first.pixel_size.is_none() {
-        warnings.push(
-            "no pixel size in the files' metadata and no --pixel-size: areas are in pixels".into(),
-        );
+        warnings.push(format!(
+            "no pixel size in the files' metadata and no {}: areas are in pixels",
+            Param::PixelSize
+        ));
     }
     Ok(first.pixel_size)
 }

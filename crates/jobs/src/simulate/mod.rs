@@ -23,7 +23,7 @@ use contactscope_formats::ranges::Quantity;
 
 use crate::error::{Error, Result};
 use crate::heights::{HeightFacts, HeightInput};
-use crate::lab;
+use crate::lab::{self, Unit, Q};
 
 /// Which model to run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,7 +59,7 @@ impl Serialize for ModelChoice {
                 hardness_pa,
                 volume_conserving,
             }) => {
-                m.serialize_entry("hardness_MPa", &Pa(hardness_pa))?;
+                m.serialize_entry("hardness_MPa", &Q(hardness_pa, Unit::PaAsMpa))?;
                 m.serialize_entry(
                     "plastic_increment",
                     if volume_conserving.is_some() {
@@ -74,8 +74,11 @@ impl Serialize for ModelChoice {
                 modulus_pa_per_m,
                 initial_pa,
             }) => {
-                m.serialize_entry("hardening_MPa_per_nm", &PaPerM(modulus_pa_per_m))?;
-                m.serialize_entry("initial_hardness_MPa", &Pa(initial_pa))?;
+                m.serialize_entry(
+                    "hardening_MPa_per_nm",
+                    &Q(modulus_pa_per_m, Unit::PaPerMAsMpaPerNm),
+                )?;
+                m.serialize_entry("initial_hardness_MPa", &Q(initial_pa, Unit::PaAsMpa))?;
                 m.serialize_entry(
                     "solve",
                     "implicit series compliance per load step (docs/methods.md §3.4)",
@@ -83,22 +86,6 @@ impl Serialize for ModelChoice {
             }
         }
         m.end()
-    }
-}
-
-/// A pressure (Pa) written in MPa.
-struct Pa(f64);
-impl Serialize for Pa {
-    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
-        lab::pa_as_mpa(&self.0, s)
-    }
-}
-
-/// A hardening coefficient (Pa/m) written in MPa/nm.
-struct PaPerM(f64);
-impl Serialize for PaPerM {
-    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
-        lab::pa_per_m_as_mpa_per_nm(&self.0, s)
     }
 }
 

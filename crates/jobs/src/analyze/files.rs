@@ -1,0 +1,206 @@
+//! The outputs of `analyze` as the command line writes them, through a staging folder (nothing
+//! appears unless everything succeeded): `areas.csv` (the outcome's rows), `summary.json` (the
+//! rest of the outcome), `area_vs_load.png/.svg` (feature `plots`) and, on request, one overlay
+//! PNG and one mask TIFF per image, written as the images are measured.
+
+use std::path::{Path, PathBuf};
+
+use contactscope::analysis::{ImageSink, Progress};
+use contactscope::image::Plane;
+use contactscope::measure::Mask;
+use contactscope_formats::tiff::write::encode_u8_stack;
+
+use super::{run_open, AnalyzeOutcome, AnalyzeRequest};
+use crate::error::Result;
+use crate::series::{ImageRef, OpenSeries};
+use crate::staging::Staging;
+use crate::summary::summary_json_without;
+use crate::table::rows_csv;
+
+/// Per-image outputs of the folder.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ImageOutputs {
+    /// One PNG per image with the contact edges in green.
+    pub overlays: bool,
+    /// The contact masks as TIFF.
+    pub masks: bool,
+}
+
+/// Run `analyze` and write its folder: the outcome and the files written (final paths).
+pub fn run_to_folder(
+    request: &AnalyzeRequest,
+    out_dir: &Path,
+    command_line: &[String],
+    images: ImageOutputs,
+    progress: Progress,
+) -> Result<(AnalyzeOutcome, Vec<PathBuf>)> {
+    request.check()?;
+    let open = request.micrographs.open()?;
+    let inputs: Vec<PathBuf> = open
+        .series
+        .files
+        .iter()
+        .map(|f| f.path.clone())
+        .chain(open.series.manifest.clone())
+        .collect();
+    let staging = Staging::new(out_dir, &inputs)?;
+    let sink = |i: usize, plane: &Plane, mask: &Mask| -> contactscope::Result<()> {
+        Ok(write_image_outputs(
+            &staging, request, &open, images, i, plane, mask,
+        )?)
+    };
+    let sink: ImageSink = &sink;
+    let outcome = run_open(request, &open, progress, sink)?;
+    staging.write("areas.csv", &areas_csv(&outcome)?)?;
+    #[cfg(feature = "plots")]
+    {
+        let plot = area_plot(&outcome, "Contact area versus normal force");
+        staging.write("area_vs_load.png", &plot.to_png()?)?;
+        staging.write("area_vs_load.svg", plot.to_svg()?.as_bytes())?;
+    }
+    staging.write(
+        "summary.json",
+        &summary_json_without(command_line, &outcome, &["rows"])?,
+    )?;
+    let written = staging.commit()?;
+    Ok((outcome, written))
+}
+
+/// `areas.csv`: one row per image, every column named with its unit.
+pub fn areas_csv(outcome: &AnalyzeOutcome) -> Result<Vec<u8>> {
+    rows_csv(&outcome.rows, &[])
+}
+
+/// Output file stem for image `index`: `003_name_p2`.
+fn image_stem(index: usize, image: &ImageRef) -> String {
+    let stem = image
+        .path
+        .file_stem()
+        .map_or("image".into(), |s| s.to_string_lossy().into_owned());
+    let clean: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("{:03}_{clean}_p{}", index + 1, image.page)
+}
+
+/// Scale factor that makes small micrographs legible in overlays.
+#[cfg(feature = "plots")]
+fn overlay_scale(width: usize) -> usize {
+    (512 / width.max(1)).clamp(1, 4)
+}
+
+fn write_image_outputs(
+    staging: &Staging,
+    request: &AnalyzeRequest,
+    open: &OpenSeries,
+    images: ImageOutputs,
+    index: usize,
+    plane: &Plane,
+    mask: &Mask,
+) -> Result<()> {
+    let image = &open.series.images[index];
+    let stem = image_stem(index, image);
+    #[cfg(feature = "plots")]
+    if images.overlays {
+        let png = crate::plot::overlay_png(
+            &plane.to_f64(),
+            plane.width,
+            plane.height,
+            &mask.as_bools(),
+            overlay_scale(plane.width),
+        )?;
+        staging.write(&format!("overlay_{stem}.png"), &png)?;
+    }
+    #[cfg(not(feature = "plots"))]
+    let _ = plane;
+    if images.masks {
+        let bytes: Vec<u8> = mask.data.iter().map(|&m| m * 255).collect();
+        let size = request.pixel_size_m.or_else(|| {
+            open.series
+                .info_of(&image.path)?
+                .pixel_size
+                .map(|p| (p.x_m, p.y_m))
+        });
+        let tiff = encode_u8_stack(&[&bytes], mask.width, mask.height, size)?;
+        staging.write(&format!("mask_{stem}.tif"), &tiff)?;
+    }
+    Ok(())
+}
+
+/// Log–log plot of area against force with both fits (and the Hertz area if known).
+#[cfg(feature = "plots")]
+pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
+    use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
+    use contactscope::mechanics::hertz;
+    let table = &outcome.rows;
+    let fits = &outcome.fits;
+    let measured: Vec<(f64, f64)> = table
+        .rows
+        .iter()
+        .filter_map(|r| r.force_mn.map(|f| (f, r.area)))
+        .collect();
+    let forces: Vec<f64> = measured.iter().map(|p| p.0).filter(|f| *f > 0.0).collect();
+    let (lo, hi) = forces
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &f| {
+            (a.min(f), b.max(f))
+        });
+    let grid: Vec<f64> = if lo < hi {
+        (0..=40)
+            .map(|i| lo * (hi / lo).powf(f64::from(i) / 40.0))
+            .collect()
+    } else {
+        forces.clone()
+    };
+    let mut curves = Vec::new();
+    if let Some(f) = fits.power_law {
+        curves.push(Curve {
+            label: format!(
+                "power law A ∝ N^β, β = {:.3}{}",
+                f.exponent,
+                f.exponent_se
+                    .map_or(String::new(), |s| format!(" ± {s:.3}"))
+            ),
+            xy: grid.iter().map(|&n| (n, f.eval(n))).collect(),
+        });
+    }
+    if let Some((p, _)) = fits.proportional_mpa {
+        curves.push(Curve {
+            label: format!("proportional A = N/p, p = {p:.1} MPa"),
+            xy: grid.iter().map(|&n| (n, n / p * 1e3)).collect(),
+        });
+    }
+    if let (Some(h), super::AreaUnit::SquareMicrometre) = (outcome.hertz, table.unit) {
+        curves.push(Curve {
+            label: "Hertz area πa²".into(),
+            xy: grid
+                .iter()
+                .map(|&n| {
+                    (
+                        n,
+                        hertz::contact_area(n * 1e-3, h.radius_m, h.modulus_pa) * 1e12,
+                    )
+                })
+                .collect(),
+        });
+    }
+    Chart {
+        title: title.to_string(),
+        x_label: "normal force N (mN)".into(),
+        y_label: table.unit.axis_label().into(),
+        axes: Axes::LogLog,
+        legend: Legend::UpperLeft,
+        points: vec![PointSet {
+            label: "measured (Otsu contact pixels × pixel area)".into(),
+            xy: measured,
+        }],
+        curves,
+    }
+}

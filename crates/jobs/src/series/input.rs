@@ -1,0 +1,256 @@
+//! Micrographs as a request carries them: files (folders, a manifest, CZI/ND2/LIF planes along a
+//! load axis) or planes already in memory (Python hands over numpy arrays in their stored
+//! sample type). Both become an [`OpenSeries`], whose [`Planes`] the analysis reads, so that a
+//! series gives one threshold and one set of areas whichever front-end handed it over.
+
+use std::path::PathBuf;
+
+use contactscope::analysis::PlaneSource;
+use contactscope::image::{Plane, SampleType};
+use contactscope_formats::microscopy::select::{LoadAxis, Selection};
+use contactscope_formats::param::Param;
+use contactscope_formats::ranges::Quantity;
+
+use super::{assign_forces, from_files_selected, from_manifest_selected, ImageRef, Series};
+use super::{SeriesPlanes, DEFAULT_MEMORY_BUDGET};
+use crate::error::{Error, Location, Result};
+
+/// Files of a series: images (folders in natural order) or one manifest, which planes, and one
+/// force per image when the files do not come with a manifest.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SeriesSpec {
+    /// TIFF, CZI, ND2 or LIF files, or folders of them (not with a manifest).
+    pub inputs: Vec<PathBuf>,
+    /// A manifest CSV (`file`, `page`, `force_mN`, `friction_mN`).
+    pub manifest: Option<PathBuf>,
+    /// Which planes of confocal files (and the channel of TIFFs).
+    pub selection: Selection,
+    /// Axis of a CZI, ND2 or LIF file whose planes are the loads.
+    pub load_axis: Option<LoadAxis>,
+    /// Normal forces, N, one per image (not with a manifest).
+    pub forces_n: Option<Vec<f64>>,
+}
+
+/// Planes in memory: one per load, all of one size and sample type.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MemorySeries {
+    /// The images, in load order.
+    pub planes: Vec<Plane>,
+    /// Normal forces, N, one per image.
+    pub forces_n: Option<Vec<f64>>,
+    /// What to call the images in outputs and messages (`image 3` of it).
+    pub label: String,
+}
+
+/// Micrographs as a request carries them.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Micrographs {
+    /// Files to read.
+    Files(SeriesSpec),
+    /// Planes in memory.
+    Memory(MemorySeries),
+}
+
+impl Micrographs {
+    /// Range checks of what the caller gave (the forces).
+    pub fn check(&self) -> Result<()> {
+        let forces = match self {
+            Micrographs::Files(spec) => spec.forces_n.as_deref(),
+            Micrographs::Memory(m) => m.forces_n.as_deref(),
+        };
+        for &f in forces.unwrap_or_default() {
+            if f != 0.0 {
+                Quantity::Force.check(f, Param::Forces)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Open the series: read the files' headers (nothing is decoded yet) or take the planes.
+    pub fn open(&self) -> Result<OpenSeries> {
+        match self {
+            Micrographs::Files(spec) => {
+                let mut series = match &spec.manifest {
+                    Some(manifest) => {
+                        if !spec.inputs.is_empty() || spec.forces_n.is_some() {
+                            return Err(Error::InvalidArgument(format!(
+                                "a manifest lists the images and their forces: give {} alone",
+                                Param::Manifest
+                            )));
+                        }
+                        from_manifest_selected(manifest, &spec.selection, spec.load_axis)?
+                    }
+                    None => from_files_selected(&spec.inputs, &spec.selection, spec.load_axis)?,
+                };
+                if let Some(forces) = &spec.forces_n {
+                    assign_forces(&mut series, forces)?;
+                }
+                Ok(OpenSeries {
+                    series,
+                    planes: None,
+                })
+            }
+            Micrographs::Memory(m) => m.open(),
+        }
+    }
+}
+
+impl MemorySeries {
+    fn open(&self) -> Result<OpenSeries> {
+        let first = self.planes.first().ok_or_else(|| {
+            Error::InvalidArgument(format!("{}: the image stack is empty", self.label))
+        })?;
+        if first.is_empty() {
+            return Err(Error::InvalidArgument(format!(
+                "{}: the images have no pixels",
+                self.label
+            )));
+        }
+        for (i, p) in self.planes.iter().enumerate() {
+            if (p.width, p.height, p.sample_type) != (first.width, first.height, first.sample_type)
+            {
+                return Err(Error::SeriesMismatch {
+                    at: Location::page(&self.label, i),
+                    reason: format!("{}×{} {}", p.width, p.height, p.sample_type.name()),
+                    expected: format!(
+                        "{}×{} {}",
+                        first.width,
+                        first.height,
+                        first.sample_type.name()
+                    ),
+                });
+            }
+        }
+        let mut series = Series {
+            images: (0..self.planes.len())
+                .map(|page| ImageRef {
+                    path: PathBuf::from(&self.label),
+                    page,
+                    plane: None,
+                    force_n: None,
+                    friction_n: None,
+                })
+                .collect(),
+            files: Vec::new(),
+            channel: 0,
+            manifest: None,
+            selection: Selection::default(),
+            load_axis: None,
+        };
+        if let Some(forces) = &self.forces_n {
+            assign_forces(&mut series, forces)?;
+        }
+        Ok(OpenSeries {
+            series,
+            planes: Some(self.planes.clone()),
+        })
+    }
+}
+
+/// A series ready for a job: its images with forces and file facts, and for a series in memory
+/// its planes.
+#[derive(Debug, Clone)]
+pub struct OpenSeries {
+    /// The images (for a series in memory, labelled `LABEL (page i)`; no files).
+    pub series: Series,
+    /// The planes of a series in memory.
+    pub planes: Option<Vec<Plane>>,
+}
+
+impl OpenSeries {
+    /// The planes as the analysis reads them, keeping up to `budget` bytes of decoded compressed
+    /// planes of files between the passes.
+    pub fn planes(&self, budget: usize) -> Planes<'_> {
+        match &self.planes {
+            Some(p) => Planes::Memory(p),
+            None => Planes::Files(self.series.planes(budget)),
+        }
+    }
+
+    /// The sample type of the images.
+    pub fn sample_type(&self) -> SampleType {
+        match &self.planes {
+            Some(p) => p[0].sample_type,
+            None => self.series.files[0].sample_type,
+        }
+    }
+
+    /// The planes with the default memory budget.
+    pub fn default_planes(&self) -> Planes<'_> {
+        self.planes(DEFAULT_MEMORY_BUDGET)
+    }
+}
+
+/// The planes of an [`OpenSeries`]: in memory, or decoded from the files on demand.
+pub enum Planes<'a> {
+    /// Planes in memory.
+    Memory(&'a [Plane]),
+    /// Planes of files.
+    Files(SeriesPlanes<'a>),
+}
+
+impl PlaneSource for Planes<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Planes::Memory(p) => p.len(),
+            Planes::Files(s) => s.len(),
+        }
+    }
+
+    fn sample_type(&self) -> SampleType {
+        match self {
+            Planes::Memory(p) => PlaneSource::sample_type(*p),
+            Planes::Files(s) => s.sample_type(),
+        }
+    }
+
+    fn label(&self, index: usize) -> String {
+        match self {
+            Planes::Memory(p) => p.label(index),
+            Planes::Files(s) => s.label(index),
+        }
+    }
+
+    fn scan<T: Send, F: Fn(usize, &Plane) -> contactscope::Result<T> + Sync>(
+        &self,
+        f: F,
+    ) -> contactscope::Result<Vec<T>> {
+        match self {
+            Planes::Memory(p) => p.scan(f),
+            Planes::Files(s) => s.scan(f),
+        }
+    }
+}
+
+/// A series read whole into memory: what Python's `read_series` and `read_image` return.
+#[derive(Debug, Clone)]
+pub struct LoadedSeries {
+    /// The planes in their stored sample type, in load order.
+    pub planes: Vec<Plane>,
+    /// Where each came from, with its force.
+    pub images: Vec<ImageRef>,
+    /// The pixel size: the override, else the files' metadata (they must agree).
+    pub pixel_size: Option<contactscope::image::PixelSize>,
+    /// Notes on the metadata, a missing pixel size.
+    pub warnings: Vec<String>,
+}
+
+/// Read every image of the series the files name (as `analyze` reads them) into memory.
+pub fn load(spec: &SeriesSpec, pixel_size_m: Option<(f64, f64)>) -> Result<LoadedSeries> {
+    let micrographs = Micrographs::Files(spec.clone());
+    micrographs.check()?;
+    if let Some((x, y)) = pixel_size_m {
+        Quantity::PixelSize.check(x, Param::PixelSize)?;
+        Quantity::PixelSize.check(y, Param::PixelSize)?;
+    }
+    let open = micrographs.open()?;
+    let mut warnings = Vec::new();
+    let pixel_size = super::pixel_size(&open.series, pixel_size_m, &mut warnings)?;
+    let planes = open.default_planes().scan(|_, p| Ok(p.clone()))?;
+    Ok(LoadedSeries {
+        planes,
+        images: open.series.images,
+        pixel_size,
+        warnings,
+    })
+}
