@@ -139,8 +139,18 @@ impl serde::Serialize for OptQ {
     }
 }
 
+/// Quantities of one unit in a list: `Qs(&forces_n, Unit::NAsMn)`.
+#[derive(Debug, Clone, Copy)]
+pub struct Qs<'a>(pub &'a [f64], pub Unit);
+
+impl serde::Serialize for Qs<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(self.0.iter().map(|&v| self.1.apply(v)))
+    }
+}
+
 macro_rules! quantities {
-    ($($(#[$doc:meta])* $name:ident, $opt:ident: $unit:ident;)*) => {$(
+    ($($(#[$doc:meta])* $name:ident, $opt:ident, $each:ident: $unit:ident;)*) => {$(
         $(#[$doc])*
         pub fn $name<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
             s.serialize_f64(Unit::$unit.apply(*v))
@@ -149,38 +159,42 @@ macro_rules! quantities {
         pub fn $opt<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
             serde::Serialize::serialize(&OptQ(*v, Unit::$unit), s)
         }
+        /// The same, for every value of a list.
+        pub fn $each<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+            serde::Serialize::serialize(&Qs(v, Unit::$unit), s)
+        }
     )*};
 }
 
 quantities! {
     /// Stored in N, written in mN.
-    n_as_mn, opt_n_as_mn: NAsMn;
+    n_as_mn, opt_n_as_mn, each_n_as_mn: NAsMn;
     /// Stored and written in mN (SI: N).
-    mn, opt_mn: Mn;
+    mn, opt_mn, each_mn: Mn;
     /// Stored in m, written in µm.
-    m_as_um, opt_m_as_um: MAsUm;
+    m_as_um, opt_m_as_um, each_m_as_um: MAsUm;
     /// Stored and written in µm (SI: m).
-    um, opt_um: Um;
+    um, opt_um, each_um: Um;
     /// Stored in m, written in nm.
-    m_as_nm, opt_m_as_nm: MAsNm;
+    m_as_nm, opt_m_as_nm, each_m_as_nm: MAsNm;
     /// Stored and written in nm (SI: m).
-    nm, opt_nm: Nm;
+    nm, opt_nm, each_nm: Nm;
     /// Stored in m², written in µm².
-    m2_as_um2, opt_m2_as_um2: M2AsUm2;
+    m2_as_um2, opt_m2_as_um2, each_m2_as_um2: M2AsUm2;
     /// Stored and written in µm² (SI: m²).
-    um2, opt_um2: Um2;
+    um2, opt_um2, each_um2: Um2;
     /// Stored in m³, written in µm³.
-    m3_as_um3, opt_m3_as_um3: M3AsUm3;
+    m3_as_um3, opt_m3_as_um3, each_m3_as_um3: M3AsUm3;
     /// Stored in Pa, written in MPa.
-    pa_as_mpa, opt_pa_as_mpa: PaAsMpa;
+    pa_as_mpa, opt_pa_as_mpa, each_pa_as_mpa: PaAsMpa;
     /// Stored and written in MPa (SI: Pa).
-    mpa, opt_mpa: Mpa;
+    mpa, opt_mpa, each_mpa: Mpa;
     /// Stored in Pa, written in GPa.
-    pa_as_gpa, opt_pa_as_gpa: PaAsGpa;
+    pa_as_gpa, opt_pa_as_gpa, each_pa_as_gpa: PaAsGpa;
     /// Stored in Pa/m, written in MPa/nm.
-    pa_per_m_as_mpa_per_nm, opt_pa_per_m_as_mpa_per_nm: PaPerMAsMpaPerNm;
+    pa_per_m_as_mpa_per_nm, opt_pa_per_m_as_mpa_per_nm, each_pa_per_m_as_mpa_per_nm: PaPerMAsMpaPerNm;
     /// Stored in 1/m, written in 1/µm.
-    per_m_as_per_um, opt_per_m_as_per_um: PerMAsPerUm;
+    per_m_as_per_um, opt_per_m_as_per_um, each_per_m_as_per_um: PerMAsPerUm;
 }
 
 /// What one unit token of a key means: (the SI token, the factor from SI to the unit).
