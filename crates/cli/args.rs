@@ -8,7 +8,6 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 
-use contactscope::solver::cg::SolverOptions;
 use contactscope::surface::fill::FillInvalid;
 use contactscope::surface::Detrend;
 use contactscope_formats::microscopy::select::{LoadAxis, Selection};
@@ -68,18 +67,6 @@ pub struct SolverArgs {
     /// Most CG iterations per load.
     #[arg(long, default_value_t = 5000)]
     pub max_iterations: usize,
-}
-
-impl SolverArgs {
-    /// The solver options (no progress monitor).
-    pub fn options(&self) -> SolverOptions<'static> {
-        SolverOptions {
-            max_iterations: self.max_iterations,
-            tolerance: self.tolerance,
-            monitor: None,
-            ..SolverOptions::default()
-        }
-    }
 }
 
 /// `--quiet`, `-q`.

@@ -4,11 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 
-use contactscope::compare::CompareSettings;
-use contactscope::spectral::register::MAX_UPSAMPLE;
 use contactscope_formats::units::{self, Dimension};
-use contactscope_jobs::compare::{run_compare, CompareRequest, ExperimentInput};
+use contactscope_jobs::compare::files::run_to_folder;
+use contactscope_jobs::compare::{CompareRequest, Simulation};
 use contactscope_jobs::results::fwhm_from_psf_json;
+use contactscope_jobs::series::{Micrographs, SeriesSpec};
 
 use super::args::{default_out, fraction, LoadAxisArg, OutputFolder, PixelSizeArg, SelectionArgs};
 use super::common::{command_line, print_warnings, print_written};
@@ -60,12 +60,22 @@ pub fn run(args: Args) -> Result<()> {
         p.is_dir() && p.join("manifest.csv").is_file()
             || p.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"))
     });
-    let experiment = match (&args.forces, is_manifest) {
-        (None, true) => ExperimentInput::Manifest(args.experiment[0].clone()),
+    let selection = args.select.selection();
+    let load_axis = args.load_axis.map(LoadAxisArg::axis);
+    let spec = match (&args.forces, is_manifest) {
+        (None, true) => SeriesSpec {
+            manifest: Some(args.experiment[0].clone()),
+            selection,
+            load_axis,
+            ..SeriesSpec::default()
+        },
         (Some(_), true) => bail!("--forces goes with TIFF inputs, not with a manifest"),
-        (Some(forces), false) => ExperimentInput::Files {
+        (Some(forces), false) => SeriesSpec {
             inputs: args.experiment.clone(),
-            forces_n: units::parse_loads(forces).context("--forces")?,
+            selection,
+            load_axis,
+            forces_n: Some(units::parse_loads(forces).context("--forces")?),
+            ..SeriesSpec::default()
         },
         (None, false) => {
             bail!("--experiment: give a manifest (or a folder with manifest.csv), or TIFFs with --forces")
@@ -73,38 +83,27 @@ pub fn run(args: Args) -> Result<()> {
     };
     let psf_fwhm_m = match (&args.psf, &args.psf_fwhm) {
         (Some(path), _) => fwhm_from_psf_json(path)?,
-        (None, Some(text)) => contactscope_formats::ranges::Quantity::Fwhm.check_text(
-            units::parse_positive(text, Dimension::Length).context("--psf-fwhm")?,
-            "--psf-fwhm",
-        )?,
+        (None, Some(text)) => {
+            units::parse_positive(text, Dimension::Length).context("--psf-fwhm")?
+        }
         (None, None) => bail!("give --psf psf.json or --psf-fwhm"),
     };
-    if !(1..=MAX_UPSAMPLE).contains(&args.upsample) {
-        bail!(
-            "--upsample {}: give 1 to {MAX_UPSAMPLE} (a sub-pixel resolution of 1/N pixel)",
-            args.upsample
-        );
-    }
     let request = CompareRequest {
-        experiment,
-        selection: args.select.selection(),
-        load_axis: args.load_axis.map(LoadAxisArg::axis),
         pixel_size_m: args.pixel_size.metres()?,
-        simulation: args.simulation.clone(),
-        settings: CompareSettings {
+        dihedral: args.dihedral,
+        upsample: args.upsample,
+        force_tolerance: fraction(&args.force_tolerance, "--force-tolerance")?,
+        ..CompareRequest::new(
+            Micrographs::Files(spec),
+            Simulation::Folder(args.simulation.clone()),
             psf_fwhm_m,
-            dihedral: args.dihedral,
-            upsample: args.upsample,
-            force_tolerance: fraction(&args.force_tolerance, "--force-tolerance")?,
-        },
-        out_dir: args.out.out.clone(),
-        command_line: command_line(),
+        )
     };
-    let outcome = run_compare(&request)?;
+    let (outcome, written) = run_to_folder(&request, &args.out.out, &command_line())?;
     print_warnings(&outcome.warnings);
     println!(
         "thresholds: experiment {:.1}, simulation {:.4} (blurred contact fraction)",
-        outcome.thresholds.0, outcome.thresholds.1
+        outcome.experiment_threshold, outcome.simulated_threshold
     );
     println!(
         "{:>10} {:>10} {:>12} {:>12} {:>7} {:>7} {:>6}",
@@ -122,6 +121,6 @@ pub fn run(args: Args) -> Result<()> {
             l.correlation_peak
         );
     }
-    print_written(outcome.written.len(), &args.out.out);
+    print_written(written.len(), &args.out.out);
     Ok(())
 }

@@ -5,11 +5,14 @@ use std::sync::Arc;
 
 use anyhow::{bail, Context, Result};
 
-use contactscope::compare::CompareSettings;
 use contactscope::model_fit::{Family, Imaging, ProgressHook, RampEvent, Search};
 use contactscope_formats::units::{self, Dimension};
-use contactscope_jobs::compare::ExperimentInput;
-use contactscope_jobs::fit_hardening::{run_fit, FitRequest, Sweep, SweepMicrographs};
+use contactscope_jobs::fit_hardening::files::run_to_folder;
+use contactscope_jobs::fit_hardening::{
+    BodyRequest, FitRequest, MeasuredInput, Sweep, SweepMicrographs,
+};
+use contactscope_jobs::heights::HeightInput;
+use contactscope_jobs::series::{Micrographs, SeriesSpec};
 
 use super::args::{default_out, optional_pixel_size, BodyArgs, OutputFolder, SolverArgs};
 use indicatif::ProgressStyle;
@@ -114,18 +117,12 @@ fn sweep_micrographs(args: &Args) -> Result<Option<SweepMicrographs>> {
         .as_deref()
         .context("--micrographs needs --psf-fwhm")?;
     Ok(Some(SweepMicrographs {
-        experiment: ExperimentInput::Manifest(path.clone()),
-        channel: None,
+        micrographs: Micrographs::Files(SeriesSpec {
+            manifest: Some(path.clone()),
+            ..SeriesSpec::default()
+        }),
         pixel_size_m: optional_pixel_size(&args.micrograph_pixel_size, "--micrograph-pixel-size")?,
-        settings: CompareSettings {
-            psf_fwhm_m: contactscope_formats::ranges::Quantity::Fwhm.check_text(
-                units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
-                "--psf-fwhm",
-            )?,
-            dihedral: false,
-            upsample: 20,
-            force_tolerance: 0.01,
-        },
+        psf_fwhm_m: units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
     }))
 }
 
@@ -137,10 +134,7 @@ fn imaging(args: &Args) -> Result<Option<Imaging>> {
         bail!("--imaged-areas needs --psf-fwhm and --micrograph-pixel-size");
     };
     Ok(Some(Imaging {
-        fwhm_m: contactscope_formats::ranges::Quantity::Fwhm.check_text(
-            units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
-            "--psf-fwhm",
-        )?,
+        fwhm_m: units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
         pixel_m: units::parse_pixel_size(pixel).context("--micrograph-pixel-size")?,
     }))
 }
@@ -163,22 +157,22 @@ pub fn run(args: Args) -> Result<()> {
     }
     let body = args.body.body()?;
     let request = FitRequest {
-        experiment: args.experiment.clone(),
-        topography: body.topography,
-        radius_m: body.radius_m,
-        e_star_pa: body.e_star_pa,
-        periodic: args.periodic,
         families,
         searches: searches(&args)?,
         sweep,
         micrographs: sweep_micrographs(&args)?,
-        imaging: imaging(&args)?,
-        options: args.solver.options(),
-        out_dir: args.out.out.clone(),
-        command_line: command_line(),
-        progress: None,
+        ..FitRequest::new(
+            MeasuredInput::File(args.experiment.clone()),
+            BodyRequest {
+                radius_m: body.radius_m,
+                periodic: args.periodic,
+                tolerance: args.solver.tolerance,
+                max_iterations: args.solver.max_iterations,
+                imaging: imaging(&args)?,
+                ..BodyRequest::new(HeightInput::File(body.topography), body.e_star_pa)
+            },
+        )
     };
-    let mut request = request;
     let bar = progress_bar(1, 1, args.quiet.quiet);
     bar.set_style(
         ProgressStyle::with_template(
@@ -190,7 +184,7 @@ pub fn run(args: Args) -> Result<()> {
     bar.set_length(0);
     let ramps = request.expected_ramps() as u64;
     let hook_bar = bar.clone();
-    request.progress = Some(ProgressHook(Arc::new(move |event: &RampEvent| {
+    let progress = Some(ProgressHook(Arc::new(move |event: &RampEvent| {
         if hook_bar.length() == Some(0) {
             hook_bar.set_length(ramps * event.loads as u64);
         }
@@ -200,12 +194,12 @@ pub fn run(args: Args) -> Result<()> {
         hook_bar.inc(1);
         hook_bar.set_message(ramp_label(event));
     })));
-    let outcome = run_fit(&request);
+    let outcome = run_to_folder(&request, &args.out.out, &command_line(), progress);
     bar.finish_and_clear();
-    let outcome = outcome?;
+    let (outcome, written) = outcome?;
     print_warnings(&outcome.warnings);
     println!("{:>10} {:>22} {:>10}", "model", "parameter", "misfit");
-    for fit in &outcome.fits {
+    for fit in outcome.fits() {
         let parameter = match (fit.family, fit.best.parameter) {
             (Family::Hardening, Some(k)) => format!(
                 "k = {:.3} ± {} MPa/nm",
@@ -228,9 +222,9 @@ pub fn run(args: Args) -> Result<()> {
             fit.best.misfit
         );
     }
-    if let Some(best) = outcome.best() {
-        println!("best model: {}", best.family.name());
+    if let Some(best) = outcome.best_model {
+        println!("best model: {best}");
     }
-    print_written(outcome.written.len(), &args.out.out);
+    print_written(written.len(), &args.out.out);
     Ok(())
 }

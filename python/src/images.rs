@@ -9,8 +9,6 @@ use numpy::{IntoPyArray, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use contactscope::analysis;
-use contactscope::compare::{compare_maps, CompareSettings, Micrograph, Micrographs, SimulatedMap};
 use contactscope::image::{Image, PixelSize, PixelSizeSource, Plane, SampleType, Samples};
 use contactscope::numerics::stats::MeanSd;
 use contactscope::optics::blur::{microscope_image, Grid};
@@ -260,115 +258,10 @@ fn blur_and_resample<'py>(
         .into_any())
 }
 
-/// Simulated contact maps against micrographs: each map (1 = contact; pixel size in m) at a
-/// force (N) is matched to the micrograph at the same force (within `force_tolerance`), blurred
-/// with the PSF (`psf_fwhm`, m), registered and scored (Dice, Jaccard, edge distance in m).
-#[pyfunction]
-#[pyo3(signature = (micrographs, forces, pixel_size, maps, map_forces, map_pixel_size, psf_fwhm, dihedral=false, upsample=20, force_tolerance=0.01))]
-#[allow(clippy::too_many_arguments)]
-fn compare<'py>(
-    py: Python<'py>,
-    micrographs: StackIn<'py>,
-    forces: Vec<f64>,
-    pixel_size: PixelArg,
-    maps: PyReadonlyArray3<'py, f64>,
-    map_forces: Vec<f64>,
-    map_pixel_size: PixelArg,
-    psf_fwhm: f64,
-    dihedral: bool,
-    upsample: usize,
-    force_tolerance: f64,
-) -> PyResult<Bound<'py, PyList>> {
-    let planes = micrographs.planes()?;
-    if forces.len() != planes.len() {
-        return Err(bad(format!(
-            "{} forces for {} micrographs",
-            forces.len(),
-            planes.len()
-        )));
-    }
-    let m = maps.as_array();
-    if map_forces.len() != m.dim().0 {
-        return Err(bad(format!(
-            "{} map forces for {} maps",
-            map_forces.len(),
-            m.dim().0
-        )));
-    }
-    if upsample == 0 {
-        return Err(bad("upsample must be at least 1"));
-    }
-    let (mdx, mdy) = map_pixel_size.xy()?;
-    let (_, mh, mw) = m.dim();
-    let sim_values: Vec<Vec<f64>> = m
-        .outer_iter()
-        .map(|p| p.iter().copied().collect())
-        .collect();
-    let pixel_m = pixel_size.xy()?;
-    let settings = CompareSettings {
-        psf_fwhm_m: psf_fwhm,
-        dihedral,
-        upsample,
-        force_tolerance,
-    };
-    let result = compute(py, move || {
-        let (t, _, warnings) = analysis::global_threshold(planes.as_slice(), &|_, _, _| {})?;
-        let images = planes
-            .into_iter()
-            .zip(&forces)
-            .enumerate()
-            .map(|(page, (plane, &f))| Micrograph {
-                plane,
-                force_n: Some(f),
-                path: PathBuf::from("micrographs"),
-                page,
-            })
-            .collect();
-        let micrographs = Micrographs {
-            images,
-            threshold: t.value,
-            pixel_m,
-            warnings,
-        };
-        let simulated = sim_values
-            .into_iter()
-            .zip(&map_forces)
-            .enumerate()
-            .map(|(i, (v, &f))| {
-                Ok(SimulatedMap {
-                    force_n: f,
-                    map: Grid::new(v, mw, mh, mdx, mdy)?,
-                    source: format!("map {i}"),
-                })
-            })
-            .collect::<contactscope::error::Result<Vec<_>>>()?;
-        compare_maps(&micrographs, &simulated, &settings)
-    })?;
-    let rows = PyList::empty(py);
-    for l in &result.loads {
-        let d = PyDict::new(py);
-        d.set_item("force_n", l.force_n)?;
-        d.set_item("simulated_force_n", l.simulated_force_n)?;
-        d.set_item("micrograph", l.micrograph.1)?;
-        d.set_item("shift_px", l.shift_px)?;
-        d.set_item("correlation_peak", l.correlation_peak)?;
-        d.set_item("experiment_area_m2", l.experiment_area_m2)?;
-        d.set_item("simulated_area_m2", l.simulated_area_m2)?;
-        d.set_item("simulated_raw_area_m2", l.simulated_raw_area_m2)?;
-        d.set_item("dice", l.dice)?;
-        d.set_item("jaccard", l.jaccard)?;
-        d.set_item("edge_distance_m", l.edge_distance_m)?;
-        d.set_item("xi_1e_m", l.xi_1e_m)?;
-        rows.append(d)?;
-    }
-    Ok(rows)
-}
-
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(psf, m)?)?;
     m.add_function(wrap_pyfunction!(autocorrelation, m)?)?;
     m.add_function(wrap_pyfunction!(newton, m)?)?;
     m.add_function(wrap_pyfunction!(blur_and_resample, m)?)?;
-    m.add_function(wrap_pyfunction!(compare, m)?)?;
     Ok(())
 }

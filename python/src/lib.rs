@@ -17,7 +17,9 @@ use pyo3::prelude::*;
 
 use contactscope_jobs::Error;
 
+mod compare;
 mod convert;
+mod fit;
 mod heights;
 mod images;
 mod mechanics;
@@ -181,6 +183,8 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
     images::register(m)?;
+    compare::register(m)?;
+    fit::register(m)?;
     mechanics::register(m)?;
     series::register(m)?;
     simulate::register(m)?;

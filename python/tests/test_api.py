@@ -222,6 +222,9 @@ def test_compare_matches_cli(cli, series_tif, tmp_path):
                      for i in (1, 2, 3)])
     mine = cs.compare(s.images, FORCES, 2e-7, maps, FORCES, 2e-7, 450e-9)
     assert len(mine.rows) == len(theirs) == 3
+    # The simulate folder itself, as the command line reads it: the same scores.
+    same = cs.compare(s.images, FORCES, 2e-7, sim, None, None, 450e-9)
+    assert [x["dice"] for x in same.rows] == [x["dice"] for x in mine.rows]
     dice_col = next(k for k in theirs[0] if k.startswith("dice"))
     for m, t in zip(mine.rows, theirs):
         assert m["dice"] == pytest.approx(float(t[dice_col]), abs=1e-5)  # CSV: 5 decimals
@@ -240,11 +243,16 @@ def test_fit_hardening_matches_cli(cli, surface_npy, tmp_path):
     rows = read_csv(out / "areas.csv")
     forces = [float(r["force_mN"]) * 1e-3 for r in rows]
     areas = [float(r["area_um2"]) * 1e-12 for r in rows]
-    h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
-    mine = cs.fit_hardening(forces, areas, h, 100e-9, 1e9, radius=20e-6)
-    assert mine.parameter * 1e-15 == pytest.approx(theirs["k_MPa_per_nm"], rel=1e-9)
-    assert mine.misfit == pytest.approx(theirs["misfit_rms_ln_area"], rel=1e-9)
+    # The same files and the default arguments: the command line's numbers.
+    mine = cs.fit_hardening(out / "areas.csv", None, surface_npy, 100e-9, 1e9, radius=20e-6)
+    assert mine.parameter * 1e-15 == theirs["k_MPa_per_nm"]
+    assert mine.misfit == theirs["misfit_rms_ln_area"]
     assert mine.parameter == pytest.approx(4e15, rel=0.1)
+    # The measured curve as numbers (N, m²) and the heights as an array give the same fit.
+    h = cs.read_topography(surface_npy, pixel_size=100e-9, detrend="none").heights
+    again = cs.fit_hardening(forces, areas, h, 100e-9, 1e9, radius=20e-6)
+    assert again.parameter == pytest.approx(mine.parameter, rel=1e-9)
+    assert again.models[0]["model"] == "hardening" and again.trace
 
 
 def test_ramp_and_misfit_agree_with_simulate(surface_npy):

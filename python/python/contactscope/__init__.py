@@ -43,6 +43,7 @@ __all__ = [
     "FileError",
     "InputError",
     "InternalError",
+    "FitResults",
     "Results",
     "Series",
     "analyze",
@@ -322,17 +323,38 @@ def blur_and_resample(map: Any, pixel_size: PixelSize, fwhm: float,
     return _cs.blur_and_resample(_f64(map, 2, "map"), pixel_size, float(fwhm), image_pixel_size)
 
 
-def compare(micrographs: Any, forces: Sequence[float], pixel_size: PixelSize, maps: Any,
-            map_forces: Sequence[float], map_pixel_size: PixelSize, psf_fwhm: float,
-            dihedral: bool = False, upsample: int = 20, force_tolerance: float = 0.01) -> Results:
-    """Simulated contact maps (1 = contact; pixel size in m) against micrographs (pixel size in
-    m) at matching forces (N, within ``force_tolerance``): each map blurred with the PSF
-    (``psf_fwhm``, m), registered and scored. ``rows``: ``dice``, ``jaccard``, areas (m²),
-    ``edge_distance_m`` (m), ``shift_px``, ``correlation_peak``."""
-    rows = _cs.compare(_stack(micrographs), [float(f) for f in forces], pixel_size,
-                       _f64(maps, 3, "maps"), [float(f) for f in map_forces], map_pixel_size,
-                       float(psf_fwhm), dihedral, upsample, force_tolerance)
-    return Results(rows=rows)
+def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Optional[PixelSize],
+            maps: Any, map_forces: Optional[Sequence[float]] = None,
+            map_pixel_size: Optional[PixelSize] = None, psf_fwhm: float = 450e-9, *,
+            dihedral: Optional[bool] = None, upsample: Optional[int] = None,
+            force_tolerance: Optional[float] = None) -> Results:
+    """Simulated contact maps against micrographs, load by load: the command line's ``compare``
+    with its defaults and checks. ``micrographs``: a :class:`Series` (its files and forces) or
+    images in their stored sample type with ``forces`` (N) and ``pixel_size`` (m). ``maps``: a
+    folder written by ``simulate`` (its maps, forces and pixel size), or contact maps (loads,
+    ny, nx; 1 = contact) with ``map_forces`` (N) and ``map_pixel_size`` (m). Each map is blurred
+    with the PSF (``psf_fwhm``, m), registered (``dihedral`` also tries mirror images and
+    rotations; sub-pixel 1/``upsample``) and scored where its force matches a micrograph's
+    within ``force_tolerance`` (default 0.01).
+
+    Returns the outcome the command line writes as ``compare.json`` (SI units): ``loads`` (per
+    matched load: ``force_n``, ``dice``, ``jaccard``, ``experiment_area_m2``,
+    ``simulated_area_m2``, ``shift_x_px``, ``edge_distance_m``, …; also
+    :attr:`Results.rows`), ``dice_mean``, the thresholds and ``warnings``.
+    """
+    if isinstance(micrographs, Series) and pixel_size is None:
+        pixel_size = micrographs._pixel_size
+    forces = None if forces is None else [float(f) for f in forces]
+    if isinstance(maps, (str, os.PathLike)):
+        maps = os.fspath(maps)
+    else:
+        maps = _f64(maps, 3, "maps")
+    map_forces = None if map_forces is None else [float(f) for f in map_forces]
+    result = Results(_cs.compare(_images(micrographs), forces, pixel_size, maps, map_forces,
+                                 map_pixel_size, float(psf_fwhm), dihedral, upsample,
+                                 force_tolerance), table="loads")
+    _warn(result)
+    return result
 
 
 def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
@@ -401,17 +423,26 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
     return result
 
 
-def ramp(heights: Any, pixel_size: PixelSize, modulus: float, family: str,
+def _heights(heights: Any) -> Any:
+    """A height-map path as it is, anything else as a 2-D float64 array."""
+    if isinstance(heights, (str, os.PathLike)):
+        return os.fspath(heights)
+    return _f64(heights, 2, "heights")
+
+
+def ramp(heights: Any, pixel_size: Optional[PixelSize], modulus: float, family: str,
          parameter: Optional[float], loads: Sequence[float], radius: Optional[float] = None,
-         tolerance: float = 1e-8, max_iterations: int = 5000,
+         tolerance: Optional[float] = None, max_iterations: Optional[int] = None,
          imaging_fwhm: Optional[float] = None,
-         imaging_pixel_size: Optional[PixelSize] = None) -> Results:
+         imaging_pixel_size: Optional[PixelSize] = None, *, detrend: str = "plane",
+         periodic: bool = False) -> Results:
     """One model evaluation of a fit (the unit of a Dask task): contact areas ``areas_m2`` (m²)
     of one load ramp (``loads`` in N, increasing) for ``family`` ("elastic", "gt", "hardness"
-    with p_Y in Pa, "hardening" with k in Pa/m), counted as :func:`fit_hardening` counts them."""
-    return Results(_cs.ramp(_f64(heights, 2, "heights"), pixel_size, float(modulus), family,
-                            parameter, [float(f) for f in loads], radius, tolerance,
-                            max_iterations, imaging_fwhm, imaging_pixel_size))
+    with p_Y in Pa, "hardening" with k in Pa/m), on the body :func:`fit_hardening` builds from
+    the same arguments and counted as it counts them."""
+    return Results(_cs.ramp(_heights(heights), pixel_size, float(modulus), family, parameter,
+                            [float(f) for f in loads], radius, tolerance, max_iterations,
+                            imaging_fwhm, imaging_pixel_size, detrend, periodic))
 
 
 def misfit(forces: Sequence[float], areas: Sequence[float], simulated: Sequence[float]) -> float:
@@ -420,34 +451,100 @@ def misfit(forces: Sequence[float], areas: Sequence[float], simulated: Sequence[
                       [float(s) for s in simulated])
 
 
-def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
-                  pixel_size: PixelSize, modulus: float, radius: Optional[float] = None,
-                  family: str = "hardening", range: Optional["tuple[float, float]"] = None,
-                  grid: int = 7, ln_tolerance: float = 0.01, tolerance: float = 1e-8,
-                  max_iterations: int = 5000, imaging_fwhm: Optional[float] = None,
-                  imaging_pixel_size: Optional[PixelSize] = None, client: Any = None) -> Results:
-    """Fit a contact model to a measured area–load curve (``forces`` in N, ``areas`` in m²) on
-    the rough sphere (heights in m, pixel size in m, sphere ``radius`` in m, E* ``modulus`` in
-    Pa). "hardening" fits k (Pa/m; default range 1e14–1e17), "hardness" p_Y (Pa); "elastic"
-    and "gt" are evaluated once. Returns ``parameter``, ``parameter_se``, ``misfit``,
-    ``areas_m2`` at the best parameter and the search ``trace``.
+class FitResults(Results):
+    """The outcome of :func:`fit_hardening` (``fit.json`` in SI units): ``models`` (per model:
+    ``model``, ``misfit_rms_ln_area``, ``areas_m2``, ``k_pa_per_m`` or ``hardness_pa`` with
+    ``_se``, ``at_range_edge``, the search ``trace``), ``best_model``, ``measured``,
+    ``roughness``, ``warnings``. The attributes below describe the best model."""
 
-    With a ``dask.distributed`` ``client``, the model evaluations run as Dask tasks
+    _table = "models"
+
+    @property
+    def best(self) -> Dict[str, Any]:
+        """The model with the lowest misfit."""
+        return min(self["models"], key=lambda m: m["misfit_rms_ln_area"])
+
+    @property
+    def family(self) -> str:
+        return self.best["model"]
+
+    @property
+    def parameter(self) -> Optional[float]:
+        """k (Pa/m) or p_Y (Pa) of the best model; ``None`` for elastic and GT."""
+        b = self.best
+        return b.get("k_pa_per_m", b.get("hardness_pa"))
+
+    @property
+    def parameter_se(self) -> Optional[float]:
+        b = self.best
+        return b.get("k_pa_per_m_se", b.get("hardness_pa_se"))
+
+    @property
+    def misfit(self) -> float:
+        return self.best["misfit_rms_ln_area"]
+
+    @property
+    def areas_m2(self) -> np.ndarray:
+        return np.asarray(self.best["areas_m2"])
+
+    @property
+    def trace(self) -> list:
+        return self.best.get("trace", [])
+
+    @property
+    def at_range_edge(self) -> bool:
+        return self.best["at_range_edge"]
+
+
+def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
+                  pixel_size: Optional[PixelSize], modulus: float,
+                  radius: Optional[float] = None, family: Union[str, Sequence[str]] = "hardening",
+                  range: Optional["tuple[float, float]"] = None, grid: Optional[int] = None,
+                  ln_tolerance: Optional[float] = None, tolerance: Optional[float] = None,
+                  max_iterations: Optional[int] = None, imaging_fwhm: Optional[float] = None,
+                  imaging_pixel_size: Optional[PixelSize] = None, client: Any = None, *,
+                  detrend: str = "plane", periodic: bool = False) -> FitResults:
+    """Fit contact models to a measured area–load curve: the command line's ``fit-hardening``,
+    with its defaults, checks and warnings. The curve: ``forces`` (N) and ``areas`` (m²), or
+    ``forces`` an ``areas.csv`` written by ``analyze`` (``areas`` None). The rough sphere:
+    ``heights`` (a height-map file, or an array in m with ``pixel_size`` in m; detrended by
+    ``detrend``), sphere ``radius`` (m), E* ``modulus`` (Pa). ``family``: one model or a list
+    ("elastic", "gt", "hardness", "hardening"); "hardening" fits k (Pa/m; default range
+    1e14–1e17), "hardness" p_Y (Pa; 1e7–1e10) by a log grid (``grid``, default 7) then Brent's
+    method to ``ln_tolerance`` (default 0.01); "elastic" and "gt" are evaluated once.
+    ``imaging_fwhm`` and ``imaging_pixel_size`` count simulated areas as imaged.
+
+    Returns a :class:`FitResults` (``parameter``, ``parameter_se``, ``misfit``, ``areas_m2``,
+    ``trace`` of the best model; the whole ``fit.json`` in SI units). With a
+    ``dask.distributed`` ``client``, the model evaluations run as Dask tasks
     (:func:`contactscope.distributed.fit_hardening`).
     """
+    families = [family] if isinstance(family, str) else list(family)
     if client is not None:
         from . import distributed
 
+        if len(families) != 1 or isinstance(forces, (str, os.PathLike)):
+            raise InputError("a distributed fit takes one family and forces and areas")
         return distributed.fit_hardening(forces, areas, heights, pixel_size, modulus,
-                                         radius=radius, family=family, range=range, grid=grid,
-                                         ln_tolerance=ln_tolerance, tolerance=tolerance,
-                                         max_iterations=max_iterations,
+                                         radius=radius, family=families[0], range=range,
+                                         grid=grid, ln_tolerance=ln_tolerance,
+                                         tolerance=tolerance, max_iterations=max_iterations,
                                          imaging_fwhm=imaging_fwhm,
                                          imaging_pixel_size=imaging_pixel_size, client=client)
-    return Results(_cs.fit_hardening([float(f) for f in forces], [float(a) for a in areas],
-                                     _f64(heights, 2, "heights"), pixel_size, float(modulus),
-                                     radius, family, range, grid, ln_tolerance, tolerance,
-                                     max_iterations, imaging_fwhm, imaging_pixel_size))
+    if isinstance(forces, (str, os.PathLike)):
+        if areas is not None:
+            raise InputError("give forces and areas, or an areas.csv alone")
+        measured: Any = os.fspath(forces)
+    else:
+        if areas is None:
+            raise InputError("areas (m²) are needed with forces (N)")
+        measured = ([float(f) for f in forces], [float(a) for a in areas])
+    result = FitResults(_cs.fit_hardening(measured, _heights(heights), pixel_size,
+                                          float(modulus), radius, families, range, grid,
+                                          ln_tolerance, tolerance, max_iterations,
+                                          imaging_fwhm, imaging_pixel_size, detrend, periodic))
+    _warn(result)
+    return result
 
 
 # Seeded generators with known truth, and a TIFF writer (inputs for examples and tests).

@@ -104,18 +104,33 @@ def newton(
 def blur_and_resample(
     map: npt.NDArray[np.float64], pixel_size: PixelSize, fwhm: float, image_pixel_size: PixelSize
 ) -> npt.NDArray[np.float64]: ...
+class CompareResult(TypedDict):
+    simulation: str
+    psf_fwhm_m: float
+    experiment_threshold: float
+    simulated_threshold: float
+    dihedral_search: bool
+    upsample: int
+    force_tolerance_pct: float
+    loads_matched: int
+    dice_mean: float
+    jaccard_mean: float
+    method: Dict[str, str]
+    loads: List[Dict[str, Any]]
+    warnings: List[str]
+
 def compare(
-    micrographs: Stack,
-    forces: Sequence[float],
-    pixel_size: PixelSize,
-    maps: npt.NDArray[np.float64],
-    map_forces: Sequence[float],
-    map_pixel_size: PixelSize,
+    micrographs: Union[Stack, SeriesSpec],
+    forces: Optional[Sequence[float]],
+    pixel_size: Optional[PixelSize],
+    maps: Union[Path, npt.NDArray[np.float64]],
+    map_forces: Optional[Sequence[float]],
+    map_pixel_size: Optional[PixelSize],
     psf_fwhm: float,
-    dihedral: bool = False,
-    upsample: int = 20,
-    force_tolerance: float = 0.01,
-) -> List[Dict[str, Any]]: ...
+    dihedral: Optional[bool] = None,
+    upsample: Optional[int] = None,
+    force_tolerance: Optional[float] = None,
+) -> CompareResult: ...
 
 # Height maps and contact mechanics
 def read_topography(
@@ -199,36 +214,60 @@ def simulate(
     channel: Optional[str] = None,
     fill_invalid: Optional[str] = None,
 ) -> SimulateResult: ...
+class RampResult(TypedDict):
+    areas_m2: npt.NDArray[np.float64]
+    edge_contact: bool
+
 def ramp(
-    heights: npt.NDArray[np.float64],
-    pixel_size: PixelSize,
+    heights: Union[Path, npt.NDArray[np.float64]],
+    pixel_size: Optional[PixelSize],
     modulus: float,
     family: str,
     parameter: Optional[float],
     loads: Sequence[float],
     radius: Optional[float] = None,
-    tolerance: float = 1e-8,
-    max_iterations: int = 5000,
+    tolerance: Optional[float] = None,
+    max_iterations: Optional[int] = None,
     imaging_fwhm: Optional[float] = None,
     imaging_pixel_size: Optional[PixelSize] = None,
-) -> Dict[str, Any]: ...
+    detrend: str = "plane",
+    periodic: bool = False,
+) -> RampResult: ...
 def misfit(forces: Sequence[float], areas: Sequence[float], simulated: Sequence[float]) -> float: ...
+
+class FitResult(TypedDict):
+    experiment: str
+    topography: str
+    topography_channel: Optional[str]
+    fill_invalid: Optional[str]
+    radius_m: Optional[float]
+    contact_modulus_pa: float
+    roughness: Dict[str, float]
+    measured: Dict[str, List[float]]
+    simulated_areas: Dict[str, Any]
+    method: str
+    models: List[Dict[str, Any]]
+    best_model: Optional[str]
+    sweep_rows: int
+    warnings: List[str]
+
 def fit_hardening(
-    forces: Sequence[float],
-    areas: Sequence[float],
-    heights: npt.NDArray[np.float64],
-    pixel_size: PixelSize,
+    measured: Union[Path, Tuple[Sequence[float], Sequence[float]]],
+    heights: Union[Path, npt.NDArray[np.float64]],
+    pixel_size: Optional[PixelSize],
     modulus: float,
     radius: Optional[float] = None,
-    family: str = "hardening",
+    families: Optional[Sequence[str]] = None,
     range: Optional[Tuple[float, float]] = None,
-    grid: int = 7,
-    ln_tolerance: float = 0.01,
-    tolerance: float = 1e-8,
-    max_iterations: int = 5000,
+    grid: Optional[int] = None,
+    ln_tolerance: Optional[float] = None,
+    tolerance: Optional[float] = None,
+    max_iterations: Optional[int] = None,
     imaging_fwhm: Optional[float] = None,
     imaging_pixel_size: Optional[PixelSize] = None,
-) -> Dict[str, Any]: ...
+    detrend: str = "plane",
+    periodic: bool = False,
+) -> FitResult: ...
 
 # Generators and a writer
 def synth_series(

@@ -28,7 +28,7 @@ from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence
 
 import numpy as np
 
-from . import Results, _cs, _f64
+from . import FitResults, Results, _cs, _f64
 
 __all__ = ["local_client", "sweep", "fit_hardening", "brent_minimum"]
 
@@ -248,10 +248,10 @@ def brent_minimum(f: Callable[[float], float], lo: float, hi: float, tol: float,
 def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
                   pixel_size: Any, modulus: float, *, radius: Optional[float] = None,
                   family: str = "hardening", range: Optional["tuple[float, float]"] = None,
-                  grid: int = 7, ln_tolerance: float = 0.01, tolerance: float = 1e-8,
-                  max_iterations: int = 5000, imaging_fwhm: Optional[float] = None,
-                  imaging_pixel_size: Any = None, client: Any = None,
-                  threads_per_task: int = 1) -> Results:
+                  grid: Optional[int] = None, ln_tolerance: Optional[float] = None,
+                  tolerance: Optional[float] = None, max_iterations: Optional[int] = None,
+                  imaging_fwhm: Optional[float] = None, imaging_pixel_size: Any = None,
+                  client: Any = None, threads_per_task: int = 1) -> FitResults:
     """:func:`contactscope.fit_hardening` with every model evaluation (one load ramp) a Dask task.
 
     The same search as the library's: a log-spaced grid of ``grid`` values over ``range``
@@ -261,7 +261,11 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
     Misfit: RMS of ln(A_sim/A_exp) (forces in N, areas in m²). "elastic" and "gt" are one ramp.
     The result equals the serial path (``client="serial"``) exactly; it agrees with the
     library's own fit to the search tolerance (their Brent implementations differ in detail).
+    Returns a :class:`contactscope.FitResults` with one model (no ``measured`` or
+    ``roughness``: the tasks see only the ramps).
     """
+    grid = 7 if grid is None else grid
+    ln_tolerance = 0.01 if ln_tolerance is None else ln_tolerance
     forces = [float(f) for f in forces]
     areas = [float(a) for a in areas]
     if len(forces) != len(areas):
@@ -298,9 +302,7 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
             out = submit(None).result()
             if out["error"] is not None:
                 raise _cs.InputError(out["error"])
-            return Results(family=family, parameter=None, parameter_se=None,
-                           misfit=score(out), areas_m2=out["areas_m2"],
-                           edge_contact=out["edge_contact"], trace=[], at_range_edge=False)
+            return _fit_results(family, None, None, score(out), out["areas_m2"], [], False)
 
         a, b = math.log(lo), math.log(hi)
         xs = [a + (b - a) * i / (grid - 1) for i in builtins.range(grid)]
@@ -338,7 +340,19 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
             res = [math.log(max(s, 0.01 * e) / e) for s, e in zip(best_areas, ms)]
             s2 = sum(r * r for r in res) / (len(fs) - 1)
             se = math.exp(ln_best) * math.sqrt(s2 / jtj)
-    return Results(family=family, parameter=math.exp(ln_best), parameter_se=se,
-                   misfit=score(final), areas_m2=final["areas_m2"],
-                   edge_contact=final["edge_contact"], trace=trace, at_range_edge=at_edge)
+    return _fit_results(family, math.exp(ln_best), se, score(final), final["areas_m2"], trace,
+                        at_edge)
+
+
+def _fit_results(family: str, parameter: Optional[float], se: Optional[float], misfit: float,
+                 areas_m2: Any, trace: List[Any], at_edge: bool) -> FitResults:
+    """One fitted model in the shape of :func:`contactscope.fit_hardening`'s result."""
+    model: Dict[str, Any] = {"model": family, "misfit_rms_ln_area": misfit,
+                             "areas_m2": list(areas_m2), "evaluations": len(trace),
+                             "at_range_edge": at_edge, "trace": trace}
+    if parameter is not None:
+        key = "hardness_pa" if family == "hardness" else "k_pa_per_m"
+        model[key] = parameter
+        model[key + "_se"] = se
+    return FitResults(models=[model], best_model=family, warnings=[])
 

@@ -23,10 +23,12 @@ use serde::Serialize;
 
 use crate::analyze::files::{run_to_folder as analyze_to_folder, ImageOutputs};
 use crate::analyze::AnalyzeRequest;
-use crate::compare::{load_micrographs, ExperimentInput};
+use crate::compare::load_micrographs;
 use crate::error::{Error, Result};
-use crate::fit_hardening::{run_fit, FitRequest};
+use crate::fit_hardening::files::run_to_folder as fit_to_folder;
+use crate::fit_hardening::{BodyRequest, FitRequest, MeasuredInput};
 use crate::friction::{run_friction, FrictionRequest};
+use crate::heights::HeightInput;
 use crate::heights::TopographySource;
 use crate::hertz::{run_hertz, HertzRequest};
 use crate::newton::{run_newton, NewtonRequest};
@@ -613,39 +615,44 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
         ln_tolerance: 0.02,
         ..Search::default_for(family)
     };
-    let outcome = run_fit(&FitRequest {
-        experiment: work.join("analysis").join("areas.csv"),
-        topography: TopographySource {
-            path: data.join("topography.npy"),
-            pixel_size_m: Some((p.sim_pixel_m, p.sim_pixel_m)),
-            height_unit_m: None,
-            detrend: contactscope::surface::Detrend::None,
-            channel: None,
-            fill_invalid: None,
-        },
+    let body = BodyRequest {
         radius_m: Some(p.radius_m),
-        e_star_pa: p.e_star_pa,
-        periodic: false,
+        imaging: Some(Imaging {
+            fwhm_m: p.psf_fwhm_m,
+            pixel_m: (p.image_pixel_m, p.image_pixel_m),
+        }),
+        ..BodyRequest::new(
+            HeightInput::File(TopographySource {
+                path: data.join("topography.npy"),
+                pixel_size_m: Some((p.sim_pixel_m, p.sim_pixel_m)),
+                height_unit_m: None,
+                detrend: contactscope::surface::Detrend::None,
+                channel: None,
+                fill_invalid: None,
+            }),
+            p.e_star_pa,
+        )
+    };
+    let request = FitRequest {
         families: Family::ALL.to_vec(),
         searches: vec![
             (Family::Hardening, search(Family::Hardening)),
             (Family::Hardness, search(Family::Hardness)),
         ],
-        sweep: None,
-        micrographs: None,
-        options: solver_options(),
-        imaging: Some(Imaging {
-            fwhm_m: p.psf_fwhm_m,
-            pixel_m: (p.image_pixel_m, p.image_pixel_m),
-        }),
-        out_dir: work.join("fit"),
-        command_line: vec!["contactscope demo".into()],
-        progress: None,
-    })?;
+        ..FitRequest::new(
+            MeasuredInput::File(work.join("analysis").join("areas.csv")),
+            body,
+        )
+    };
+    let (outcome, _) = fit_to_folder(
+        &request,
+        &work.join("fit"),
+        &["contactscope demo".into()],
+        None,
+    )?;
     let parameter = |family: Family| {
         outcome
-            .fits
-            .iter()
+            .fits()
             .find(|f| f.family == family)
             .and_then(|f| f.best.parameter.map(|v| (v, f.parameter_se)))
             .ok_or_else(|| Error::InvalidArgument(format!("no {} fit", family.name())))
@@ -663,7 +670,7 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
         },
         k_pa_per_m: k,
         hardness_pa: hardness,
-        fits: outcome.fits.clone(),
+        fits: outcome.fits().cloned().collect(),
     })
 }
 
@@ -675,9 +682,10 @@ fn compare_models(
     fit: &FitResult,
 ) -> Result<Vec<(String, Comparison)>> {
     let (_, micrographs) = load_micrographs(
-        &ExperimentInput::Manifest(manifest.to_path_buf()),
-        &contactscope_formats::microscopy::select::Selection::default(),
-        None,
+        &Micrographs::Files(SeriesSpec {
+            manifest: Some(manifest.to_path_buf()),
+            ..SeriesSpec::default()
+        }),
         None,
     )?;
     let settings = CompareSettings {

@@ -78,7 +78,11 @@ impl Micrographs {
                                 Param::Manifest
                             )));
                         }
-                        from_manifest_selected(manifest, &spec.selection, spec.load_axis)?
+                        from_manifest_selected(
+                            &manifest_file(manifest)?,
+                            &spec.selection,
+                            spec.load_axis,
+                        )?
                     }
                     None => from_files_selected(&spec.inputs, &spec.selection, spec.load_axis)?,
                 };
@@ -92,6 +96,26 @@ impl Micrographs {
             }
             Micrographs::Memory(m) => m.open(),
         }
+    }
+}
+
+/// The manifest a path names: a CSV, or a folder holding `manifest.csv`.
+fn manifest_file(path: &std::path::Path) -> Result<PathBuf> {
+    if !path.is_dir() {
+        return Ok(path.to_path_buf());
+    }
+    let manifest = path.join("manifest.csv");
+    if manifest.is_file() {
+        Ok(manifest)
+    } else {
+        Err(Error::bad_input(
+            Location::file(path),
+            format!(
+                "no manifest: give a manifest CSV (file, page, force_mN) or a folder holding \
+                 manifest.csv, or image files with {}",
+                Param::Forces
+            ),
+        ))
     }
 }
 
