@@ -570,7 +570,7 @@ fn hertz_command_writes_its_outputs() {
     assert_eq!(summary["radius_um"].as_f64().unwrap(), 290.0);
     let predicted = summary["predicted"].as_array().unwrap();
     assert_eq!(predicted.len(), 2);
-    // validation.md B20: a = 6.172 µm at 4 mN, R = 290 µm, E* = 3.7 GPa.
+    // docs/validation.md B20: a = 6.172 µm at 4 mN, R = 290 µm, E* = 3.7 GPa.
     let a4 = predicted[0]["contact_radius_um"].as_f64().unwrap();
     assert!((a4 - 6.172).abs() < 5e-4, "{a4}");
     let (header, rows) = read_csv(&out.join("hertz_fit.csv"));

@@ -1,4 +1,4 @@
-//! Load sweeps with the contact models, against analytic limits (validation.md B7, B9, B10, B19,
+//! Load sweeps with the contact models, against analytic limits (docs/validation.md B7, B9, B10, B19,
 //! B21). Dimensionless Hertz geometry: R = 20, E* = 102, L = 5.
 
 use contactscope::analysis::fit::fit_power_law;
@@ -45,7 +45,7 @@ fn elastic_sweep_follows_hertz() {
     let steps = run(&topo, Model::Elastic, &loads);
     let areas: Vec<f64> = steps.iter().map(|s| s.area_m2).collect();
     let fit = fit_power_law(&loads, &areas).unwrap();
-    // validation.md B19: simulated Hertz areas at ≥ 5 loads give β = 0.667 ± 0.01 (pixel counting
+    // docs/validation.md B19: simulated Hertz areas at ≥ 5 loads give β = 0.667 ± 0.01 (pixel counting
     // on a 96² grid adds a little noise).
     assert!(
         (fit.exponent - 2.0 / 3.0).abs() < 0.02,
@@ -113,7 +113,7 @@ fn rough_sphere(n: usize, side: f64, amplitude: f64) -> Topography {
 
 #[test]
 fn volume_conserving_increment_matches_eq4_area() {
-    // validation.md B21 / the paper: on a rough sphere, where plastic patches are small, Eqs. 4
+    // docs/validation.md B21 / the paper: on a rough sphere, where plastic patches are small, Eqs. 4
     // and 5 give the same total area (2 %); Eq. 5 conserves volume and piles material up. (On a
     // smooth sphere whose whole contact yields the pile-up raises the rim pressure and the areas
     // differ by ~9 %, and on this rough sphere at p_Y = 3 by 4 %: the paper's statement holds
@@ -183,7 +183,7 @@ fn hardening_without_seed_and_path_independence() {
         &[15.0],
     );
     assert!(soft[0].area_m2 > 1.2 * elastic[0].area_m2);
-    // Monotone loading is path independent (methods.md §3.4): W/2 then W equals W directly.
+    // Monotone loading is path independent (docs/methods.md §3.4): W/2 then W equals W directly.
     let model = Model::Hardening {
         modulus_pa_per_m: 200.0,
         initial_pa: 2.0,

@@ -1,4 +1,4 @@
-//! Contact solver against analytic solutions (validation.md B3, B4, B5, B8), at grid sizes that
+//! Contact solver against analytic solutions (docs/validation.md B3, B4, B5, B8), at grid sizes that
 //! keep the suite fast; tolerances are stated per check.
 
 use contactscope::mechanics::hertz;
@@ -116,7 +116,7 @@ fn hertz_load_control() {
 
 #[test]
 fn flat_punch_stiffness() {
-    // validation.md B4: punch radius 20, domain 50, E* = 3.56: N/δ = 2aE* = 142.4 ± 0.5 %.
+    // docs/validation.md B4: punch radius 20, domain 50, E* = 3.56: N/δ = 2aE* = 142.4 ± 0.5 %.
     let (n, a, e) = (256, 20.0, 3.56);
     let dx = 50.0 / n as f64;
     let s: Vec<f64> = (0..n * n)
@@ -148,7 +148,7 @@ fn flat_punch_stiffness() {
 
 #[test]
 fn westergaard_periodic_sinusoid() {
-    // validation.md B5: λ = 1, s = h(1 − cos 2πx/λ), h = 0.01, E* = 1, periodic 256 × 4.
+    // docs/validation.md B5: λ = 1, s = h(1 − cos 2πx/λ), h = 0.01, E* = 1, periodic 256 × 4.
     let (nx, ny, h) = (256, 4, 0.01);
     let dx = 1.0 / nx as f64;
     let s: Vec<f64> = (0..nx * ny)
@@ -201,7 +201,7 @@ fn westergaard_periodic_sinusoid() {
 
 #[test]
 fn perfect_plasticity_under_load_control() {
-    // validation.md B8: Hertz geometry, 128², N = 15, cap p_Y = 3.
+    // docs/validation.md B8: Hertz geometry, 128², N = 15, cap p_Y = 3.
     let n = 128;
     let (s, dx) = sphere(n);
     let op = ElasticOperator::new(n, n, dx, dx, E, Boundary::Free);
@@ -271,7 +271,7 @@ fn perfect_plasticity_under_load_control() {
 
 #[test]
 fn implicit_hardening_step() {
-    // validation.md B9: p_Y = p_Y0 + k·h_pl, p_Y0 = 2, k = 200, N = 15, one step from h_pl = 0:
+    // docs/validation.md B9: p_Y = p_Y0 + k·h_pl, p_Y0 = 2, k = 200, N = 15, one step from h_pl = 0:
     // A = 5.7373, V_pl = 0.020510, max h_pl = 0.0082357, δ = 0.0870518 (1 % tolerance).
     let n = 128;
     let (s, dx) = sphere(n);
@@ -373,7 +373,7 @@ fn periodic_surface(n: usize) -> (Vec<f64>, f64, f64) {
 
 #[test]
 fn persson_slope_kappa_for_a_periodic_self_affine_surface() {
-    // validation.md B6: κ = (A/A₀)·E*h'_rms/p̄ in 1.8…2.4 (numerical reference on 512², seed 7 of
+    // docs/validation.md B6: κ = (A/A₀)·E*h'_rms/p̄ in 1.8…2.4 (numerical reference on 512², seed 7 of
     // numpy: 2.17, 2.18, 2.08 at p̄/(E*h') = 0.01, 0.03, 0.1). Measured here on 512², seed 7:
     // 2.40, 2.33, 2.10 — converged (unchanged from tolerance 1e-8 to 1e-11). The lowest load sits
     // at the range's edge and 10 % above the reference (three seeds: 2.35–2.45), so it is reported
@@ -406,7 +406,7 @@ fn persson_slope_kappa_for_a_periodic_self_affine_surface() {
 
 #[test]
 fn tiny_hardness_gives_the_bearing_area() {
-    // validation.md B7: p_Y = 1e-4·E*, δ with 5 % geometric overlap: the contact set equals the
+    // docs/validation.md B7: p_Y = 1e-4·E*, δ with 5 % geometric overlap: the contact set equals the
     // overlap set {s − δ < 0} up to 0.5 % of the contact pixels.
     let n = 256;
     let (s, dx, _) = periodic_surface(n);

@@ -16,7 +16,7 @@ fn rel(a: f64, b: f64) -> f64 {
     (a / b - 1.0).abs()
 }
 
-/// B6-like set-up of validation.md at 256²: L = 256 px, H = 0.8, roll-off at L/4, cutoff 8 px.
+/// B6-like set-up of docs/validation.md at 256²: L = 256 px, H = 0.8, roll-off at L/4, cutoff 8 px.
 fn b6(seed: u64, target: RmsTarget) -> SelfAffineParams {
     SelfAffineParams {
         nx: 256,
@@ -132,7 +132,7 @@ fn generator_hits_the_slope_target_of_each_estimator() {
     assert!(rel(SurfaceStats::spectral(&t).h_prime_rms, 0.1) < 1e-12);
     // With 8 px per shortest wavelength, central differences read low by the transfer function
     // sin(qΔ)/(qΔ) per component: the ensemble ratio for this spectrum is 0.9796 (sum over the
-    // discrete spectrum; methods.md §5.4 rounds it to 0.98). This realisation gives 0.977.
+    // discrete spectrum; docs/methods.md §5.4 rounds it to 0.98). This realisation gives 0.977.
     let ratio = rms_slope(&t).unwrap() / rms_slope_spectral(&t);
     assert!((ratio - 0.9796).abs() < 0.01, "central/spectral = {ratio}");
 }

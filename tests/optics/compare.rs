@@ -147,7 +147,7 @@ fn recovers_the_offset_and_overlaps_the_simulation() {
         .iter()
         .all(|r| r[header.iter().position(|h| h == "transform").unwrap()] == "identity"));
     // Blurring merges the sub-resolution patches, so thresholding the blurred map gives more area
-    // than the raw g = 0 pixels (methods.md §7.1): the reason both are reported.
+    // than the raw g = 0 pixels (docs/methods.md §7.1): the reason both are reported.
     let (raw, blurred) = (col("simulated_raw_area_um2"), col("simulated_area_um2"));
     for (r, b) in raw.iter().zip(&blurred) {
         assert!(b > r, "raw {r} µm² vs blurred {b} µm²");

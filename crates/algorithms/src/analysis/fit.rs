@@ -84,7 +84,7 @@ mod tests {
 
     #[test]
     fn hertz_areas_give_two_thirds() {
-        // validation.md B19: Hertz A(N) at N = 1…100 (log-spaced) gives β = 2/3 to 1e-12.
+        // docs/validation.md B19: Hertz A(N) at N = 1…100 (log-spaced) gives β = 2/3 to 1e-12.
         let forces: Vec<f64> = (0..12).map(|i| 10f64.powf(2.0 * i as f64 / 11.0)).collect();
         let areas: Vec<f64> = forces
             .iter()

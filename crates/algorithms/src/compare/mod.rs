@@ -1,5 +1,5 @@
 //! Simulated contact maps against micrographs, load by load (Weber et al. 2018, Fig. 2 and
-//! "Comparison with experiments"; methods.md §7.4 and §8).
+//! "Comparison with experiments"; docs/methods.md §7.4 and §8).
 //!
 //! Per load present in both (matched by force): the simulated contact map (pixels with g = 0) is
 //! blurred with the PSF and integrated onto the micrograph's pixels ([`crate::optics::blur`]),

@@ -45,7 +45,7 @@ mod tests {
 
     #[test]
     fn paper_scale() {
-        // validation.md B20: R = 290 µm, E* = 3.7 GPa: a = 6.172 µm at 4 mN, 28.649 µm at 400 mN.
+        // docs/validation.md B20: R = 290 µm, E* = 3.7 GPa: a = 6.172 µm at 4 mN, 28.649 µm at 400 mN.
         assert!((contact_radius(4e-3, 290e-6, 3.7e9) * 1e6 - 6.172).abs() < 5e-4);
         assert!((contact_radius(0.4, 290e-6, 3.7e9) * 1e6 - 28.649).abs() < 5e-4);
         let a = contact_radius(0.01, 290e-6, 3.7e9);
@@ -54,7 +54,7 @@ mod tests {
 
     #[test]
     fn reference_values() {
-        // validation.md B3 (CM `test_Hertz_refVals`): E* = 5, R = 4, F = 7.
+        // docs/validation.md B3 (CM `test_Hertz_refVals`): E* = 5, R = 4, F = 7.
         let rel = |a: f64, b: f64| (a - b).abs() / b;
         assert!(rel(approach(7.0, 4.0, 5.0), 0.6507879989531481) < 1e-7);
         assert!(rel(contact_radius(7.0, 4.0, 5.0), 1.6134286460245437) < 1e-7);

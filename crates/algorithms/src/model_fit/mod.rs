@@ -160,7 +160,7 @@ pub struct ModelBody {
     pub progress: Option<ProgressHook>,
 }
 
-/// How simulated maps are imaged before their area is counted (methods.md §7.1: apply the same
+/// How simulated maps are imaged before their area is counted (docs/methods.md §7.1: apply the same
 /// blur-and-threshold procedure to simulated maps as to micrographs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Imaging {

@@ -1,6 +1,6 @@
 //! Simulated contact maps as the microscope would see them: blur with a Gaussian PSF, then
 //! integrate over the camera's pixels (Weber et al. 2018, Fig. 2 and Methods: "convolved with the
-//! point spread function of the microscope"; methods.md §7.4).
+//! point spread function of the microscope"; docs/methods.md §7.4).
 //!
 //! Recorded choices:
 //! * **Order.** Blur on the simulation grid first, then integrate over image pixels. This is the
@@ -330,7 +330,7 @@ mod tests {
             .collect()
     }
 
-    /// validation.md B24: FWHM 450 nm, 32 nm simulation pixels, 200 nm image pixels: the image
+    /// docs/validation.md B24: FWHM 450 nm, 32 nm simulation pixels, 200 nm image pixels: the image
     /// sums to the contact area in image-pixel units to 1e-9.
     #[test]
     fn blur_preserves_mass_and_matches_gaussian_width() {

@@ -2,11 +2,11 @@
 //!
 //! * Free boundaries: the displacement under uniform unit pressure on one rectangular pixel
 //!   (Love 1929; K. L. Johnson, *Contact Mechanics*, 1985, §3.2, Eq. 3.25), written with `asinh`
-//!   so that the far field does not cancel catastrophically (methods.md §1.2):
+//!   so that the far field does not cancel catastrophically (docs/methods.md §1.2):
 //!   G(x, y) = [f(x+a, y+b) − f(x+a, y−b) − f(x−a, y+b) + f(x−a, y−b)] / (π E*),
 //!   f(X, Y) = X·asinh(Y/|X|) + Y·asinh(X/|Y|), a = Δx/2, b = Δy/2.
 //! * Periodic boundaries: the continuum multiplier û(q) = 2 p̂(q) / (E* |q|) (Johnson, Greenwood &
-//!   Higginson 1985, App. 1; methods.md §1.4), with the q = 0 mode set to zero: a mean pressure
+//!   Higginson 1985, App. 1; docs/methods.md §1.4), with the q = 0 mode set to zero: a mean pressure
 //!   produces no mean displacement, and under load control the approach δ is the Lagrange
 //!   multiplier of the load.
 
@@ -45,7 +45,7 @@ mod tests {
 
     #[test]
     fn self_coefficient_and_far_field() {
-        // validation.md B1: G(0,0) = (4/π) ln(1+√2) Δ/E* = 1.1221997 Δ/E*.
+        // docs/validation.md B1: G(0,0) = (4/π) ln(1+√2) Δ/E* = 1.1221997 Δ/E*.
         let g0 = love_pixel(0.0, 0.0, 1.0, 1.0, 1.0);
         let exact = 4.0 / std::f64::consts::PI * (1.0 + 2f64.sqrt()).ln();
         assert!((g0 - exact).abs() < 1e-12 * exact);

@@ -5,7 +5,7 @@
 //!   The kernel spectrum of the Love pixel response is computed once, and the round-trip
 //!   normalisation 1/(4N_xN_y) is folded into it.
 //! * [`Boundary::Periodic`]: the continuum multiplier 2/(E*|q|) on the N_y × N_x grid, q = 0 set
-//!   to zero (methods.md §1.4).
+//!   to zero (docs/methods.md §1.4).
 //!
 //! Both are symmetric positive (semi-)definite, as conjugate gradients need.
 //!
@@ -250,7 +250,7 @@ mod tests {
 
     #[test]
     fn free_operator_equals_direct_summation() {
-        // validation.md B1: zero-padded FFT product = direct O(N⁴) sum on a small grid, 1e-12.
+        // docs/validation.md B1: zero-padded FFT product = direct O(N⁴) sum on a small grid, 1e-12.
         let (ny, nx, dx, dy, e) = (16, 13, 0.7, 0.9, 2.5);
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         let p: Vec<f64> = (0..nx * ny).map(|_| rng.random_range(0.0..1.0)).collect();
@@ -325,7 +325,7 @@ mod tests {
 
     #[test]
     fn periodic_single_mode() {
-        // validation.md B2: p = p₀ cos(q·x) gives u = 2p₀/(E*|q|) cos(q·x); mean pressure gives 0.
+        // docs/validation.md B2: p = p₀ cos(q·x) gives u = 2p₀/(E*|q|) cos(q·x); mean pressure gives 0.
         let (ny, nx, dx, dy, e) = (8, 32, 0.5, 0.25, 3.0);
         let op = ElasticOperator::new(ny, nx, dx, dy, e, Boundary::Periodic);
         let (lx, ly) = (nx as f64 * dx, ny as f64 * dy);

@@ -2,7 +2,7 @@
 //! penetration hardness (bounded pressure, plastic displacement from the overlap, Eq. 4, or its
 //! volume-conserving form, Eq. 5), and linear contact hardening p_Y = p_Y0 + k·h_pl.
 //!
-//! Decisions on the open choices of methods.md §10, recorded here and in `docs/solver.md`:
+//! Decisions on the open choices of docs/methods.md §10, recorded here and in `docs/solver.md`:
 //! * **Eq. 4** (α = 1) is exact in one pass for a constant hardness: the overlap on capped pixels
 //!   becomes plastic displacement and the pressure does not change (§3.1, validation B8).
 //! * **Eq. 5** is implemented in its exactly volume-conserving form (§3.1): each yielding pixel's
@@ -490,7 +490,7 @@ mod tests {
 
     #[test]
     fn conserving_increment_sums_to_zero() {
-        // validation.md B21: Σ Δh_pl = 0 to round-off; the literal printed form would give −1 for
+        // docs/validation.md B21: Σ Δh_pl = 0 to round-off; the literal printed form would give −1 for
         // a lone yielding pixel with g = −1.
         let (nx, ny) = (7, 5);
         let mut overlap = vec![0.0; nx * ny];

@@ -1,6 +1,6 @@
 //! Radially averaged, mean-subtracted, normalised autocorrelation of an image (Wiener–Khinchin),
 //! as the paper compares experimental and simulated fluorescence images (Weber et al. 2018,
-//! Methods: patch scale ≈ 5 µm; methods.md §7.2).
+//! Methods: patch scale ≈ 5 µm; docs/methods.md §7.2).
 //!
 //! Recorded choices: the mean over the finite pixels is subtracted; the image is zero-padded to
 //! 2N_y × 2N_x so there is no wrap-around; the estimate is **unbiased**: the raw correlation at
@@ -253,7 +253,7 @@ mod tests {
 
     #[test]
     fn blurred_noise_has_correlation_length_two_sigma() {
-        // validation.md B17: white noise blurred by a Gaussian of σ_g has C(r) = exp(−r²/(4σ_g²)),
+        // docs/validation.md B17: white noise blurred by a Gaussian of σ_g has C(r) = exp(−r²/(4σ_g²)),
         // so ξ_1/e = 2σ_g (±3 %).
         let n = 512;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);

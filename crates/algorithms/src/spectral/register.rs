@@ -1,7 +1,7 @@
 //! Image registration by phase correlation with sub-pixel refinement by an upsampled DFT around
 //! the peak (Kuglin & Hines 1975; Guizar-Sicairos, Thurman & Fienup, Opt. Lett. 33, 156 (2008)),
 //! and a search over the eight dihedral transforms, because the microscope looks up through the
-//! coverslip while the AFM scanned the sphere from outside (methods.md §8).
+//! coverslip while the AFM scanned the sphere from outside (docs/methods.md §8).
 //!
 //! Sign convention (checked by a test): [`phase_correlation`] returns the shift `(dx, dy)` such
 //! that `moving(x, y) ≈ reference(x − dx, y − dy)`, i.e. how far the content moved.
@@ -369,7 +369,7 @@ mod tests {
         out.iter().map(|v| v / (n * n) as f64).collect()
     }
 
-    /// validation.md B18: integer circular shift (17, −9) exactly, with the documented sign.
+    /// docs/validation.md B18: integer circular shift (17, −9) exactly, with the documented sign.
     #[test]
     fn b18_integer_shift_is_exact() {
         let n = 256;
@@ -380,7 +380,7 @@ mod tests {
         assert!(s.peak > 0.99, "{}", s.peak);
     }
 
-    /// validation.md B18: a Fourier-shifted (−2.4, 1.32) px copy is found to ±0.05 px with
+    /// docs/validation.md B18: a Fourier-shifted (−2.4, 1.32) px copy is found to ±0.05 px with
     /// upsampling 20.
     #[test]
     fn b18_subpixel_shift_with_upsampling() {
@@ -399,7 +399,7 @@ mod tests {
         );
     }
 
-    /// validation.md B18: a mirrored copy is found only with the dihedral search on.
+    /// docs/validation.md B18: a mirrored copy is found only with the dihedral search on.
     #[test]
     fn b18_mirror_found_only_with_dihedral_search() {
         let n = 96;

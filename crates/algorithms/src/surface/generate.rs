@@ -1,6 +1,6 @@
 //! Seeded self-affine random surfaces by Fourier filtering (Ramisetti et al. 2011, J. Phys.:
 //! Condens. Matter 23, 215004; Jacobs, Junge, Pastewka 2017, Surf. Topogr. Metrol. Prop. 5,
-//! 013001; methods.md §5.2).
+//! 013001; docs/methods.md §5.2).
 //!
 //! Recipe: real Gaussian white noise `w ~ N(0, 1)` on the `ny × nx` grid → forward FFT →
 //! multiply by `sqrt(C(|q|))` with the isotropic PSD
@@ -38,7 +38,7 @@ pub enum RmsTarget {
     /// returns exactly this value.
     Slope(f64),
     /// rms slope by the spectral estimator ([`super::stats::rms_slope_spectral`]), as in the
-    /// B6 set-up of validation.md ("spectral h'_rms normalised to 0.1").
+    /// B6 set-up of docs/validation.md ("spectral h'_rms normalised to 0.1").
     SpectralSlope(f64),
 }
 

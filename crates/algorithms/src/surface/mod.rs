@@ -3,12 +3,12 @@
 //! A [`Topography`] holds heights in metres on a regular grid, row-major `(y, x)`, with heights
 //! **positive towards the counter-surface** (the apex of a sphere is the maximum), as measured on
 //! a sphere's top by AFM. The solver converts to the undeformed separation
-//! `s = max(h) − h` (`docs/conventions.md`, methods.md §0).
+//! `s = max(h) − h` (`docs/conventions.md`, docs/methods.md §0).
 //!
 //! * [`stats`] — rms height, slope and curvature (finite-difference and spectral estimators) and
 //!   the radially averaged power spectral density (Jacobs, Junge, Pastewka 2017).
 //! * [`generate`] — seeded self-affine random surfaces by Fourier filtering (Ramisetti et al.
-//!   2011; methods.md §5.2).
+//!   2011; docs/methods.md §5.2).
 //! * [`masked`] — the same statistics over the valid points of a map as an instrument stored it
 //!   (invalid points NaN); [`fill`] — filling those points on request.
 //! * Reading and writing height maps (`.npy`, float TIFF, Gwyddion `.gsf`, text matrices, WSxM
@@ -113,7 +113,7 @@ impl Topography {
     /// Root-mean-square height about the mean, `sqrt(⟨(h − ⟨h⟩)²⟩)`, in metres, over every pixel.
     /// No detrending beyond the mean: call [`Topography::remove_plane`] (or
     /// [`Topography::detrend`]) first where a tilt should not count as roughness
-    /// (methods.md §5.4).
+    /// (docs/methods.md §5.4).
     pub fn rms_height(&self) -> f64 {
         let mean = self.mean();
         let sum: f64 = self.heights.iter().map(|h| (h - mean) * (h - mean)).sum();
@@ -162,7 +162,7 @@ impl Topography {
     /// Add a spherical cap of radius `radius_m` in its small-slope (paraboloid) form
     /// `−r²/(2R)`, centred on the map centre (pixel centres `(nx − 1)/2`, `(ny − 1)/2`), so
     /// that the apex is the highest point: heights are positive towards the counter-surface
-    /// (methods.md §0, `s = r²/(2R) − z_rough`).
+    /// (docs/methods.md §0, `s = r²/(2R) − z_rough`).
     pub fn add_sphere(&mut self, radius_m: f64) -> Result<()> {
         if !(radius_m.is_finite() && radius_m > 0.0) {
             return Err(Error::InvalidArgument(format!(
@@ -179,7 +179,7 @@ impl Topography {
     }
 }
 
-/// Detrending applied to a measured map before statistics (methods.md §5.4: "record which").
+/// Detrending applied to a measured map before statistics (docs/methods.md §5.4: "record which").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Detrend {
     /// Heights as read.

@@ -2,7 +2,7 @@
 //!
 //! # Estimators (recorded in `docs/conventions.md`, "Roughness statistics")
 //! Weber et al. (2018) use the asperity radius `β = 1/h''_rms` and `η·h_rms·β ≈ 0.05` without
-//! defining the estimators (methods.md §4.1, §5.4, §10 item 6). The choices made here:
+//! defining the estimators (docs/methods.md §4.1, §5.4, §10 item 6). The choices made here:
 //!
 //! * `h_rms`: rms about the mean over every pixel ([`Topography::rms_height`]); detrend first
 //!   where needed (the caller records which [`super::Detrend`]).
@@ -10,10 +10,10 @@
 //!   (`(h[i][j+1] − h[i][j−1])/(2Δx)`, likewise in y; rows and columns `1..n−1`). Central rather
 //!   than forward differences because both components then sit on the same point; for a
 //!   spectrum that reaches the grid scale it underestimates more than forward differences do
-//!   (methods.md §5.4: 0.85 vs 0.95 of the spectral value at H = 0.8 with q_s at Nyquist).
+//!   (docs/methods.md §5.4: 0.85 vs 0.95 of the spectral value at H = 0.8 with q_s at Nyquist).
 //! * `h''_rms` = rms of the **full Laplacian** `∂²h/∂x² + ∂²h/∂y²` with the **5-point stencil**
 //!   on interior points, as PyCo's `compute_rms_curvature` did in January 2018 (before the
-//!   November 2019 change to half the Laplacian; methods.md §4.1). The paper predates the change.
+//!   November 2019 change to half the Laplacian; docs/methods.md §4.1). The paper predates the change.
 //!   For an isotropic Gaussian surface, rms(∇²h) = sqrt(8/3)·rms(∂²h/∂x²).
 //! * Spectral estimators for periodic maps ([`SurfaceStats::spectral`]):
 //!   `h'_rms² = (1/A₀) Σ_q q² C(q)`, `h''_rms² = (1/A₀) Σ_q q⁴ C(q)`, summed over the full
@@ -21,7 +21,7 @@
 //!   Surf. Topogr. Metrol. Prop. 5, 013001, Eqs. for the spectral moments). On a non-periodic
 //!   map the jump at the boundary inflates them; use the finite-difference estimators there.
 //!
-//! # PSD normalisation (methods.md §5.1)
+//! # PSD normalisation (docs/methods.md §5.1)
 //! `C(q) = |ĥ(q)|²/A₀` with `ĥ(q) = ΔA·DFT(h)` (unnormalised DFT, ΔA = ΔxΔy, A₀ = nx·ny·ΔA),
 //! `q = 2π(mx/Lx, my/Ly)` in rad/m. Parseval: `h_rms² = (1/A₀) Σ_{q≠0} C(q)` over the full
 //! spectrum, i.e. `(2π)⁻² ∫ d²q C(q)` in the continuum. Persson's (2006) C differs by (2π)²
@@ -109,7 +109,7 @@ pub fn rms_slope(topography: &Topography) -> Result<f64> {
 }
 
 /// rms of the full Laplacian `∂²h/∂x² + ∂²h/∂y²` by the 5-point stencil on interior points,
-/// in 1/m (PyCo 2018 definition; methods.md §4.1).
+/// in 1/m (PyCo 2018 definition; docs/methods.md §4.1).
 pub fn rms_laplacian(topography: &Topography) -> Result<f64> {
     need_interior(topography, "the rms curvature")?;
     let a = 1.0 / (topography.dx_m * topography.dx_m);
@@ -205,7 +205,7 @@ pub fn rms_laplacian_spectral(topography: &Topography) -> f64 {
 /// on the grid, the corner of the spectrum), each giving `(mean |q|, mean C)` over the
 /// full-spectrum bins it holds, in (rad/m, m⁴). Empty annuli are left out; q = 0 is excluded.
 /// Same normalisation as [`psd`], so that for an isotropic surface
-/// `h_rms² ≈ (1/2π) ∫ q C(q) dq` (methods.md §5.1).
+/// `h_rms² ≈ (1/2π) ∫ q C(q) dq` (docs/methods.md §5.1).
 pub fn radial_psd(topography: &Topography, bins: usize) -> Result<Vec<(f64, f64)>> {
     if bins == 0 {
         return Err(Error::InvalidArgument(

@@ -223,7 +223,7 @@ mod tests {
 
     #[test]
     fn gaussian_mixture_threshold_near_midpoint() {
-        // validation.md B16 asks for t ≈ 100 ± 1 for equal-weight Gaussians at 50 and 150. That
+        // docs/validation.md B16 asks for t ≈ 100 ± 1 for equal-weight Gaussians at 50 and 150. That
         // holds when the classes overlap (σ = 15 here). With σ = 5 the valley between the peaks
         // is empty, σ_B² is flat across it, and the first-maximum rule returns the valley's
         // lowest bin: the last occupied level of the lower peak.

@@ -99,7 +99,7 @@ mod tests {
 
     #[test]
     fn large_counts_do_not_overflow() {
-        // validation.md B16: 10 M at 10, 1 M at 128, 20 M at 250 must give 128 (imageproc's
+        // docs/validation.md B16: 10 M at 10, 1 M at 128, 20 M at 250 must give 128 (imageproc's
         // otsu_level overflows here and returns 10).
         let mut counts = vec![0u64; 256];
         counts[10] = 10_000_000;

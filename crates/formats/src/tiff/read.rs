@@ -1,7 +1,7 @@
 //! TIFF pages → [`Plane`]s, with the facts `contactscope info` prints.
 //!
 //! Built on the `tiff` crate's decoder. Two of its behaviours are handled here on purpose
-//! (`../shared/docs/images.md` §2): `read_image` returns only the first plane of a planar
+//! (`docs/formats.md`, TIFF): `read_image` returns only the first plane of a planar
 //! (PlanarConfiguration = 2) file, so we use `read_image_to_buffer` and check that every plane
 //! arrived; and packed 12-bit or palette images are reported as unsupported, never guessed at.
 //! Reduced-resolution pages (NewSubfileType bit 0, e.g. LSM thumbnails) are skipped.

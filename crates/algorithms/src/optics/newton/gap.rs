@@ -1,6 +1,6 @@
 //! The two formulas behind the Newton-ring analysis and the fit that joins them:
 //! ring gaps d_m (Weber et al. 2018, Eq. 1) and the Hertz exterior gap g(r; a, R)
-//! (K. L. Johnson, *Contact Mechanics*, 1985, §4.2; `methods.md` §6.1). SI units.
+//! (K. L. Johnson, *Contact Mechanics*, 1985, §4.2; `docs/methods.md` §6.1). SI units.
 
 use std::f64::consts::PI;
 
@@ -168,7 +168,7 @@ mod tests {
         (a / b - 1.0).abs()
     }
 
-    /// validation.md B13: λ = 488 nm, n = 1.447.
+    /// docs/validation.md B13: λ = 488 nm, n = 1.447.
     #[test]
     fn b13_ring_gaps() {
         let expected = [84.31, 252.94, 421.56, 590.19, 758.81, 927.44];
@@ -190,7 +190,7 @@ mod tests {
         );
     }
 
-    /// validation.md B14: a = R = 1, g(10) = 49.042484; near the edge
+    /// docs/validation.md B14: a = R = 1, g(10) = 49.042484; near the edge
     /// g / (a^½ (r − a)^{3/2} / R) → 8√2/(3π) = 1.20042.
     #[test]
     fn b14_hertz_exterior_gap() {

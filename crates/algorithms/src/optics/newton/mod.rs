@@ -1,5 +1,5 @@
 //! Newton rings and the detection gap (Weber et al. 2018, Methods, "Newton rings", Eq. 1;
-//! `methods.md` §7.5; `docs/optics.md`).
+//! `docs/methods.md` §7.5; `docs/optics.md`).
 //!
 //! A reflection image shows Newton rings around the contact: intensity maxima where the gap is
 //! d_m = (m + ½)·λ/(2n). A fluorescence image of the same field shows the contact where the

@@ -1,7 +1,7 @@
 //! Image side of the Newton-ring analysis: the fluorescent contact (exact Otsu threshold, largest
 //! 8-connected component, centroid), width-averaged line profiles through the centre with
 //! bilinear interpolation, light smoothing, the fluorescence edge on a profile and ring maxima
-//! found by prominence (`methods.md` §7.5, steps 1–3).
+//! found by prominence (`docs/methods.md` §7.5, steps 1–3).
 
 use crate::error::{Error, Location, Result};
 use crate::image::Image;

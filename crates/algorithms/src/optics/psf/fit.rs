@@ -1,5 +1,5 @@
 //! One bead on one plane: window, background, centre of intensity, radial profile and the two
-//! Gaussian fits (Weber et al. 2018, Methods: Microscopy; `methods.md` §7.3 steps 1–5).
+//! Gaussian fits (Weber et al. 2018, Methods: Microscopy; `docs/methods.md` §7.3 steps 1–5).
 //!
 //! Pixel coordinates are pixel centres: pixel (x, y) sits at (x, y), so a spot centred between
 //! two pixels has a half-integer centre.

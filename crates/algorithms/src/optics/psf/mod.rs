@@ -2,7 +2,7 @@
 //!
 //! Weber et al. 2018, Methods (Microscopy): 100 nm beads imaged under the contact experiments'
 //! conditions, "radially averaged around the center of intensity to obtain a Gaussian profile"
-//! of FWHM 450 nm. The procedure is `../shared/docs/methods.md` §7.3; the choices made here are
+//! of FWHM 450 nm. The procedure is `docs/methods.md` §7.3; the choices made here are
 //! written down in `docs/optics.md` ("PSF from beads"):
 //!
 //! 1. Candidates ([`detect()`]): local maxima of the image (or of the maximum projection of a

@@ -1,4 +1,4 @@
-//! Why a bead candidate is not used (methods.md §7.3: isolated, unsaturated, in-focus beads only).
+//! Why a bead candidate is not used (docs/methods.md §7.3: isolated, unsaturated, in-focus beads only).
 
 use super::{Candidate, PlaneView, PsfOptions, SpotFit};
 

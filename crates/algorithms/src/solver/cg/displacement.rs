@@ -1,4 +1,4 @@
-//! Contact at an imposed approach δ (methods.md §2.2), with the pressure bounded as a
+//! Contact at an imposed approach δ (docs/methods.md §2.2), with the pressure bounded as a
 //! [`Plasticity`] says (§2.3, §3.4): CG over a working set of free pixels plus the pixels that
 //! violate complementarity, restarting when the set changes or a step is clipped.
 
@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 
 use super::{finish, Plasticity, Problem, Solution, SolverOptions};
 
-/// Contact at imposed approach δ (methods.md §2.2), with the pressure bounded as `plasticity`
+/// Contact at imposed approach δ (docs/methods.md §2.2), with the pressure bounded as `plasticity`
 /// says (§2.3, §3.4). `warm` is a starting pressure (e.g. the previous load step's).
 pub fn solve_displacement(
     problem: &Problem,

@@ -1,6 +1,6 @@
 //! Polonsky–Keer constrained conjugate gradients (I. A. Polonsky & L. M. Keer, Wear 231, 206
 //! (1999)), with the bounded-pressure modification of Weber et al. 2018 (Methods: Plasticity
-//! models; Almqvist et al. 2007) and the implicit hardening step of methods.md §3.4.
+//! models; Almqvist et al. 2007) and the implicit hardening step of docs/methods.md §3.4.
 //!
 //! Sign conventions (`docs/conventions.md`): separation s ≥ 0, approach δ > 0 pushes the bodies
 //! together, compressive pressure p ≥ 0, displacement u = G∗p ≥ 0 away from the counter-surface,
@@ -148,7 +148,7 @@ pub enum Plasticity<'a> {
     Elastic,
     /// Penetration hardness: 0 ≤ p ≤ cap (per pixel).
     Cap(&'a [f64]),
-    /// Implicit linear hardening within one load step (methods.md §3.4): pressure above
+    /// Implicit linear hardening within one load step (docs/methods.md §3.4): pressure above
     /// `yield_pressure` compresses a local spring of compliance `compliance` (= 1/k) in series
     /// with the half-space.
     Hardening {

@@ -5,7 +5,7 @@
 //! * [`solve_load_pk`] — elastic load control as Polonsky & Keer 1999 (§2) wrote it, restarting
 //!   CG whenever any pixel enters the contact (Tamaas has the same rule).
 //! * [`solve_load_bounded`] — load control with a bounded pressure by an outer Illinois root-find
-//!   on the approach δ over displacement-controlled solves (methods.md §2.3(a)).
+//!   on the approach δ over displacement-controlled solves (docs/methods.md §2.3(a)).
 
 use rayon::prelude::*;
 
@@ -143,7 +143,7 @@ fn sum_over_union(a: &[usize], b: &[usize], f: impl Fn(usize) -> f64) -> f64 {
 }
 
 /// Load control with a bounded pressure: an outer Illinois (regula falsi) root-find on δ for
-/// W(δ) = force, warm-starting each inner displacement-controlled solve (methods.md §2.3(a)).
+/// W(δ) = force, warm-starting each inner displacement-controlled solve (docs/methods.md §2.3(a)).
 /// W(δ) is non-decreasing, so the bracket never fails for a feasible load.
 pub fn solve_load_bounded(
     problem: &Problem,

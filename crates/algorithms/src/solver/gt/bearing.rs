@@ -7,7 +7,7 @@ use super::profile::GtProfile;
 use crate::error::{Error, Result};
 use crate::surface::Topography;
 
-/// The GT bearing-area contact map (Weber et al. 2018, Fig. 2b; `methods.md` §4.4).
+/// The GT bearing-area contact map (Weber et al. 2018, Fig. 2b; `docs/methods.md` §4.4).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactMap {
     /// Contact pixels, shape `(ny, nx)` like the roughness map.
@@ -27,7 +27,7 @@ pub struct ContactMap {
 }
 
 /// Overlays a roughness map on the GT separation profile: a pixel is in contact where
-/// z_rough(x, y) ≥ u_GT(r(x, y)) (`methods.md` §4.4).
+/// z_rough(x, y) ≥ u_GT(r(x, y)) (`docs/methods.md` §4.4).
 ///
 /// `roughness` is the measured **roughness** z_rough, not the sphere: heights in m with the mean
 /// plane removed, positive towards the flat (the [`Topography`] convention); the caller removes

@@ -23,7 +23,7 @@ pub(super) fn erfc(x: f64) -> f64 {
 /// Implemented for the orders the model needs, n = 0, ½, 1 and 3/2 (F₀ is the fraction of
 /// summits in contact, F₁ their area, F_{3/2} their load; F_{1/2} = −(2/3)·dF_{3/2}/dt enters the
 /// Newton Jacobian); any other `n` returns NaN. Relative accuracy is about 1e-13 or better
-/// wherever the value is a normal floating-point number (`validation.md` B11 asks for 1e-7):
+/// wherever the value is a normal floating-point number (`docs/validation.md` B11 asks for 1e-7):
 ///
 /// * F₀(t) = ½·erfc(t/√2) and F₁(t) = φ(t) − t·F₀(t) in closed form;
 /// * F_{1/2}, F_{3/2}: with z = t + s², F_n(t) = ∫_0^∞ 2s^{2n+1} φ(s² + t) ds, whose integrand is
@@ -124,7 +124,7 @@ pub(super) fn f_moment_expansion(n: f64, big_t: f64) -> f64 {
 /// complementary modulus k′ (its parameter form ellipk(m = k²) loses up to 2.7e-11 near k = 1);
 /// against 50-digit mpmath values up to k = 1 − 2⁻⁴⁵ it matches ours for K (1.7e-16) and is
 /// better for E (3.8e-16 against 3.8e-15), far below anything the GT model needs (1e-7,
-/// `validation.md` B11). But one pass of this mean gives both integrals, where the crate needs
+/// `docs/validation.md` B11). But one pass of this mean gives both integrals, where the crate needs
 /// two evaluations: 47 against 31 ns per pair, and the GT kernel build (256 points) takes 9.0 ms
 /// instead of 7.0 ms.
 pub(super) fn elliptic_pair(k: f64) -> (f64, f64) {
@@ -171,7 +171,7 @@ pub fn elliptic_e(k: f64) -> f64 {
 }
 
 /// The ring-load kernel (2/π)·Λ(ξ), Λ(ξ) = ξ·K(ξ) for ξ < 1 and K(1/ξ) for ξ > 1
-/// (`methods.md` §4.2): the deflection at radius r per unit pressure on the ring at radius rξ.
+/// (`docs/methods.md` §4.2): the deflection at radius r per unit pressure on the ring at radius rξ.
 /// It tends to 1 as ξ → ∞, vanishes like ξ at 0 and has an integrable logarithmic singularity at
 /// ξ = 1 (returned as ∞). Negative or NaN ξ gives NaN.
 pub fn ring_kernel(xi: f64) -> f64 {

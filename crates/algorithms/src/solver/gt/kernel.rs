@@ -187,7 +187,7 @@ impl RadialKernel {
         }
     }
 
-    /// Damped fixed point p̃ ← (1 − m)·p̃ + m·μ·F_{3/2}(…) (`methods.md` §4.3): the undamped map
+    /// Damped fixed point p̃ ← (1 − m)·p̃ + m·μ·F_{3/2}(…) (`docs/methods.md` §4.3): the undamped map
     /// overshoots because a higher pressure raises the separation that lowers it.
     fn fixed_point(
         &self,
@@ -437,7 +437,7 @@ pub(super) fn solve_dense(mut a: Vec<f64>, mut b: Vec<f64>) -> Option<Vec<f64>> 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ScaledMethod {
     /// Damped fixed point p̃ ← (1 − m)·p̃ + m·μ·F_{3/2}(…) with mixing m in (0, 1]
-    /// (ContactMechanics' scheme, `methods.md` §4.3). Converges only while m·μ·(3/2)·F_{1/2}
+    /// (ContactMechanics' scheme, `docs/methods.md` §4.3). Converges only while m·μ·(3/2)·F_{1/2}
     /// times the kernel norm stays below about 2, i.e. away from the Hertz limit.
     FixedPoint {
         /// Mixing m; ContactMechanics' default is 0.1.

@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 pub struct GtParams {
     /// Sphere radius R, m.
     pub sphere_radius_m: f64,
-    /// Contact modulus E* (`methods.md` §0), Pa.
+    /// Contact modulus E* (`docs/methods.md` §0), Pa.
     pub e_star_pa: f64,
     /// Rms roughness height h_rms, m; used as the summit-height deviation σ.
     pub h_rms_m: f64,
@@ -189,7 +189,7 @@ pub fn gt_profile(params: &GtParams, force_n: f64) -> Result<GtProfile> {
 /// Solves the GT model of a rough sphere under the normal force `force_n` (N).
 ///
 /// The central separation d is found by a bracketing root search on ln N(d), which decreases
-/// monotonically with d (`methods.md` §4.3 item 3); every solve at fixed d uses Newton's method,
+/// monotonically with d (`docs/methods.md` §4.3 item 3); every solve at fixed d uses Newton's method,
 /// warm-started from the previous one. The grid runs to ρ_max = 2·ρ_Hertz + 5 (ρ_Hertz: the
 /// Hertz radius in units of √(2Rσ); the 5 covers the rough tail at light loads) and is extended
 /// by half until the pressure at ρ_max is below 1e-6 of the central pressure.

@@ -1,4 +1,4 @@
-//! Tests of the Greenwood–Tripp model (validation.md B11, B12) against references.
+//! Tests of the Greenwood–Tripp model (docs/validation.md B11, B12) against references.
 
 use std::f64::consts::PI;
 
@@ -42,7 +42,7 @@ fn tanh_sinh(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
 
 #[test]
 fn b11_special_values() {
-    // validation.md B11, quoted to 7 decimals.
+    // docs/validation.md B11, quoted to 7 decimals.
     assert!((gt_f(0.0, 1.0) - 0.1586553).abs() < 5e-8);
     assert!((gt_f(1.0, 0.0) - 0.3989423).abs() < 5e-8);
     assert!((gt_f(1.5, 0.0) - 0.4300200).abs() < 5e-8);
@@ -197,7 +197,7 @@ fn one_percent_radius(s: &ScaledSolution) -> f64 {
 
 #[test]
 fn b12_contact_mechanics_reference() {
-    // validation.md B12: μ = 24.0425586841, 100 points on [0, 5], mixing 0.1, tol 1e-6.
+    // docs/validation.md B12: μ = 24.0425586841, 100 points on [0, 5], mixing 0.1, tol 1e-6.
     let fixed = ScaledMethod::FixedPoint { mixing: 0.1 };
     for (d_star, p0, load, rho1) in [(0.5, 4.69319, 44.1697, 2.58), (1.0, 1.81926, 5.35602, 1.67)] {
         let s = b12(d_star, fixed);
@@ -393,7 +393,7 @@ fn bearing_area_beyond_the_profile_follows_the_sphere() {
 #[test]
 fn bearing_fraction_of_gaussian_roughness_is_f0() {
     // i.i.d. Gaussian heights of deviation σ: a pixel at separation u is in contact with
-    // probability F₀(u/σ) (methods.md §4.4), so the count matches Σ F₀ within noise.
+    // probability F₀(u/σ) (docs/methods.md §4.4), so the count matches Σ F₀ within noise.
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
     let (params, profile) = rough_profile();
@@ -423,7 +423,7 @@ fn bearing_fraction_of_gaussian_roughness_is_f0() {
         (observed - mean).abs() < 5.0 * variance.sqrt(),
         "{observed} vs {mean}"
     );
-    // The overlap differs from GT's own area (methods.md §4.4); both are reported.
+    // The overlap differs from GT's own area (docs/methods.md §4.4); both are reported.
     assert!(map.gt_area_m2 > 0.0 && map.gt_area_m2 != map.area_m2);
 }
 

@@ -1,5 +1,5 @@
 //! Load control for every model in one constrained-CG run (Polonsky & Keer, Wear 231, 206 (1999),
-//! §2, generalised to the bounded and hardening problems of methods.md §2.3 and §3.4).
+//! §2, generalised to the bounded and hardening problems of docs/methods.md §2.3 and §3.4).
 //!
 //! All three models minimise a convex energy of the pressure under the load constraint
 //! ΔA·Σp = W:
