@@ -21,7 +21,67 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
-    /// An argument or value given by the caller is invalid (unit, count, range).
+    /// A number given to an algorithm that it cannot take (not positive, not finite, outside
+    /// its interval), with the number.
+    #[error("{what} {value} {unit} {requirement}")]
+    Value {
+        /// What it is (with the algorithm, where that helps: "Greenwood–Tripp: force").
+        what: &'static str,
+        /// The value given.
+        value: f64,
+        /// Its unit ("" for a pure number).
+        unit: &'static str,
+        /// What it must be ("must be positive and finite").
+        requirement: &'static str,
+    },
+    /// Two sizes that must agree do not.
+    #[error("{what}: {got} given for {expected}")]
+    SizeMismatch {
+        /// What was counted.
+        what: &'static str,
+        /// The size it must have.
+        expected: usize,
+        /// The size it has.
+        got: usize,
+    },
+    /// Fewer items than an algorithm needs.
+    #[error("{what} needs at least {needed} (got {got})")]
+    TooFew {
+        /// What needs them.
+        what: &'static str,
+        /// The minimum.
+        needed: usize,
+        /// How many there are.
+        got: usize,
+    },
+    /// A load heavier than a penetration hardness can carry on the whole map.
+    #[error("load {load_n:.4e} N exceeds what the hardness can carry on the whole map ({capacity_n:.4e} N)")]
+    ExceedsCapacity {
+        /// The load, N.
+        load_n: f64,
+        /// Hardness × map area, N.
+        capacity_n: f64,
+    },
+    /// A work size beyond the limits.
+    #[error("{what}: {source}")]
+    Limit {
+        /// The work it was for.
+        what: String,
+        /// The size and the limit.
+        #[source]
+        source: contactscope_formats::limits::LimitError,
+    },
+    /// A name that is not one of the choices.
+    #[error("unknown {what} '{name}': use {choices}")]
+    UnknownName {
+        /// What the name names.
+        what: &'static str,
+        /// The name given.
+        name: String,
+        /// The choices, in words.
+        choices: &'static str,
+    },
+    /// An argument or value given by the caller is invalid; the message says why.
     #[error("{0}")]
     InvalidArgument(String),
     /// No threshold exists: all pixels have one value.
@@ -73,6 +133,16 @@ pub enum Error {
 }
 
 impl Error {
+    /// [`Error::Value`] for a number that must be positive and finite.
+    pub fn not_positive(what: &'static str, value: f64, unit: &'static str) -> Self {
+        Error::Value {
+            what,
+            value,
+            unit,
+            requirement: "must be positive and finite",
+        }
+    }
+
     /// A bad-input error at a location.
     pub fn bad_input(at: Location, reason: impl Into<String>) -> Self {
         Error::BadInput {

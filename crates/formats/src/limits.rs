@@ -6,6 +6,66 @@
 //! image-tiff's `Limits` (a decoding budget); these limits are far above any real image or
 //! simulation and far below what would exhaust a workstation.
 
+/// A work size beyond the [`Limits`], with the numbers.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum LimitError {
+    /// A plane with no pixels.
+    #[error("a {nx}×{ny} plane has no pixels")]
+    EmptyPlane {
+        /// Columns.
+        nx: usize,
+        /// Rows.
+        ny: usize,
+    },
+    /// A side longer than [`Limits::max_side`].
+    #[error("a {nx}×{ny} plane exceeds the limit of {limit} pixels per side")]
+    SideTooLong {
+        /// Columns.
+        nx: usize,
+        /// Rows.
+        ny: usize,
+        /// The limit.
+        limit: usize,
+    },
+    /// More bytes than [`Limits::max_plane_bytes`].
+    #[error(
+        "a {nx}×{ny} plane of {bytes_per_value}-byte values exceeds the {limit_mib} MiB limit"
+    )]
+    PlaneTooLarge {
+        /// Columns.
+        nx: usize,
+        /// Rows.
+        ny: usize,
+        /// Bytes per value.
+        bytes_per_value: usize,
+        /// The limit, MiB.
+        limit_mib: usize,
+    },
+    /// A Gaussian kernel wider than [`Limits::max_kernel_radius`].
+    #[error("a Gaussian of σ = {sigma_px:.4e} pixels needs a kernel of ±{radius:e} pixels (limit ±{limit})")]
+    KernelTooWide {
+        /// σ, pixels.
+        sigma_px: f64,
+        /// ⌈4σ⌉.
+        radius: f64,
+        /// The limit, pixels.
+        limit: usize,
+    },
+    /// Too many samples along an axis.
+    #[error("{extent_m:.4e} m in pixels of {pixel_m:.4e} m is {samples:e} pixels (limit {limit})")]
+    TooManySamples {
+        /// Length, m.
+        extent_m: f64,
+        /// Pixel, m.
+        pixel_m: f64,
+        /// Pixels it would take.
+        samples: f64,
+        /// The limit.
+        limit: usize,
+    },
+}
+
 /// The limits in force. [`Limits::DEFAULT`] is what the command line and Python use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Limits {
@@ -35,52 +95,55 @@ impl Limits {
         nx: usize,
         ny: usize,
         bytes_per_value: usize,
-    ) -> Result<usize, String> {
+    ) -> Result<usize, LimitError> {
         if nx == 0 || ny == 0 {
-            return Err(format!("a {nx}×{ny} plane has no pixels"));
+            return Err(LimitError::EmptyPlane { nx, ny });
         }
         if nx > self.max_side || ny > self.max_side {
-            return Err(format!(
-                "a {nx}×{ny} plane exceeds the limit of {} pixels per side",
-                self.max_side
-            ));
+            return Err(LimitError::SideTooLong {
+                nx,
+                ny,
+                limit: self.max_side,
+            });
         }
         nx.checked_mul(ny)
             .and_then(|n| n.checked_mul(bytes_per_value))
             .filter(|&b| b <= self.max_plane_bytes)
-            .ok_or_else(|| {
-                format!(
-                    "a {nx}×{ny} plane of {bytes_per_value}-byte values exceeds the {} MiB limit",
-                    self.max_plane_bytes >> 20
-                )
+            .ok_or(LimitError::PlaneTooLarge {
+                nx,
+                ny,
+                bytes_per_value,
+                limit_mib: self.max_plane_bytes >> 20,
             })
     }
 
     /// The radius ⌈4σ⌉ of a Gaussian kernel of `sigma_px` pixels, if within the limit.
-    pub fn kernel_radius(&self, sigma_px: f64) -> Result<usize, String> {
+    pub fn kernel_radius(&self, sigma_px: f64) -> Result<usize, LimitError> {
         let radius = (4.0 * sigma_px).ceil();
         if sigma_px.is_finite() && sigma_px >= 0.0 && radius <= self.max_kernel_radius as f64 {
             Ok(radius as usize)
         } else {
-            Err(format!(
-                "a Gaussian of σ = {sigma_px:.4e} pixels needs a kernel of ±{radius:e} pixels \
-                 (limit ±{})",
-                self.max_kernel_radius
-            ))
+            Err(LimitError::KernelTooWide {
+                sigma_px,
+                radius,
+                limit: self.max_kernel_radius,
+            })
         }
     }
 
     /// Pixels along an axis of `extent_m` cut into pixels of `pixel_m`, if within the side limit.
-    pub fn samples(&self, extent_m: f64, pixel_m: f64) -> Result<usize, String> {
+    pub fn samples(&self, extent_m: f64, pixel_m: f64) -> Result<usize, LimitError> {
         // The tolerance keeps an exact multiple (10 µm / 200 nm) from gaining a sliver pixel.
         let n = ((extent_m / pixel_m) * (1.0 - 1e-12)).ceil();
         if n.is_finite() && n >= 0.0 && n <= self.max_side as f64 {
             Ok(n as usize)
         } else {
-            Err(format!(
-                "{extent_m:.4e} m in pixels of {pixel_m:.4e} m is {n:e} pixels (limit {})",
-                self.max_side
-            ))
+            Err(LimitError::TooManySamples {
+                extent_m,
+                pixel_m,
+                samples: n,
+                limit: self.max_side,
+            })
         }
     }
 }

@@ -121,10 +121,11 @@ pub fn fit_hertz_with_offset(points: &[SqueezePoint], radius_m: f64) -> Result<H
     check_radius(radius_m)?;
     check_points(points).map_err(Error::InvalidArgument)?;
     if points.len() < MIN_POINTS + 1 {
-        return Err(Error::InvalidArgument(format!(
-            "the fit with a contact offset needs at least {} points",
-            MIN_POINTS + 1
-        )));
+        return Err(Error::TooFew {
+            what: "the fit with a contact offset",
+            needed: MIN_POINTS + 1,
+            got: points.len(),
+        });
     }
     let d_min = points[0].delta_m();
     let d_max = points[points.len() - 1].delta_m();

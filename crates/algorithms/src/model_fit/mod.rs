@@ -65,10 +65,10 @@ impl Family {
         Family::ALL
             .into_iter()
             .find(|f| f.name() == text.trim())
-            .ok_or_else(|| {
-                Error::InvalidArgument(format!(
-                    "unknown model '{text}': use elastic, gt, hardness or hardening"
-                ))
+            .ok_or_else(|| Error::UnknownName {
+                what: "model",
+                name: text.to_string(),
+                choices: "elastic, gt, hardness or hardening",
             })
     }
 
@@ -208,9 +208,11 @@ impl Measured {
     /// Points sorted by force; errors for fewer than 2 points or non-positive values.
     pub fn new(mut points: Vec<(f64, f64)>) -> Result<Self> {
         if points.len() < 2 {
-            return Err(Error::InvalidArgument(
-                "a fit needs at least 2 measured loads".into(),
-            ));
+            return Err(Error::TooFew {
+                what: "a fit",
+                needed: 2,
+                got: points.len(),
+            });
         }
         if let Some((f, a)) = points
             .iter()

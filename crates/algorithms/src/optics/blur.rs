@@ -59,10 +59,11 @@ impl Grid {
         dy_m: f64,
     ) -> Result<Self> {
         if width == 0 || height == 0 || Some(values.len()) != width.checked_mul(height) {
-            return Err(Error::InvalidArgument(format!(
-                "grid of {} values is not {width}×{height}",
-                values.len()
-            )));
+            return Err(Error::SizeMismatch {
+                what: "grid values",
+                expected: width * height,
+                got: values.len(),
+            });
         }
         if !(dx_m > 0.0 && dy_m > 0.0 && dx_m.is_finite() && dy_m.is_finite()) {
             return Err(Error::InvalidArgument(format!(
@@ -216,7 +217,10 @@ pub fn resample_area(grid: &Grid, dx_m: f64, dy_m: f64) -> Result<Grid> {
     ] {
         Limits::DEFAULT
             .samples(n as f64 * d_in, d_out)
-            .map_err(|reason| Error::InvalidArgument(format!("resampling: {reason}")))?;
+            .map_err(|source| Error::Limit {
+                what: "resampling".into(),
+                source,
+            })?;
     }
     let wx = overlap_weights(grid.width, grid.dx_m, dx_m);
     let wy = overlap_weights(grid.height, grid.dy_m, dy_m);
@@ -251,21 +255,27 @@ pub fn resample_area(grid: &Grid, dx_m: f64, dy_m: f64) -> Result<Grid> {
 /// A binary contact map becomes an image whose values sum to the contact area in image pixels.
 pub fn microscope_image(map: &Grid, fwhm_m: f64, pixel_m: (f64, f64)) -> Result<Grid> {
     if !(fwhm_m >= 0.0 && fwhm_m.is_finite()) {
-        return Err(Error::InvalidArgument(format!(
-            "PSF FWHM {fwhm_m:e} m is not a non-negative length"
-        )));
+        return Err(Error::Value {
+            what: "PSF FWHM",
+            value: fwhm_m,
+            unit: "m",
+            requirement: "is not a non-negative length",
+        });
     }
     let sigma_m = fwhm_m / FWHM_PER_SIGMA;
     let sigma_px = (sigma_m / map.dx_m, sigma_m / map.dy_m);
     for s in [sigma_px.0, sigma_px.1] {
-        Limits::DEFAULT.kernel_radius(s).map_err(|reason| {
-            Error::InvalidArgument(format!(
-                "PSF FWHM {:.4} µm on a grid of {:.4e} × {:.4e} m pixels: {reason}",
-                fwhm_m * 1e6,
-                map.dx_m,
-                map.dy_m
-            ))
-        })?;
+        Limits::DEFAULT
+            .kernel_radius(s)
+            .map_err(|source| Error::Limit {
+                what: format!(
+                    "PSF FWHM {:.4} µm on a grid of {:.4e} × {:.4e} m pixels",
+                    fwhm_m * 1e6,
+                    map.dx_m,
+                    map.dy_m
+                ),
+                source,
+            })?;
     }
     let blurred = gaussian_blur(&map.values, map.width, map.height, sigma_px, Edges::Zero);
     let blurred = Grid::new(blurred, map.width, map.height, map.dx_m, map.dy_m)?;

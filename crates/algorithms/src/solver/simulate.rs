@@ -147,9 +147,10 @@ pub fn sweep_each(
         let capacity = hardness_pa * (nx * ny) as f64 * topo.dx_m * topo.dy_m;
         let heaviest = loads_n.iter().copied().fold(0.0, f64::max);
         if heaviest >= capacity {
-            return Err(Error::InvalidArgument(format!(
-                "load {heaviest:.4e} N exceeds what the hardness can carry on the whole map ({capacity:.4e} N)"
-            )));
+            return Err(Error::ExceedsCapacity {
+                load_n: heaviest,
+                capacity_n: capacity,
+            });
         }
     }
     let operator = ElasticOperator::new(
@@ -172,8 +173,10 @@ pub fn sweep_each(
 fn check_setup(setup: &Setup) -> Result<()> {
     let positive = |v: f64| v.is_finite() && v > 0.0;
     if !positive(setup.e_star_pa) {
-        return Err(Error::InvalidArgument(
-            "contact modulus must be positive".into(),
+        return Err(Error::not_positive(
+            "contact modulus",
+            setup.e_star_pa,
+            "Pa",
         ));
     }
     match setup.model {
@@ -182,13 +185,16 @@ fn check_setup(setup: &Setup) -> Result<()> {
             volume_conserving,
         } => {
             if !positive(hardness_pa) {
-                return Err(Error::InvalidArgument("hardness must be positive".into()));
+                return Err(Error::not_positive("hardness", hardness_pa, "Pa"));
             }
             if let Some(alpha) = volume_conserving {
                 if !(alpha > 0.0 && alpha <= 1.0) {
-                    return Err(Error::InvalidArgument(format!(
-                        "relaxation factor α must lie in (0, 1] (got {alpha})"
-                    )));
+                    return Err(Error::Value {
+                        what: "relaxation factor α",
+                        value: alpha,
+                        unit: "",
+                        requirement: "must lie in (0, 1]",
+                    });
                 }
             }
         }

@@ -337,16 +337,15 @@ fn finish_with(
 /// pixel at its cap carries.
 fn check_load(problem: &Problem, force: f64, plasticity: Plasticity) -> crate::error::Result<()> {
     if !(force > 0.0 && force.is_finite()) {
-        return Err(crate::error::Error::InvalidArgument(format!(
-            "load must be positive (got {force})"
-        )));
+        return Err(crate::error::Error::not_positive("load", force, "N"));
     }
     if let Plasticity::Cap(cap) = plasticity {
         let capacity = cap.iter().sum::<f64>() * problem.pixel_area;
         if force >= capacity {
-            return Err(crate::error::Error::InvalidArgument(format!(
-                "load {force:.6e} exceeds what the hardness can carry on the whole map ({capacity:.6e})"
-            )));
+            return Err(crate::error::Error::ExceedsCapacity {
+                load_n: force,
+                capacity_n: capacity,
+            });
         }
     }
     Ok(())

@@ -19,9 +19,7 @@ use super::{finish, Plasticity, Problem, Solution, SolverOptions};
 /// each iteration, and CG restarts whenever any pixel enters the contact.
 pub fn solve_load_pk(problem: &Problem, force: f64, options: &SolverOptions) -> Result<Solution> {
     if !(force > 0.0 && force.is_finite()) {
-        return Err(Error::InvalidArgument(format!(
-            "load must be positive (got {force})"
-        )));
+        return Err(Error::not_positive("load", force, "N"));
     }
     let n = problem.len();
     let op = problem.operator;

@@ -151,10 +151,11 @@ impl RadialKernel {
         let n = self.rho.len();
         let start = match initial {
             Some(p) if p.len() != n => {
-                return Err(Error::InvalidArgument(format!(
-                    "initial pressure has {} values for a grid of {n}",
-                    p.len()
-                )))
+                return Err(Error::SizeMismatch {
+                    what: "initial pressure values",
+                    expected: n,
+                    got: p.len(),
+                })
             }
             Some(p) => p.to_vec(),
             None => vec![0.0; n],
@@ -286,10 +287,11 @@ impl RadialKernel {
 
 pub(super) fn check_grid(rho: &[f64]) -> Result<()> {
     if rho.len() < 3 {
-        return Err(Error::InvalidArgument(format!(
-            "radial grid needs at least 3 points (got {})",
-            rho.len()
-        )));
+        return Err(Error::TooFew {
+            what: "a radial grid",
+            needed: 3,
+            got: rho.len(),
+        });
     }
     if rho[0] != 0.0 {
         return Err(Error::InvalidArgument(format!(
@@ -307,9 +309,7 @@ pub(super) fn check_grid(rho: &[f64]) -> Result<()> {
 
 pub(super) fn check_scaled(mu: f64, d_star: f64, options: &ScaledOptions) -> Result<()> {
     if !(mu.is_finite() && mu > 0.0) {
-        return Err(Error::InvalidArgument(format!(
-            "μ must be positive (got {mu})"
-        )));
+        return Err(Error::not_positive("μ", mu, ""));
     }
     if !d_star.is_finite() {
         return Err(Error::InvalidArgument(format!(
@@ -324,20 +324,24 @@ pub(super) fn check_scaled(mu: f64, d_star: f64, options: &ScaledOptions) -> Res
     }
     if let ScaledMethod::FixedPoint { mixing } = options.method {
         if !(mixing > 0.0 && mixing <= 1.0) {
-            return Err(Error::InvalidArgument(format!(
-                "mixing must lie in (0, 1] (got {mixing})"
-            )));
+            return Err(Error::Value {
+                what: "mixing",
+                value: mixing,
+                unit: "",
+                requirement: "must lie in (0, 1]",
+            });
         }
     }
     Ok(())
 }
 
 pub(super) fn not_converged(method: &str, options: &ScaledOptions, change: f64) -> Error {
-    Error::InvalidArgument(format!(
-        "Greenwood–Tripp {method} did not converge in {} iterations \
-         (last max |Δp̃| = {change:.3e}, tolerance {:.1e})",
-        options.max_iter, options.tol
-    ))
+    Error::NotConverged {
+        what: format!("Greenwood–Tripp {method} (last max |Δp̃|)"),
+        iterations: options.max_iter,
+        residual: change,
+        tolerance: options.tol,
+    }
 }
 
 /// Row i ≥ 1 of the absolute displacement map (see [`RadialKernel`]).

@@ -45,17 +45,19 @@ impl GtParams {
     /// Every parameter must be finite and positive.
     pub fn validate(&self) -> Result<()> {
         let named = [
-            ("sphere radius", self.sphere_radius_m, "m"),
-            ("contact modulus E*", self.e_star_pa, "Pa"),
-            ("h_rms", self.h_rms_m, "m"),
-            ("h''_rms", self.h_double_prime_rms_per_m, "1/m"),
-            ("η·h_rms·β", self.eta_h_beta, ""),
+            ("Greenwood–Tripp: sphere radius", self.sphere_radius_m, "m"),
+            ("Greenwood–Tripp: contact modulus E*", self.e_star_pa, "Pa"),
+            ("Greenwood–Tripp: h_rms", self.h_rms_m, "m"),
+            (
+                "Greenwood–Tripp: h''_rms",
+                self.h_double_prime_rms_per_m,
+                "1/m",
+            ),
+            ("Greenwood–Tripp: η·h_rms·β", self.eta_h_beta, ""),
         ];
         for (name, value, unit) in named {
             if !(value.is_finite() && value > 0.0) {
-                return Err(Error::InvalidArgument(format!(
-                    "Greenwood–Tripp: {name} must be positive and finite (got {value} {unit})"
-                )));
+                return Err(Error::not_positive(name, value, unit));
             }
         }
         Ok(())
@@ -223,9 +225,7 @@ pub fn gt_profile_with(
     params.validate()?;
     check_numerics(numerics)?;
     if !(force_n.is_finite() && force_n > 0.0) {
-        return Err(Error::InvalidArgument(format!(
-            "Greenwood–Tripp: force must be positive and finite (got {force_n} N)"
-        )));
+        return Err(Error::not_positive("Greenwood–Tripp: force", force_n, "N"));
     }
     let target = force_n / params.load_scale_n();
     if target.is_nan() || target <= 1e-250 {
@@ -432,8 +432,11 @@ impl<'a> LoadSearch<'a> {
                 last_side = -1;
             }
         }
-        Err(Error::InvalidArgument(
-            "Greenwood–Tripp: load search did not converge in 200 steps".into(),
-        ))
+        Err(Error::NotConverged {
+            what: "Greenwood–Tripp load search".into(),
+            iterations: 200,
+            residual: f_heavy.abs().min(f_light.abs()),
+            tolerance: self.numerics.load_rtol,
+        })
     }
 }
