@@ -18,6 +18,11 @@ def read_csv(path):
         return list(csv.DictReader(f))
 
 
+def columns(rows):
+    """A result's rows as columns (numpy arrays), without pandas (an optional dependency)."""
+    return {k: np.array([r[k] for r in rows]) for k in rows[0]}
+
+
 def test_read_image_round_trip(tmp_path):
     stack = np.random.default_rng(1).random((3, 20, 30)).astype(np.float32)
     cs.write_tiff(tmp_path / "f.tif", stack, (1e-7, 2e-7))
@@ -39,7 +44,7 @@ def test_read_series_keeps_sample_type_and_forces(series_tif):
     assert r.forces_n == FORCES
     assert r.pages == [0, 1, 2]
     assert r.pixel_size_m == pytest.approx((2e-7, 2e-7))
-    assert list(r.to_pandas()["force_n"]) == FORCES
+    assert r.forces_n == FORCES
 
 
 def test_read_series_manifest_matches_cli(cli, tmp_path):
@@ -70,7 +75,7 @@ def test_analyze_matches_cli(cli, series_tif, tmp_path):
     cli("analyze", path, "--forces", "2,4,8mN", "--out", tmp_path / "an", "-q")
     rows = read_csv(tmp_path / "an" / "areas.csv")
     a = cs.analyze(cs.read_series(path, forces=FORCES))
-    df = a.to_pandas()
+    df = columns(a.rows)
     assert list(df["contact_pixels"]) == [int(r["contact_pixels"]) for r in rows]
     np.testing.assert_allclose(df["area_m2"] * 1e12, [float(r["area_um2"]) for r in rows],
                                rtol=1e-12)
@@ -174,7 +179,7 @@ def test_simulate_matches_cli(cli, surface_npy, tmp_path):
     rows = read_csv(out / "areas.csv")
     h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
     r = cs.simulate(h, 100e-9, 1e9, [20e-6, 40e-6, 80e-6], "hardening", k=4e15, radius=20e-6)
-    df = r.to_pandas()
+    df = columns(r.rows)
     np.testing.assert_allclose(df["area_m2"] * 1e12, [float(x["area_um2"]) for x in rows],
                                rtol=1e-12)
     np.testing.assert_allclose(df["approach_m"] * 1e6, [float(x["approach_um"]) for x in rows],
@@ -376,3 +381,13 @@ def test_read_topography_gsf_carries_its_pixel_size(cli, tmp_path):
     with pytest.raises(cs.InputError, match="extension"):
         (tmp_path / "s.xyz").write_text("1 2 3")
         cs.read_topography(tmp_path / "s.xyz", pixel_size=1e-7)
+
+
+def test_to_pandas_gives_the_rows_as_a_table():
+    pd = pytest.importorskip("pandas", reason="to_pandas() needs pandas, an optional dependency")
+    s = cs.synth_series(64, 64, 2e-7, FORCES)
+    a = cs.analyze(s.images, forces=FORCES, pixel_size=2e-7)
+    df = a.to_pandas()
+    assert isinstance(df, pd.DataFrame) and len(df) == len(FORCES)
+    assert list(df["force_n"]) == FORCES
+    assert list(df.columns) == list(a.rows[0])

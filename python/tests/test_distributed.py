@@ -49,6 +49,7 @@ def test_sweep_equals_serial(client):
     np.testing.assert_array_equal(on_dask.rows[1]["areas_m2"], ref.areas_m2)
     # A softer material (smaller k) gives more area at every load.
     assert (on_dask.rows[0]["areas_m2"] >= on_dask.rows[2]["areas_m2"]).all()
+    pytest.importorskip("pandas", reason="to_pandas() needs pandas, an optional dependency")
     df = on_dask.to_pandas()
     assert len(df) == 9 * len(LOADS)
 

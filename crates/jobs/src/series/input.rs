@@ -269,7 +269,18 @@ pub fn load(spec: &SeriesSpec, pixel_size_m: Option<(f64, f64)>) -> Result<Loade
     }
     let open = micrographs.open()?;
     let mut warnings = Vec::new();
-    let pixel_size = super::pixel_size(&open.series, pixel_size_m, &mut warnings)?;
+    // Reading does not need a pixel size: metadata that cannot be used (implausible, or files
+    // that disagree) leave it unknown, with the reason, as `analyze` would refuse them.
+    let pixel_size = match super::pixel_size(&open.series, pixel_size_m, &mut warnings) {
+        Ok(p) => p,
+        Err(e) => {
+            warnings.push(format!(
+                "{e}; the pixel size is left unknown (give {})",
+                Param::PixelSize
+            ));
+            None
+        }
+    };
     let planes = open.default_planes().scan(|_, p| Ok(p.clone()))?;
     Ok(LoadedSeries {
         planes,
