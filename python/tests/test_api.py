@@ -385,7 +385,7 @@ def test_read_topography_gsf_carries_its_pixel_size(cli, tmp_path):
 
 def test_to_pandas_gives_the_rows_as_a_table():
     pd = pytest.importorskip("pandas", reason="to_pandas() needs pandas, an optional dependency")
-    s = cs.synth_series(64, 64, 2e-7, FORCES)
+    s = cs.synth_series(96, 96, 2e-7, FORCES)
     a = cs.analyze(s.images, forces=FORCES, pixel_size=2e-7)
     df = a.to_pandas()
     assert isinstance(df, pd.DataFrame) and len(df) == len(FORCES)
