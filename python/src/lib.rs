@@ -122,6 +122,33 @@ fn set_num_threads(n: usize) -> PyResult<()> {
     Ok(())
 }
 
+/// Every parameter a person sets, as the front-ends name it, with its plausible range: for the
+/// test that walks both front-ends' checks. Each entry: `flag` (command line), `keyword`
+/// (Python; empty where Python has none), `words`, and for physical quantities `quantity`,
+/// `lowest` and `highest` (SI) and the `unit` and `factor` (SI to that unit) of the messages.
+#[pyfunction]
+fn _params(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyList>> {
+    use contactscope_formats::param::Param;
+    let list = pyo3::types::PyList::empty(py);
+    for &p in Param::ALL {
+        let d = pyo3::types::PyDict::new(py);
+        d.set_item("flag", p.flag())?;
+        d.set_item("keyword", p.keyword())?;
+        d.set_item("words", p.words())?;
+        if let Some(q) = p.quantity() {
+            let (name, factor, unit) = q.describe();
+            let (lo, hi) = q.range();
+            d.set_item("quantity", name)?;
+            d.set_item("lowest", lo)?;
+            d.set_item("highest", hi)?;
+            d.set_item("factor", factor)?;
+            d.set_item("unit", unit)?;
+        }
+        list.append(d)?;
+    }
+    Ok(list)
+}
+
 /// Threads contactscope's parallel loops use in this process.
 #[pyfunction]
 fn get_num_threads() -> usize {
@@ -175,6 +202,7 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     // Messages name parameters as keywords (`pixel_size=`).
     contactscope_formats::param::set_front_end(contactscope_formats::param::FrontEnd::Python);
+    m.add_function(wrap_pyfunction!(_params, m)?)?;
     m.add("InputError", py.get_type::<InputError>())?;
     m.add("FileError", py.get_type::<FileError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;

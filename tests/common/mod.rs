@@ -30,6 +30,12 @@ pub fn shared_data(sub: &str) -> Option<PathBuf> {
     }
 }
 
+/// Name parameters in messages as the command line does (`--channel`), for tests that call the
+/// library directly and check a message the command line prints.
+pub fn cli_names() {
+    contactscope_formats::param::set_front_end(contactscope_formats::param::FrontEnd::CommandLine);
+}
+
 /// Run the contactscope binary.
 pub fn run(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_contactscope"))

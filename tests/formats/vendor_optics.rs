@@ -73,6 +73,7 @@ fn autocorr_reads_the_selected_plane_as_its_tiff_export() {
 
 #[test]
 fn psf_and_newton_readers_take_the_selected_planes() {
+    crate::common::cli_names();
     use contactscope_formats::microscopy::select::{
         read_images, read_one_image, LoadAxis, Selection,
     };

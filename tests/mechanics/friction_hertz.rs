@@ -332,6 +332,7 @@ fn normal_force_is_required() {
 
 #[test]
 fn mismatched_forces_list_both_sides() {
+    crate::common::cli_names();
     let dir = tempfile::tempdir().unwrap();
     let (traces, _) = load_series(dir.path());
     let areas = write(dir.path(), "few.csv", "force_mN,area_um2\n4,40\n10,83\n");

@@ -93,6 +93,7 @@ fn integer_files_match_scikit_image() {
 
 #[test]
 fn multi_channel_files_need_a_channel() {
+    crate::common::cli_names();
     let Some(dir) = crate::common::shared_data("real-tiff") else {
         return;
     };

@@ -157,6 +157,51 @@ impl fmt::Display for Param {
     }
 }
 
+impl Param {
+    /// The plausible range a value of this parameter is checked against
+    /// ([`crate::ranges::Quantity`]), for parameters that are physical quantities.
+    pub fn quantity(self) -> Option<crate::ranges::Quantity> {
+        use crate::ranges::Quantity;
+        Some(match self {
+            Param::PixelSize => Quantity::PixelSize,
+            Param::HeightUnit => Quantity::Height,
+            Param::Forces | Param::Loads | Param::NormalForce => Quantity::Force,
+            Param::Radius => Quantity::Radius,
+            Param::Modulus => Quantity::Modulus,
+            Param::Hardness | Param::InitialHardness => Quantity::Hardness,
+            Param::Hardening => Quantity::Hardening,
+            Param::PsfFwhm => Quantity::Fwhm,
+            Param::Wavelength => Quantity::Wavelength,
+            Param::BeadDiameter | Param::MaxLag | Param::RotationRadius => Quantity::Length,
+            _ => return None,
+        })
+    }
+}
+
+impl Param {
+    /// The parameter with a value as a person would write it in the front-end: `--channel 2`,
+    /// `channel=2`, "the channel 2".
+    pub fn with_value(self, value: impl fmt::Display) -> String {
+        match front_end() {
+            FrontEnd::CommandLine => format!("{} {value}", self.flag()),
+            FrontEnd::Python if !self.keyword().is_empty() => {
+                format!("{}={value}", self.keyword())
+            }
+            _ => format!("{} {value}", self.words()),
+        }
+    }
+
+    /// An index along a named extra axis as the front-end writes it: `--axis H=0`,
+    /// `axes={'H': 0}`.
+    pub fn axis_value(name: &str, value: impl fmt::Display) -> String {
+        match front_end() {
+            FrontEnd::CommandLine => format!("--axis {name}={value}"),
+            FrontEnd::Python => format!("axes={{'{name}': {value}}}"),
+            FrontEnd::Library => format!("axis {name} = {value}"),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

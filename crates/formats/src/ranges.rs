@@ -51,8 +51,9 @@ impl Quantity {
         }
     }
 
-    /// What it is, in words, with the unit its range is written in.
-    fn describe(self) -> (&'static str, f64, &'static str) {
+    /// What it is, in words, with the factor from SI to the unit its range is written in and
+    /// that unit.
+    pub fn describe(self) -> (&'static str, f64, &'static str) {
         match self {
             Quantity::Force => ("force", 1e3, "mN"),
             Quantity::PixelSize => ("pixel size", 1e9, "nm"),

@@ -21,9 +21,12 @@ pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
     for column in ["force_mN", "area_um2"] {
         if !table.header().iter().any(|h| h == column) {
             let hint = if column == "area_um2" && table.header().iter().any(|h| h == "area_px") {
-                " (areas are in pixels: run analyze with --pixel-size)"
+                format!(
+                    " (areas are in pixels: run analyze with {})",
+                    contactscope_formats::param::Param::PixelSize
+                )
             } else {
-                ""
+                String::new()
             };
             return Err(Error::bad_input(
                 table.location(),

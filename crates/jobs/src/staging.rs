@@ -156,7 +156,10 @@ fn is_input(target: &Path, protected: &[PathBuf]) -> bool {
 fn input_refusal(target: PathBuf) -> Error {
     Error::Output {
         path: target,
-        reason: "it is an input file of this run; choose another --out".into(),
+        reason: format!(
+            "it is an input file of this run; choose another {}",
+            contactscope_formats::param::Param::Out
+        ),
     }
 }
 

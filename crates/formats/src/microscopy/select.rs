@@ -21,6 +21,7 @@ use serde::Serialize;
 use super::{MicroscopyFile, MicroscopyFormat, PlaneIndex, SeriesInfo};
 use crate::error::{Error, Location, Result};
 use crate::image::{pixel_size_or, Image, PixelSize, PixelSizeSource};
+use crate::param::Param;
 
 /// The selection flags: each `None` when not given.
 #[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
@@ -97,12 +98,17 @@ impl Selection {
 
     /// Refuse flags that do not apply to a TIFF file (a non-zero series, z or t).
     pub fn check_tiff(&self, path: &Path) -> Result<()> {
-        for (flag, value) in [("--series", self.series), ("--z", self.z), ("--t", self.t)] {
+        for (flag, value) in [
+            (Param::Series, self.series),
+            (Param::Z, self.z),
+            (Param::T, self.t),
+        ] {
             if let Some(v) = value.filter(|v| *v > 0) {
                 return Err(Error::bad_input(
                     Location::file(path),
                     format!(
-                        "{flag} {v}: a TIFF's pages are its images; {flag} applies to CZI, ND2 and LIF files"
+                        "{}: a TIFF's pages are its images; {flag} applies to CZI, ND2 and LIF files",
+                        flag.with_value(v)
                     ),
                 ));
             }
@@ -125,13 +131,15 @@ impl Selection {
         }
         let series: Vec<usize> = if along == Some(LoadAxis::Series) {
             if self.series.is_some() {
-                return Err(Error::InvalidArgument(
-                    "--series cannot be combined with --load-axis series".into(),
-                ));
+                return Err(Error::InvalidArgument(format!(
+                    "{} cannot be combined with {}",
+                    Param::Series,
+                    Param::LoadAxis.with_value("series")
+                )));
             }
             (0..n_series).collect()
         } else {
-            vec![pick(path, "series", "--series", self.series, n_series)?]
+            vec![pick(path, "series", Param::Series, self.series, n_series)?]
         };
         let mut out = Vec::new();
         for (k, &s) in series.iter().enumerate() {
@@ -142,11 +150,11 @@ impl Selection {
                 1 => axis.to_string(),
                 _ => format!("{axis} in series {s}"),
             };
-            let c = pick(path, &what("channels"), "--channel", self.channel, a.c)?;
+            let c = pick(path, &what("channels"), Param::Channel, self.channel, a.c)?;
             let zs = along_or_pick(
                 path,
                 &what("z planes"),
-                "--z",
+                Param::Z,
                 self.z,
                 a.z,
                 along,
@@ -155,7 +163,7 @@ impl Selection {
             let ts = along_or_pick(
                 path,
                 &what("time points"),
-                "--t",
+                Param::T,
                 self.t,
                 a.t,
                 along,
@@ -184,18 +192,19 @@ impl Selection {
 }
 
 /// The index along an axis of length `n`: the requested one (checked), or 0 when `n` is 1.
-fn pick(path: &Path, what: &str, flag: &str, requested: Option<usize>, n: usize) -> Result<usize> {
+fn pick(path: &Path, what: &str, flag: Param, requested: Option<usize>, n: usize) -> Result<usize> {
     let bad = |reason: String| Error::bad_input(Location::file(path), reason);
     match requested {
         Some(i) if i < n => Ok(i),
         Some(i) => Err(bad(format!(
-            "{flag} {i} requested; the file has {n} {what} (0..{})",
+            "{} requested; the file has {n} {what} (0..{})",
+            flag.with_value(i),
             n.saturating_sub(1)
         ))),
         None if n == 1 => Ok(0),
         None => Err(bad(format!(
-            "{n} {what}; choose one with {flag} 0..{}",
-            n - 1
+            "{n} {what}; choose one with {}",
+            flag.with_value(format!("0..{}", n - 1))
         ))),
     }
 }
@@ -204,7 +213,7 @@ fn pick(path: &Path, what: &str, flag: &str, requested: Option<usize>, n: usize)
 fn along_or_pick(
     path: &Path,
     what: &str,
-    flag: &str,
+    flag: Param,
     requested: Option<usize>,
     n: usize,
     along: Option<LoadAxis>,
@@ -213,8 +222,8 @@ fn along_or_pick(
     if along == Some(axis) {
         if requested.is_some() {
             return Err(Error::InvalidArgument(format!(
-                "{flag} cannot be combined with --load-axis {}",
-                axis.name()
+                "{flag} cannot be combined with {}",
+                Param::LoadAxis.with_value(axis.name())
             )));
         }
         return Ok((0..n).collect());
@@ -241,16 +250,17 @@ impl Selection {
                 }
                 Some(&i) => {
                     return Err(bad(format!(
-                        "--axis {axis}={i} requested; series {} has {n} planes along {axis} (0..{})",
+                        "{} requested; series {} has {n} planes along {axis} (0..{})",
+                        Param::axis_value(axis, i),
                         info.index,
                         n - 1
                     )))
                 }
                 None if n > 1 => {
                     return Err(bad(format!(
-                        "series {} has {n} planes along axis {axis}{meaning}; choose one with --axis {axis}=0..{}",
+                        "series {} has {n} planes along axis {axis}{meaning}; choose one with {}",
                         info.index,
-                        n - 1
+                        Param::axis_value(axis, format!("0..{}", n - 1))
                     )))
                 }
                 None => {}
@@ -262,7 +272,8 @@ impl Selection {
             .find(|(a, &i)| !info.axes.extra.contains_key(*a) && i > 0)
         {
             return Err(bad(format!(
-                "--axis {axis}={i} requested; series {} has no axis {axis} longer than 1",
+                "{} requested; series {} has no axis {axis} longer than 1",
+                Param::axis_value(axis, i),
                 info.index
             )));
         }
@@ -356,13 +367,14 @@ mod tests {
     #[test]
     fn pick_defaults_and_errors() {
         let p = Path::new("f.czi");
-        assert_eq!(pick(p, "channels", "--channel", None, 1).unwrap(), 0);
-        assert_eq!(pick(p, "channels", "--channel", Some(2), 3).unwrap(), 2);
-        let e = pick(p, "channels", "--channel", None, 3)
+        crate::param::set_front_end(crate::param::FrontEnd::CommandLine);
+        assert_eq!(pick(p, "channels", Param::Channel, None, 1).unwrap(), 0);
+        assert_eq!(pick(p, "channels", Param::Channel, Some(2), 3).unwrap(), 2);
+        let e = pick(p, "channels", Param::Channel, None, 3)
             .unwrap_err()
             .to_string();
         assert_eq!(e, "f.czi: 3 channels; choose one with --channel 0..2");
-        let e = pick(p, "channels", "--channel", Some(3), 3)
+        let e = pick(p, "channels", Param::Channel, Some(3), 3)
             .unwrap_err()
             .to_string();
         assert!(
@@ -372,7 +384,7 @@ mod tests {
         let all = along_or_pick(
             p,
             "z planes",
-            "--z",
+            Param::Z,
             None,
             4,
             Some(LoadAxis::Z),
@@ -382,7 +394,7 @@ mod tests {
         let both = along_or_pick(
             p,
             "z planes",
-            "--z",
+            Param::Z,
             Some(1),
             4,
             Some(LoadAxis::Z),

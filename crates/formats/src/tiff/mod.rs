@@ -30,10 +30,10 @@ pub fn read_pages(
             return Err(Error::bad_input(
                 Location::file(path),
                 format!(
-                    "file has {} channels ({}); choose one with --channel 0..{}",
+                    "file has {} channels ({}); choose one with {}",
                     info.channels,
                     info.channel_layout.describe(),
-                    info.channels - 1
+                    crate::param::Param::Channel.with_value(format!("0..{}", info.channels - 1))
                 ),
             ))
         }

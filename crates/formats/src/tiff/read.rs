@@ -543,8 +543,9 @@ fn pixel_size_from_tags<R: Read + Seek>(
     };
     if size.x_m > 100e-6 {
         notes.push(format!(
-            "resolution tags give {:.1} µm pixels, implausibly large for a microscope; check the file or use --pixel-size",
-            size.x_m * 1e6
+            "resolution tags give {:.1} µm pixels, implausibly large for a microscope; check the file or give {}",
+            size.x_m * 1e6,
+            crate::param::Param::PixelSize
         ));
     }
     Some(size)

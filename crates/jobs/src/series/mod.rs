@@ -182,10 +182,10 @@ fn tiff_channel(info: &TiffInfo, channel: Option<usize>) -> Result<usize> {
         None if info.channels > 1 => Err(Error::bad_input(
             Location::file(&info.path),
             format!(
-                "file has {} channels ({}); choose one with --channel 0..{}",
+                "file has {} channels ({}); choose one with {}",
                 info.channels,
                 info.channel_layout.describe(),
-                info.channels - 1
+                Param::Channel.with_value(format!("0..{}", info.channels - 1))
             ),
         )),
         Some(c) if c >= info.channels => Err(Error::bad_input(

@@ -240,8 +240,8 @@ fn check_options(o: &NewtonOptions) -> Result<()> {
     }
     if !(1..=3600).contains(&o.profiles) {
         return Err(Error::InvalidArgument(format!(
-            "--profiles {} is out of range 1..=3600",
-            o.profiles
+            "{} is out of range 1..=3600",
+            contactscope_formats::param::Param::Profiles.with_value(o.profiles)
         )));
     }
     if o.line_width_px == 0 || o.smoothing_px.is_nan() || o.smoothing_px < 0.0 {

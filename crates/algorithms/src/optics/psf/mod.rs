@@ -186,9 +186,10 @@ fn square_pixel_size(image: &Image) -> Result<PixelSize> {
         return Err(Error::bad_input(
             Location::file(&image.path),
             format!(
-                "psf needs square pixels; this file has {} × {} nm (give --pixel-size to override)",
+                "psf needs square pixels; this file has {} × {} nm (give {} to override)",
                 px.x_m * 1e9,
-                px.y_m * 1e9
+                px.y_m * 1e9,
+                contactscope_formats::param::Param::PixelSize
             ),
         ));
     }
