@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use contactscope::mechanics::friction::SlipOptions;
 use contactscope_formats::units::{self, Dimension};
-use contactscope_jobs::friction::{run_friction, FrictionRequest};
+use contactscope_jobs::friction::files::run_to_folder;
+use contactscope_jobs::friction::FrictionRequest;
 
 use super::args::{default_out, fraction, OutputFolder};
 use super::common::{command_line, print_warnings, print_written};
@@ -43,7 +43,6 @@ pub fn run(args: Args) -> Result<()> {
             .with_context(|| flag.to_string())
     };
     let request = FrictionRequest {
-        traces: args.traces.clone(),
         normal_force_n: quantity(&args.normal_force, "--normal-force", Dimension::Force)?,
         rotation_radius_m: quantity(
             &args.rotation_radius,
@@ -52,11 +51,9 @@ pub fn run(args: Args) -> Result<()> {
         )?,
         areas: args.areas.clone(),
         force_tolerance: fraction(&args.force_tolerance, "--force-tolerance")?,
-        slip: SlipOptions::default(),
-        out_dir: args.out.out.clone(),
-        command_line: command_line(),
+        ..FrictionRequest::new(args.traces.clone())
     };
-    let outcome = run_friction(&request)?;
+    let (outcome, written) = run_to_folder(&request, &args.out.out, &command_line())?;
     print_warnings(&outcome.warnings);
     println!(
         "{:>9} {:>9} {:>9} {:>12} {:>7} {:>7}  file",
@@ -98,6 +95,6 @@ pub fn run(args: Args) -> Result<()> {
             m.relative_spread * 100.0
         );
     }
-    print_written(outcome.written.len(), &args.out.out);
+    print_written(written.len(), &args.out.out);
     Ok(())
 }

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 
 use contactscope_formats::units::{self, Dimension};
-use contactscope_jobs::hertz::{run_hertz, HertzRequest};
+use contactscope_jobs::hertz::files::run_to_folder;
+use contactscope_jobs::hertz::HertzRequest;
 
 use super::args::{default_out, OutputFolder};
 use super::common::{command_line, print_written};
@@ -27,22 +28,17 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let radius_m = units::parse_positive(&args.radius, Dimension::Length).context("--radius")?;
     let request = HertzRequest {
-        input: args.input.clone(),
-        radius_m: contactscope_formats::ranges::Quantity::Radius.check_text(
-            units::parse_positive(&args.radius, Dimension::Length).context("--radius")?,
-            "--radius",
-        )?,
         loads_n: args
             .loads
             .as_deref()
             .map(units::parse_loads)
             .transpose()
             .context("--loads")?,
-        out_dir: args.out.out.clone(),
-        command_line: command_line(),
+        ..HertzRequest::new(args.input.clone(), radius_m)
     };
-    let outcome = run_hertz(&request)?;
+    let (outcome, written) = run_to_folder(&request, &args.out.out, &command_line())?;
     let fit = &outcome.fit;
     println!(
         "E* = {:.4} ± {:.4} GPa (R² {:.5}, {} points, fit through the origin)",
@@ -60,9 +56,13 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     println!("{:>10} {:>12}", "load_mN", "a_Hertz_µm");
-    for (p, a) in &outcome.predicted {
-        println!("{:>10.3} {:>12.4}", p * 1e3, a * 1e6);
+    for p in &outcome.predicted {
+        println!(
+            "{:>10.3} {:>12.4}",
+            p.force_n * 1e3,
+            p.contact_radius_m * 1e6
+        );
     }
-    print_written(outcome.written.len(), &args.out.out);
+    print_written(written.len(), &args.out.out);
     Ok(())
 }

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use contactscope_formats::microscopy::summary::{info_summary_selected, InfoSummary};
+use contactscope_formats::microscopy::summary::InfoSummary;
 use contactscope_formats::units;
-use contactscope_jobs::info::{run_info, InfoRequest};
+use contactscope_jobs::info::{self as job, tiff_details, InfoRequest};
 
 use super::args::SelectionArgs;
 
@@ -32,15 +32,19 @@ pub fn run(args: Args) -> Result<()> {
     let selection = args.select.selection();
     let selected = selection != Default::default();
     if args.json || args.stats || selected || !is_tiff(&args.file) {
-        let summary = info_summary_selected(&args.file, args.stats, &selection)?;
+        let outcome = job::run(&InfoRequest {
+            file: args.file.clone(),
+            stats: args.stats,
+            selection,
+        })?;
         if args.json {
-            println!("{}", serde_json::to_string_pretty(&summary)?);
+            println!("{}", serde_json::to_string_pretty(&outcome)?);
         } else {
-            print_summary(&summary);
+            print_summary(&outcome.summary);
         }
         return Ok(());
     }
-    let i = run_info(&InfoRequest { file: args.file })?;
+    let i = tiff_details(&args.file)?;
     println!("file:         {}", i.path.display());
     println!("pages:        {}", i.pages.len());
     println!(

@@ -4,23 +4,21 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 
-use contactscope::surface::generate::{RmsTarget, SelfAffineParams};
-use contactscope_formats::ranges::Quantity;
+use contactscope::surface::generate::RmsTarget;
 use contactscope_formats::units::{self, Dimension};
-use contactscope_jobs::surface::{run_surface, SurfaceRequest};
-
-use super::args::optional_length;
+use contactscope_jobs::surface::files::run_to_file;
+use contactscope_jobs::surface::SurfaceRequest;
 
 #[derive(clap::Args)]
 pub struct Args {
     /// Grid size in pixels (square).
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, default_value_t = SurfaceRequest::SIZE)]
     size: usize,
     /// Pixel size, e.g. 32nm.
     #[arg(long)]
     pixel_size: String,
     /// Hurst exponent H in (0, 1].
-    #[arg(long, default_value_t = 0.8)]
+    #[arg(long, default_value_t = SurfaceRequest::HURST)]
     hurst: f64,
     /// RMS slope h'_rms (central differences); or give --rms-height.
     #[arg(long, conflicts_with = "rms_height")]
@@ -35,11 +33,18 @@ pub struct Args {
     #[arg(long)]
     cutoff: Option<String>,
     /// Random seed.
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = SurfaceRequest::SEED)]
     seed: u64,
     /// Output file: .npy or .gsf (heights in metres).
     #[arg(long)]
     out: PathBuf,
+}
+
+/// An optional length (`8um`) in metres.
+fn length(text: &Option<String>, flag: &str) -> Result<Option<f64>> {
+    text.as_deref()
+        .map(|t| units::parse_positive(t, Dimension::Length).with_context(|| flag.to_string()))
+        .transpose()
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -47,35 +52,29 @@ pub fn run(args: Args) -> Result<()> {
     let target = match (&args.rms_slope, &args.rms_height) {
         (Some(slope), None) => RmsTarget::Slope(*slope),
         (None, Some(h)) => {
-            let h = units::parse_positive(h, Dimension::Length).context("--rms-height")?;
-            RmsTarget::Height(Quantity::Height.check_text(h, "--rms-height")?)
+            RmsTarget::Height(units::parse_positive(h, Dimension::Length).context("--rms-height")?)
         }
         _ => bail!("give --rms-slope or --rms-height"),
     };
-    let params = SelfAffineParams {
+    let request = SurfaceRequest {
         nx: args.size,
         ny: args.size,
-        dx_m: dx,
         hurst: args.hurst,
-        rolloff_wavelength_m: optional_length(&args.rolloff, "--rolloff")?,
-        short_cutoff_wavelength_m: optional_length(&args.cutoff, "--cutoff")?,
-        target,
+        rolloff_m: length(&args.rolloff, "--rolloff")?,
+        cutoff_m: length(&args.cutoff, "--cutoff")?,
         seed: args.seed,
+        ..SurfaceRequest::new(dx, target)
     };
-    let outcome = run_surface(&SurfaceRequest {
-        params,
-        out: args.out.clone(),
-    })?;
-    let (topo, stats) = (&outcome.topography, &outcome.stats);
+    let outcome = run_to_file(&request, &args.out)?;
     println!(
         "{}: {}×{} px of {}, h_rms = {:.4} nm, h'_rms = {:.5}, h''_rms = {:.5} 1/µm",
         args.out.display(),
-        topo.nx(),
-        topo.ny(),
-        units::format_length(dx),
-        stats.h_rms_m * 1e9,
-        stats.h_prime_rms,
-        stats.h_double_prime_rms_per_m * 1e-6
+        outcome.nx,
+        outcome.ny,
+        units::format_length(outcome.pixel_size_m),
+        outcome.h_rms_m * 1e9,
+        outcome.h_prime_rms,
+        outcome.h_double_prime_rms_per_m * 1e-6
     );
     Ok(())
 }

@@ -8,7 +8,7 @@ use clap::ValueEnum;
 use contactscope::synth::SynthParams;
 use contactscope_formats::tiff::Compression;
 use contactscope_formats::units::{self, Dimension};
-use contactscope_jobs::synth_series::{run_synth_series, Layout, SynthSeriesRequest};
+use contactscope_jobs::synth_series::{run_to_folder, Layout, SynthSeriesRequest};
 
 #[derive(Clone, Copy, ValueEnum)]
 enum LayoutArg {
@@ -55,28 +55,29 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let (pixel, _) = units::parse_pixel_size(&args.pixel_size).context("--pixel-size")?;
-    let params = SynthParams {
-        width: args.size,
-        height: args.size,
-        pixel_size_m: pixel,
-        forces_n: units::parse_quantity_list(&args.loads, Dimension::Force).context("--loads")?,
-        seed: args.seed,
-        ..SynthParams::default()
-    };
+    let defaults = SynthSeriesRequest::default();
     let request = SynthSeriesRequest {
-        params,
-        out_dir: args.out,
-        layout: match args.layout {
-            LayoutArg::Multipage => Layout::MultiPage,
-            LayoutArg::Files => Layout::Files,
-        },
-        compression: match args.compression {
-            CompressionArg::None => Compression::None,
-            CompressionArg::Lzw => Compression::Lzw,
-            CompressionArg::Deflate => Compression::Deflate,
+        params: SynthParams {
+            width: args.size,
+            height: args.size,
+            pixel_size_m: pixel,
+            forces_n: units::parse_quantity_list(&args.loads, Dimension::Force)
+                .context("--loads")?,
+            seed: args.seed,
+            ..defaults.params
         },
     };
-    for path in run_synth_series(&request)? {
+    let layout = match args.layout {
+        LayoutArg::Multipage => Layout::MultiPage,
+        LayoutArg::Files => Layout::Files,
+    };
+    let compression = match args.compression {
+        CompressionArg::None => Compression::None,
+        CompressionArg::Lzw => Compression::Lzw,
+        CompressionArg::Deflate => Compression::Deflate,
+    };
+    let (_, written) = run_to_folder(&request, &args.out, layout, compression)?;
+    for path in written {
         println!("{}", path.display());
     }
     Ok(())

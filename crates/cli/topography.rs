@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use contactscope_formats::units;
-use contactscope_jobs::topography::{run_topography, TopographyRequest};
+use contactscope_jobs::topography::{self as job, TopographyRequest};
 
 use super::args::HeightMapOptions;
 
@@ -29,31 +29,15 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let source = args.options.source(args.file.clone())?;
+    let mut source = args.options.source(args.file.clone())?;
+    source.channel = args.channel.clone();
     let detrend = source.detrend.name();
-    let outcome = run_topography(&TopographyRequest {
-        source,
-        channel: args.channel.clone(),
-    })?;
-    let summary = &outcome.summary;
+    let outcome = job::run(&TopographyRequest { source })?;
     if args.json {
-        let mut value = serde_json::to_value(summary)?;
-        value["detrended"] = match &outcome.detrended {
-            Some((topo, stats)) => serde_json::json!({
-                "detrend": detrend,
-                "pixel_size_x_nm": topo.dx_m * 1e9, "pixel_size_y_nm": topo.dy_m * 1e9,
-                "h_rms_nm": stats.h_rms_m * 1e9,
-                "h_prime_rms": stats.h_prime_rms,
-                "h_double_prime_rms_per_um": stats.h_double_prime_rms_per_m * 1e-6,
-            }),
-            None => serde_json::Value::Null,
-        };
-        if let Some(note) = &outcome.note {
-            value["note"] = note.clone().into();
-        }
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        println!("{}", serde_json::to_string_pretty(&outcome.summary)?);
         return Ok(());
     }
+    let summary = &outcome.summary.stored;
     println!("file:        {}", args.file.display());
     println!(
         "format:      {} (channel {})",
@@ -63,13 +47,13 @@ pub fn run(args: Args) -> Result<()> {
         "size:        {} × {} px = {:.4} × {:.4} µm",
         summary.nx,
         summary.ny,
-        summary.nx as f64 * summary.pixel_size_um.x,
-        summary.ny as f64 * summary.pixel_size_um.y
+        summary.nx as f64 * (summary.pixel_size.x_m * 1e6),
+        summary.ny as f64 * (summary.pixel_size.y_m * 1e6)
     );
     println!(
         "pixel size:  {} × {}",
-        units::format_length(summary.pixel_size_um.x * 1e-6),
-        units::format_length(summary.pixel_size_um.y * 1e-6)
+        units::format_length(summary.pixel_size.x_m * 1e6 * 1e-6),
+        units::format_length(summary.pixel_size.y_m * 1e6 * 1e-6)
     );
     println!(
         "valid:       {} of {} points",
@@ -78,12 +62,14 @@ pub fn run(args: Args) -> Result<()> {
     );
     println!(
         "heights:     {:.5} … {:.5} µm as stored (mean {:.5} µm)",
-        summary.height_min_um, summary.height_max_um, summary.height_mean_um
+        summary.height_min_m * 1e6,
+        summary.height_max_m * 1e6,
+        summary.height_mean_m * 1e6
     );
-    let Some((_, stats)) = &outcome.detrended else {
+    let Some(stats) = &outcome.summary.detrended else {
         println!(
             "note:        {}",
-            outcome.note.as_deref().unwrap_or("no statistics")
+            outcome.summary.note.as_deref().unwrap_or("no statistics")
         );
         return Ok(());
     };

@@ -9,34 +9,20 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use contactscope::surface::fill::FillInvalid;
-use contactscope::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
-use contactscope::surface::{Detrend, Topography};
+use contactscope::surface::generate::RmsTarget;
+use contactscope_formats::param::Param;
 use contactscope_jobs::heights::TopographySource;
+use contactscope_jobs::surface::SurfaceRequest;
+use contactscope_jobs::topography::TopographyRequest;
 
+use crate::convert::outcome_dict;
+use crate::heights::{detrend_of, fill_of};
 use crate::{bad, compute, PixelArg};
 
-fn detrend_of(name: &str) -> PyResult<Detrend> {
-    match name {
-        "none" => Ok(Detrend::None),
-        "mean" => Ok(Detrend::Mean),
-        "plane" => Ok(Detrend::Plane),
-        other => Err(bad(format!(
-            "detrend '{other}' is not one of none, mean, plane"
-        ))),
-    }
-}
-
-fn heights_to_py<'py>(py: Python<'py>, t: Topography) -> Bound<'py, PyAny> {
-    t.heights.into_pyarray(py).into_any()
-}
-
-/// Read a height map of any format contactscope reads (npy, TIFF, GSF, text, WSxM, Nanoscope
-/// and the vendor AFM and profilometer formats recognised by content), in m, with its pixel
-/// size (m), then detrend it ("none", "mean" or "plane", the command line's default). `channel`
-/// names the channel of a multi-channel vendor file (default: its height channel); a map with
-/// invalid points is refused unless `fill_invalid` is "mean" or "nearest" (the notes say how
-/// many were filled).
+/// Read a height map of any format contactscope reads (the job `contactscope_jobs::topography`,
+/// as the command line's `topography`): the outcome in SI units (`summary`: `topography --json`;
+/// `notes`) and `heights` (m, rows = y, filled as asked and detrended). A map that cannot be used
+/// (invalid points without `fill_invalid`) is refused with the reason.
 #[pyfunction]
 #[pyo3(signature = (path, pixel_size=None, height_unit=None, detrend="plane", channel=None, fill_invalid=None))]
 fn read_topography<'py>(
@@ -48,66 +34,74 @@ fn read_topography<'py>(
     channel: Option<String>,
     fill_invalid: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let source = TopographySource {
-        path,
-        pixel_size_m: crate::pixel_opt(pixel_size)?,
-        height_unit_m: height_unit,
-        detrend: detrend_of(detrend)?,
-        channel,
-        fill_invalid: match fill_invalid {
-            None => None,
-            Some("mean") => Some(FillInvalid::Mean),
-            Some("nearest") => Some(FillInvalid::Nearest),
-            Some(other) => {
-                return Err(bad(format!(
-                    "fill_invalid '{other}' is not one of mean, nearest"
-                )))
-            }
+    let request = TopographyRequest {
+        source: TopographySource {
+            pixel_size_m: crate::pixel_opt(pixel_size)?,
+            height_unit_m: height_unit,
+            detrend: detrend_of(detrend)?,
+            channel,
+            fill_invalid: fill_of(fill_invalid)?,
+            ..TopographyRequest::new(path).source
         },
     };
-    let (t, notes) = compute(py, move || source.read_with_notes())?;
-    let d = PyDict::new(py);
-    d.set_item("pixel_size_m", (t.dx_m, t.dy_m))?;
-    d.set_item("heights", heights_to_py(py, t))?;
-    d.set_item("notes", notes)?;
+    let mut outcome = compute(py, move || {
+        let outcome = contactscope_jobs::topography::run(&request)?;
+        outcome.usable_heights()?;
+        Ok::<_, contactscope_jobs::Error>(outcome)
+    })?;
+    let heights = outcome.heights.take();
+    let d = outcome_dict(py, &outcome)?;
+    if let Some(t) = heights {
+        d.set_item("heights", t.heights.into_pyarray(py))?;
+    }
     Ok(d)
 }
 
-/// A seeded self-affine random surface (heights in m, rows = y): `nx` × `ny` pixels of
-/// `pixel_size` m, Hurst exponent `hurst`, scaled to `rms_height` (m) or `rms_slope`, with an
-/// optional roll-off and short-wavelength cutoff (m).
+/// A seeded self-affine random surface (the job `contactscope_jobs::surface`, as the command
+/// line's `surface`, with its defaults and range checks): the outcome in SI units (`nx`, `ny`,
+/// `pixel_size_m`, `h_rms_m`, `h_prime_rms`, `h_double_prime_rms_per_m`) and `heights` (m,
+/// rows = y).
 #[pyfunction]
-#[pyo3(signature = (nx, ny, pixel_size, hurst=0.8, rms_height=None, rms_slope=None, rolloff=None, cutoff=None, seed=0))]
+#[pyo3(signature = (nx, ny, pixel_size, hurst=None, rms_height=None, rms_slope=None, rolloff=None, cutoff=None, seed=None))]
 #[allow(clippy::too_many_arguments)]
 fn surface<'py>(
     py: Python<'py>,
     nx: usize,
     ny: usize,
     pixel_size: f64,
-    hurst: f64,
+    hurst: Option<f64>,
     rms_height: Option<f64>,
     rms_slope: Option<f64>,
     rolloff: Option<f64>,
     cutoff: Option<f64>,
-    seed: u64,
-) -> PyResult<Bound<'py, PyAny>> {
+    seed: Option<u64>,
+) -> PyResult<Bound<'py, PyDict>> {
     let target = match (rms_height, rms_slope) {
         (Some(h), None) => RmsTarget::Height(h),
         (None, Some(s)) => RmsTarget::Slope(s),
-        _ => return Err(bad("give exactly one of rms_height (m) and rms_slope")),
+        _ => {
+            return Err(bad(format!(
+                "give exactly one of {} (m) and {}",
+                Param::RmsHeight,
+                Param::RmsSlope
+            )))
+        }
     };
-    let params = SelfAffineParams {
+    let defaults = SurfaceRequest::new(pixel_size, target);
+    let request = SurfaceRequest {
         nx,
         ny,
-        dx_m: pixel_size,
-        hurst,
-        rolloff_wavelength_m: rolloff,
-        short_cutoff_wavelength_m: cutoff,
-        target,
-        seed,
+        hurst: hurst.unwrap_or(defaults.hurst),
+        rolloff_m: rolloff,
+        cutoff_m: cutoff,
+        seed: seed.unwrap_or(defaults.seed),
+        ..defaults
     };
-    let t = compute(py, move || self_affine(&params))?;
-    Ok(heights_to_py(py, t))
+    let mut outcome = compute(py, move || contactscope_jobs::surface::run(&request))?;
+    let heights = std::mem::take(&mut outcome.topography.heights);
+    let d = outcome_dict(py, &outcome)?;
+    d.set_item("heights", heights.into_pyarray(py))?;
+    Ok(d)
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -11,9 +11,11 @@ use pyo3::types::PyDict;
 
 use contactscope::synth::beads::{synth_beads as make_beads, BeadParams};
 use contactscope::synth::rings::{synth_newton as make_newton, NewtonSynthParams};
-use contactscope::synth::{generate, SynthParams};
+use contactscope::synth::SynthParams;
 use contactscope_formats::tiff::write::{encode_f32_stack, encode_u16_stack};
+use contactscope_jobs::synth_series::SynthSeriesRequest;
 
+use crate::convert::outcome_dict;
 use crate::{bad, compute, pixel_opt, PixelArg};
 
 fn stack_u16<'py>(
@@ -31,50 +33,47 @@ fn stack_u16<'py>(
 }
 
 /// A synthetic confocal load series (12-bit in uint16) of a rough sphere on the rigidochromic
-/// flat: `width` × `height` pixels of `pixel_size` m, one image per force (N), with the true
-/// contact areas (m²) and masks. Defaults are the bundled fixture's.
+/// flat (the job `contactscope_jobs::synth_series`, as the command line's `synth-series`, with
+/// its defaults and range checks; `None` keyword = its default): `width` × `height` pixels of
+/// `pixel_size` m, one image per force (N). Returns the outcome in SI units (`forces_n`,
+/// `true_area_m2`, `true_contact_pixels`) with the `images` and the true masks `truth`.
 #[pyfunction]
-#[pyo3(signature = (width=256, height=256, pixel_size=200e-9, forces=None, seed=2018))]
+#[pyo3(signature = (width=None, height=None, pixel_size=None, forces=None, seed=None))]
 fn synth_series<'py>(
     py: Python<'py>,
-    width: usize,
-    height: usize,
-    pixel_size: f64,
+    width: Option<usize>,
+    height: Option<usize>,
+    pixel_size: Option<f64>,
     forces: Option<Vec<f64>>,
-    seed: u64,
+    seed: Option<u64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut params = SynthParams {
-        width,
-        height,
-        pixel_size_m: pixel_size,
-        seed,
-        ..SynthParams::default()
+    let defaults = SynthSeriesRequest::default().params;
+    let request = SynthSeriesRequest {
+        params: SynthParams {
+            width: width.unwrap_or(defaults.width),
+            height: height.unwrap_or(defaults.height),
+            pixel_size_m: pixel_size.unwrap_or(defaults.pixel_size_m),
+            forces_n: forces.unwrap_or_else(|| defaults.forces_n.clone()),
+            seed: seed.unwrap_or(defaults.seed),
+            ..defaults
+        },
     };
-    if let Some(f) = forces {
-        params.forces_n = f;
-    }
-    let images = compute(py, move || generate(&params))?;
-    let d = PyDict::new(py);
-    d.set_item(
-        "forces_n",
-        images.iter().map(|i| i.force_n).collect::<Vec<_>>(),
-    )?;
-    d.set_item(
-        "true_area_m2",
-        images
-            .iter()
-            .map(|i| i.true_area_um2 * 1e-12)
-            .collect::<Vec<_>>(),
-    )?;
-    let truth: Vec<bool> = images.iter().flat_map(|i| i.truth.clone()).collect();
+    let (w, h) = (request.params.width, request.params.height);
+    let mut outcome = compute(py, move || contactscope_jobs::synth_series::run(&request))?;
+    let images = std::mem::take(&mut outcome.images);
+    let d = outcome_dict(py, &outcome)?;
+    let truth: Vec<bool> = images
+        .iter()
+        .flat_map(|i| i.truth.iter().copied())
+        .collect();
     d.set_item(
         "truth",
-        Array3::from_shape_vec((images.len(), height, width), truth)
+        Array3::from_shape_vec((images.len(), h, w), truth)
             .map_err(|e| bad(format!("truth: {e}")))?
             .into_pyarray(py),
     )?;
     let planes = images.into_iter().map(|i| i.codes).collect();
-    d.set_item("images", stack_u16(py, planes, height, width)?)?;
+    d.set_item("images", stack_u16(py, planes, h, w)?)?;
     Ok(d)
 }
 

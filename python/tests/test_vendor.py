@@ -55,13 +55,20 @@ def test_vendor_height_maps_match_cli(cli):
     assert t.heights.shape == (summary["ny"], summary["nx"])
     assert t.heights.std() * 1e6 == pytest.approx(summary["h_rms_um"], rel=1e-6)
     assert t.pixel_size_m[0] * 1e6 == pytest.approx(summary["pixel_size_um"]["x"], rel=1e-12)
+    # Python describes the file as `topography --json` does, in SI units.
+    mine = t.summary
+    for key in ("file", "format", "channel", "nx", "ny", "valid_points", "slope_rms",
+                "curvature_rms"):
+        assert mine[key] == summary[key], key
+    for key in ("height_min", "height_max", "height_mean", "h_rms"):
+        assert mine[f"{key}_m"] * 1e6 == pytest.approx(summary[f"{key}_um"], rel=1e-12), key
     with pytest.raises(cs.InputError, match="channel"):
         cs.read_topography(ibw, channel="NoSuchChannel")
 
 
 def test_invalid_points_refused_unless_filled(cli):
     opd = sample("opd/opd-1.opd")
-    with pytest.raises(cs.InputError, match="invalid"):
+    with pytest.raises(cs.InputError, match="invalid.*fill_invalid="):
         cs.read_topography(opd)
     t = cs.read_topography(opd, fill_invalid="mean", detrend="none")
     summary = json.loads(cli("topography", opd, "--json"))
@@ -70,5 +77,8 @@ def test_invalid_points_refused_unless_filled(cli):
     assert np.isfinite(t.heights).all()
     # Filled with the mean of the valid heights: the mean is unchanged.
     assert t.heights.mean() * 1e6 == pytest.approx(summary["height_mean_um"], rel=1e-9)
+    # The summary describes the file as stored (its invalid points), as the command line does.
+    assert t.summary["valid_points"] == summary["valid_points"]
+    assert summary["detrended"] is None and "invalid" in summary["note"]
     with pytest.raises(cs.InputError, match="fill_invalid"):
         cs.read_topography(opd, fill_invalid="zero")

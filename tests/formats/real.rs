@@ -197,23 +197,20 @@ fn height_maps_match_surface_topography() {
             "{file}"
         );
         assert!(
-            rel(s.pixel_size_um.x, dx * 1e6) < 1e-6 && rel(s.pixel_size_um.y, dy * 1e6) < 1e-6,
+            rel(s.pixel_size.x_m, dx) < 1e-6 && rel(s.pixel_size.y_m, dy) < 1e-6,
             "{file}: pixel"
         );
         for (what, got, want) in [
-            ("min", s.height_min_um, min),
-            ("max", s.height_max_um, max),
-            ("rms", s.h_rms_um, rms),
+            ("min", s.height_min_m, min),
+            ("max", s.height_max_m, max),
+            ("rms", s.h_rms_m, rms),
         ] {
-            assert!(
-                rel(got, want * 1e6) < 1e-6,
-                "{file}: {what} {got} µm vs {want} m"
-            );
+            assert!(rel(got, want) < 1e-6, "{file}: {what} {got} m vs {want} m");
         }
         assert!(
-            (s.height_mean_um - mean * 1e6).abs() < 1e-6 * rms * 1e6,
+            (s.height_mean_m - mean).abs() < 1e-6 * rms,
             "{file}: mean {}",
-            s.height_mean_um
+            s.height_mean_m
         );
         assert!(
             s.slope_rms.unwrap() > 0.0 && s.curvature_rms.unwrap() > 0.0,
@@ -305,8 +302,8 @@ fn real_afm_copies_read_the_same() {
         let x = topography_summary(&afm.join(a), None).unwrap();
         let y = topography_summary(&formats.join(f), None).unwrap();
         assert_eq!(
-            (x.nx, x.h_rms_um, x.height_min_um),
-            (y.nx, y.h_rms_um, y.height_min_um),
+            (x.nx, x.h_rms_m, x.height_min_m),
+            (y.nx, y.h_rms_m, y.height_min_m),
             "{a}"
         );
     }

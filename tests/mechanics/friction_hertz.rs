@@ -12,8 +12,9 @@ use contactscope::mechanics::squeeze::fit_hertz;
 use contactscope::synth::traces::{
     synthetic_trace, trace_csv, CsvLayout, SyntheticTrace, TraceParams,
 };
-use contactscope_jobs::friction::{run_friction, FrictionRequest};
-use contactscope_jobs::hertz::{run_hertz, HertzRequest};
+use contactscope_formats::param::Param;
+use contactscope_jobs::friction::{files::run_to_folder, FrictionOutcome, FrictionRequest};
+use contactscope_jobs::hertz::{files::run_to_folder as hertz_to_folder, HertzRequest};
 use contactscope_jobs::mechanics_csv::{read_squeeze, read_trace};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -83,17 +84,42 @@ fn load_series(dir: &Path) -> (Vec<PathBuf>, PathBuf) {
     (traces, write(dir, "areas.csv", &areas))
 }
 
-fn request(traces: Vec<PathBuf>, areas: Option<PathBuf>, out: PathBuf) -> FrictionRequest {
-    FrictionRequest {
-        traces,
-        normal_force_n: None,
-        rotation_radius_m: None,
-        areas,
-        force_tolerance: 0.02,
-        slip: SlipOptions::default(),
-        out_dir: out,
-        command_line: vec!["test".into()],
+/// A friction request with the folder the command line would write.
+struct Req {
+    job: FrictionRequest,
+    out: PathBuf,
+}
+
+impl std::ops::Deref for Req {
+    type Target = FrictionRequest;
+    fn deref(&self) -> &FrictionRequest {
+        &self.job
     }
+}
+
+impl std::ops::DerefMut for Req {
+    fn deref_mut(&mut self) -> &mut FrictionRequest {
+        &mut self.job
+    }
+}
+
+fn request(traces: Vec<PathBuf>, areas: Option<PathBuf>, out: PathBuf) -> Req {
+    Req {
+        job: FrictionRequest {
+            traces,
+            normal_force_n: None,
+            rotation_radius_m: None,
+            areas,
+            force_tolerance: 0.02,
+            slip: SlipOptions::default(),
+        },
+        out,
+    }
+}
+
+/// The job run as the command line runs it: its folder written all or nothing.
+fn run_friction(req: &Req) -> contactscope_jobs::Result<FrictionOutcome> {
+    Ok(run_to_folder(&req.job, &req.out, &["test".into()])?.0)
 }
 
 /// Known τ = 50 MPa from four noisy traces with creep and stick-slip; tolerance 2 % (measured
@@ -325,7 +351,7 @@ fn normal_force_is_required() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("t.csv") && err.contains("--normal-force"),
+        err.contains("t.csv") && err.contains(&Param::NormalForce.to_string()),
         "{err}"
     );
 }
@@ -536,15 +562,10 @@ fn bad_squeeze_inputs() {
     let err = read_squeeze(&not_number).unwrap_err().to_string();
     assert!(err.contains("line 2") && err.contains("abc"), "{err}");
     let good = squeeze_csv(dir.path(), "good.csv", 0.0, 1);
-    let req = |radius_m: f64| HertzRequest {
-        input: good.clone(),
-        radius_m,
-        loads_n: None,
-        out_dir: dir.path().join("out"),
-        command_line: vec![],
-    };
-    assert!(run_hertz(&req(0.0)).is_err());
-    assert!(run_hertz(&req(-290e-6)).is_err());
+    let out = dir.path().join("out");
+    let req = |radius_m: f64| HertzRequest::new(good.clone(), radius_m);
+    assert!(hertz_to_folder(&req(0.0), &out, &[]).is_err());
+    assert!(hertz_to_folder(&req(-290e-6), &out, &[]).is_err());
     assert!(!dir.path().join("out").exists());
 }
 

@@ -145,6 +145,16 @@ params! {
     Areas: "--areas", "areas", "the measured areas";
     /// Output folder or file.
     Out: "--out", "out", "the output";
+    /// Hurst exponent of a self-affine surface.
+    Hurst: "--hurst", "hurst", "the Hurst exponent";
+    /// rms height a generated surface is scaled to.
+    RmsHeight: "--rms-height", "rms_height", "the rms height";
+    /// rms slope a generated surface is scaled to.
+    RmsSlope: "--rms-slope", "rms_slope", "the rms slope";
+    /// Roll-off wavelength of a generated surface.
+    Rolloff: "--rolloff", "rolloff", "the roll-off wavelength";
+    /// Short-wavelength cutoff of a generated surface.
+    Cutoff: "--cutoff", "cutoff", "the short-wavelength cutoff";
 }
 
 impl fmt::Display for Param {

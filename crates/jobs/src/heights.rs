@@ -61,20 +61,12 @@ impl HeightInput {
 
     /// Range checks of what the caller gave: pixel sizes and the height unit.
     pub fn check(&self) -> Result<()> {
-        let pixel = match self {
-            HeightInput::File(s) => {
-                if let Some(u) = s.height_unit_m {
-                    Quantity::Height.check(u, Param::HeightUnit)?;
-                }
-                s.pixel_size_m
+        match self {
+            HeightInput::File(s) => s.check(),
+            HeightInput::Memory { topography, .. } => {
+                check_pixel_size((topography.dx_m, topography.dy_m))
             }
-            HeightInput::Memory { topography, .. } => Some((topography.dx_m, topography.dy_m)),
-        };
-        if let Some((x, y)) = pixel {
-            Quantity::PixelSize.check(x, Param::PixelSize)?;
-            Quantity::PixelSize.check(y, Param::PixelSize)?;
         }
-        Ok(())
     }
 
     /// The heights, filled and detrended, with notes for the user.
@@ -173,6 +165,17 @@ impl TopographySource {
         }
     }
 
+    /// Range checks of the overrides: the pixel size and the height unit.
+    pub fn check(&self) -> Result<()> {
+        if let Some(u) = self.height_unit_m {
+            Quantity::Height.check(u, Param::HeightUnit)?;
+        }
+        match self.pixel_size_m {
+            Some(p) => check_pixel_size(p),
+            None => Ok(()),
+        }
+    }
+
     /// The map as stored (no filling, no detrending), with every override applied.
     pub fn read_raw(&self) -> Result<HeightMap> {
         Ok(read_height_map(
@@ -195,26 +198,17 @@ impl TopographySource {
         let mut map = self.read_raw()?;
         let mut notes = Vec::new();
         match self.fill_invalid {
-            Some(how) => {
-                let filled = fill_invalid(&mut map, how);
-                if filled > 0 {
-                    notes.push(format!(
-                        "{}: {filled} invalid point(s) filled with the {} valid height",
-                        self.path.display(),
-                        how.name()
-                    ));
-                }
-            }
+            Some(_) => notes.extend(self.fill(&mut map)),
             None if map.invalid_points > 0 && map.valid_points() > 0 => {
                 return Err(Error::bad_input(
                     Location::file(&self.path),
                     format!(
                         "{} of {} points of channel '{}' are invalid (not measured); a contact \
-                         calculation needs every height: give --fill-invalid mean|nearest to \
-                         fill them",
+                         calculation needs every height: give {} mean|nearest to fill them",
                         map.invalid_points,
                         map.heights.len(),
-                        map.channel
+                        map.channel,
+                        Param::FillInvalid
                     ),
                 ));
             }
@@ -224,6 +218,29 @@ impl TopographySource {
         topography.detrend(self.detrend);
         Ok((topography, notes))
     }
+}
+
+impl TopographySource {
+    /// Fill the map's invalid points as asked ([`Self::fill_invalid`]); the note for the user
+    /// when any were filled.
+    pub fn fill(&self, map: &mut HeightMap) -> Option<String> {
+        let how = self.fill_invalid?;
+        let filled = fill_invalid(map, how);
+        (filled > 0).then(|| {
+            format!(
+                "{}: {filled} invalid point(s) filled with the {} valid height",
+                self.path.display(),
+                how.name()
+            )
+        })
+    }
+}
+
+/// A pixel size (x, y), m, within the plausible range.
+fn check_pixel_size((x, y): (f64, f64)) -> Result<()> {
+    Quantity::PixelSize.check(x, Param::PixelSize)?;
+    Quantity::PixelSize.check(y, Param::PixelSize)?;
+    Ok(())
 }
 
 /// The map as a [`Topography`] for a contact calculation, or an error naming the file (invalid

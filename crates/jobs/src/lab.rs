@@ -85,6 +85,10 @@ pub enum Unit {
     PerMAsPerUm,
     /// A count or a ratio: no unit.
     None,
+    /// Stored in m, written in mm.
+    MAsMm,
+    /// Stored as a fraction, written in percent (SI: the fraction).
+    FractionAsPct,
 }
 
 impl Unit {
@@ -106,6 +110,8 @@ impl Unit {
             Unit::PaPerMAsMpaPerNm => (1e-15, 1.0),
             Unit::PerMAsPerUm => (1e-6, 1.0),
             Unit::None => (1.0, 1.0),
+            Unit::MAsMm => (1e3, 1.0),
+            Unit::FractionAsPct => (100.0, 1.0),
         }
     }
 
@@ -195,6 +201,10 @@ quantities! {
     pa_per_m_as_mpa_per_nm, opt_pa_per_m_as_mpa_per_nm, each_pa_per_m_as_mpa_per_nm: PaPerMAsMpaPerNm;
     /// Stored in 1/m, written in 1/µm.
     per_m_as_per_um, opt_per_m_as_per_um, each_per_m_as_per_um: PerMAsPerUm;
+    /// Stored in m, written in mm.
+    m_as_mm, opt_m_as_mm, each_m_as_mm: MAsMm;
+    /// Stored as a fraction, written in percent (SI key: `…_fraction`).
+    fraction_as_pct, opt_fraction_as_pct, each_fraction_as_pct: FractionAsPct;
 }
 
 /// What one unit token of a key means: (the SI token, the factor from SI to the unit).
@@ -208,6 +218,8 @@ fn unit_token(token: &str) -> Option<(&'static str, f64)> {
         "um3" => ("m3", 1e18),
         "MPa" => ("pa", 1e-6),
         "GPa" => ("pa", 1e-9),
+        "mm" => ("m", 1e3),
+        "pct" => ("fraction", 100.0),
         _ => return None,
     })
 }
@@ -324,5 +336,27 @@ mod tests {
         assert!(close(key_factor("area_um2"), 1e12));
         assert_eq!(key_factor("prefactor_um2_per_mN_pow_exponent"), None);
         assert_eq!(key_factor("patches"), None);
+    }
+
+    #[test]
+    fn millimetres_and_percent() {
+        #[derive(Serialize)]
+        struct Inputs {
+            #[serde(rename = "rotation_radius_mm", serialize_with = "opt_m_as_mm")]
+            r: Option<f64>,
+            #[serde(rename = "force_tolerance_pct", serialize_with = "fraction_as_pct")]
+            t: f64,
+        }
+        let i = Inputs {
+            r: Some(5e-3),
+            t: 0.02,
+        };
+        let lab = serde_json::to_value(&i).unwrap();
+        assert_eq!(lab["rotation_radius_mm"], 5e-3 * 1e3);
+        assert_eq!(lab["force_tolerance_pct"], 0.02 * 100.0);
+        let si = to_si_value(&i).unwrap();
+        assert_eq!(si["rotation_radius_m"], 5e-3);
+        assert_eq!(si["force_tolerance_fraction"], 0.02);
+        assert!((key_factor("rotation_radius_mm").unwrap() - 1e3).abs() < 1e-9);
     }
 }

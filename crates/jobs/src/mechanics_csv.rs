@@ -34,6 +34,7 @@ use crate::error::{Error, Location, Result};
 use contactscope::mechanics::friction::{Trace, XAxis, MIN_SAMPLES};
 use contactscope::mechanics::squeeze::{check_points, SqueezePoint};
 use contactscope::numerics::stats::median;
+use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
 
 const FRICTION_COLUMNS: [(&str, f64); 2] = [("friction_mN", 1e-3), ("friction_N", 1.0)];
@@ -155,7 +156,8 @@ fn friction_column(table: &Table, rotation_radius_m: Option<f64>) -> Result<Vec<
                 Error::bad_input(
                     table.location(),
                     format!(
-                        "{name} is a torque; give the sphere's rotation radius (--rotation-radius, e.g. 5mm) to turn it into a force"
+                        "{name} is a torque; give the sphere's rotation radius ({}, e.g. 5mm) to turn it into a force",
+                        Param::RotationRadius
                     ),
                 )
             })?;

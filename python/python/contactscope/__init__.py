@@ -51,7 +51,10 @@ __all__ = [
     "blur_and_resample",
     "compare",
     "fit_hardening",
+    "friction",
     "get_num_threads",
+    "hertz",
+    "info",
     "measure",
     "misfit",
     "newton",
@@ -64,6 +67,7 @@ __all__ = [
     "set_num_threads",
     "simulate",
     "surface",
+    "surface_with_stats",
 ]
 
 
@@ -363,24 +367,54 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
                     fill_invalid: Optional[str] = None) -> Results:
     """A height map from any format contactscope reads (npy, TIFF, GSF, text, WSxM, Nanoscope,
     Igor ibw, Nanosurf nid, PicoView mi, Park TIFF, Gwyddion, X3P, SDF, Wyko opd, Sensofar plu,
-    Digital Surf sur, FRT … by extension or content): ``heights`` (rows = y, m) and
-    ``pixel_size_m`` ((x, y), m), after ``detrend`` ("none", "mean", "plane" as the command
-    line's default). ``height_unit``: metres per stored unit for files without one.
-    ``channel`` names the channel of a multi-channel file (default: its height channel). A map
-    with invalid (unmeasured) points raises :class:`InputError` unless ``fill_invalid`` is
-    "mean" or "nearest"; ``notes`` then says how many points were filled."""
-    return Results(_cs.read_topography(os.fspath(path), pixel_size, height_unit, detrend,
-                                       channel, fill_invalid))
+    Digital Surf sur, FRT … by extension or content), read as the command line's ``topography``
+    reads it (the same checks and messages).
+
+    ``pixel_size`` (m, or (x, y)) overrides the file's; ``height_unit``: metres per stored unit
+    for files without one. ``channel`` names the channel of a multi-channel file (default: its
+    height channel). A map with invalid (unmeasured) points raises :class:`InputError` unless
+    ``fill_invalid`` is "mean" or "nearest"; ``notes`` then says how many points were filled.
+
+    Returns ``heights`` (rows = y, m; filled as asked, then detrended by ``detrend``: "none",
+    "mean" or "plane", the command line's default), ``pixel_size_m`` ((x, y), m), ``notes`` and
+    ``summary``: the command line's ``topography --json`` in SI units, describing the file as
+    stored (``file``, ``format``, ``channel``, ``nx``, ``ny``, ``pixel_size_m`` {``x``, ``y``},
+    ``valid_points``, ``height_min_m``, ``height_max_m``, ``height_mean_m``, ``h_rms_m``,
+    ``slope_rms``, ``curvature_rms`` (1/m)) and after detrending (``detrended``: ``detrend``,
+    ``pixel_size_x_m``, ``pixel_size_y_m``, ``h_rms_m``, ``h_prime_rms``,
+    ``h_double_prime_rms_per_m``).
+    """
+    result = Results(_cs.read_topography(os.fspath(path), pixel_size, height_unit, detrend,
+                                         channel, fill_invalid))
+    d = result["summary"]["detrended"]
+    result["pixel_size_m"] = (d["pixel_size_x_m"], d["pixel_size_y_m"])
+    return result
 
 
-def surface(nx: int, ny: int, pixel_size: float, hurst: float = 0.8,
+def surface(nx: int, ny: int, pixel_size: float, hurst: Optional[float] = None,
             rms_height: Optional[float] = None, rms_slope: Optional[float] = None,
             rolloff: Optional[float] = None, cutoff: Optional[float] = None,
-            seed: int = 0) -> np.ndarray:
-    """A seeded self-affine random surface: heights (ny, nx) in m on ``pixel_size`` m pixels,
-    Hurst exponent ``hurst``, scaled to ``rms_height`` (m) or ``rms_slope``; optional roll-off
-    and short-wavelength cutoff wavelengths (m)."""
-    return _cs.surface(nx, ny, pixel_size, hurst, rms_height, rms_slope, rolloff, cutoff, seed)
+            seed: Optional[int] = None) -> np.ndarray:
+    """A seeded self-affine random surface, as the command line's ``surface`` makes it (the
+    same defaults and range checks): heights (ny, nx) in m on ``pixel_size`` m pixels, Hurst
+    exponent ``hurst`` (default 0.8), scaled to ``rms_height`` (m) or ``rms_slope`` (give
+    exactly one); optional roll-off and short-wavelength cutoff wavelengths (m); ``seed``
+    (default 7, as the command line). :func:`surface_with_stats` also returns its roughness
+    statistics."""
+    return surface_with_stats(nx, ny, pixel_size, hurst, rms_height, rms_slope, rolloff,
+                              cutoff, seed)["heights"]
+
+
+def surface_with_stats(nx: int, ny: int, pixel_size: float, hurst: Optional[float] = None,
+                       rms_height: Optional[float] = None, rms_slope: Optional[float] = None,
+                       rolloff: Optional[float] = None, cutoff: Optional[float] = None,
+                       seed: Optional[int] = None) -> Results:
+    """:func:`surface` with the finite-difference roughness statistics the command line's
+    ``surface`` prints: ``heights`` (ny, nx; m), ``nx``, ``ny``, ``pixel_size_m``, ``h_rms_m``
+    (m), ``h_prime_rms`` (central differences) and ``h_double_prime_rms_per_m`` (5-point
+    Laplacian, 1/m)."""
+    return Results(_cs.surface(nx, ny, pixel_size, hurst, rms_height, rms_slope, rolloff,
+                               cutoff, None if seed is None else int(seed)))
 
 
 def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
@@ -547,13 +581,80 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
     return result
 
 
+def friction(traces: Union[PathLike, Sequence[PathLike]], normal_force: Optional[float] = None,
+             rotation_radius: Optional[float] = None, areas: Optional[PathLike] = None,
+             force_tolerance: Optional[float] = None) -> Results:
+    """Static and kinetic friction from rheometer traces, the command line's ``friction`` on the
+    same files (the same defaults, checks, warnings and numbers).
+
+    ``traces``: one CSV per trace (columns ``time_s`` | ``displacement_um`` | ``angle_rad``,
+    ``friction_mN`` | ``friction_N`` | ``torque_mNm`` | ``torque_Nm``, optional
+    ``normal_force_mN`` | ``normal_force_N``). ``normal_force`` (N) for traces without a
+    normal-force column; ``rotation_radius`` (m) turns torque into force; ``areas``: an
+    ``areas.csv`` of :func:`analyze` or the command line (``force_mN``, ``area_um2``) for
+    F_s = τ·A, each trace matched to the row with the nearest force within ``force_tolerance``
+    (a fraction, default 0.02).
+
+    Returns the outcome the command line writes as ``summary.json``, in SI units: ``traces``
+    (per trace: ``file``, ``normal_force_n``, ``static_friction_n``, ``kinetic_friction_n``,
+    ``slip_at`` with ``slip_at_unit`` ("m", "rad" or "s"), ``mu_static``, ``mu_kinetic``,
+    ``noise_n``, ``area_m2``, …; also :attr:`Results.rows`), ``tau_pa``, ``tau_se_pa``, ``r2``,
+    ``static_shear_fit``, ``kinetic_shear_fit``, ``mu_static_vs_load``, ``inputs``, ``method``
+    and ``warnings`` (also issued as :class:`ContactscopeWarning`).
+    """
+    if isinstance(traces, (str, os.PathLike)):
+        traces = [traces]
+    result = Results(_cs.friction([os.fspath(t) for t in traces],
+                                  None if normal_force is None else float(normal_force),
+                                  None if rotation_radius is None else float(rotation_radius),
+                                  None if areas is None else os.fspath(areas),
+                                  None if force_tolerance is None else float(force_tolerance)),
+                     table="traces")
+    _warn(result)
+    return result
+
+
+def hertz(squeeze: PathLike, radius: float, loads: Optional[Sequence[float]] = None) -> Results:
+    """The contact modulus E* from a squeeze test of a sphere of ``radius`` (m) between two
+    plates, the command line's ``hertz`` on the same file: P = (4/3) E* R^(1/2) δ^(3/2) with
+    δ = displacement/2, least squares through the origin (and with a free contact point).
+
+    ``squeeze``: a CSV with ``force_mN`` (or ``force_N``) and ``displacement_um`` (total plate
+    displacement 2δ); ``loads`` (N) where the Hertz contact is predicted (default: the measured
+    forces).
+
+    Returns the outcome the command line writes as ``hertz.json``, in SI units:
+    ``contact_modulus_pa``, ``contact_modulus_se_pa``, ``r2``, ``points_used``,
+    ``max_abs_residual_n``, ``offset_fit`` (``contact_modulus_pa``, …,
+    ``contact_offset_displacement_m``), ``radius_m``, ``predicted`` (per load: ``force_n``,
+    ``contact_radius_m``, ``contact_area_m2``; also :attr:`Results.rows`), ``method``, and
+    ``points``: the fitted points as ``hertz_fit.csv`` has them (``force_n``,
+    ``displacement_m``, ``delta_m``, ``fitted_force_n``, ``residual_n``).
+    """
+    loads = None if loads is None else [float(f) for f in loads]
+    return Results(_cs.hertz(os.fspath(squeeze), float(radius), loads), table="predicted")
+
+
+def info(path: PathLike, stats: bool = False) -> Results:
+    """What a TIFF, Zeiss CZI, Nikon ND2 or Leica LIF file holds, as the command line's
+    ``info --json`` describes it, in SI units: ``file``, ``format`` and ``series`` (per series:
+    ``index``, ``name``, ``axes`` (``T``, ``Z``, ``C``, ``Y``, ``X`` and extra axes by name),
+    ``dtype``, ``pixel_size_m`` {``x``, ``y``, ``z``} (m, ``None`` where the file does not
+    state it), ``pixel_size_source`` and, with ``stats``, ``planes``: every plane's index with
+    its ``min``, ``max``, ``mean`` and ``sum``)."""
+    return Results(_cs.info(os.fspath(path), bool(stats)), table="series")
+
+
 # Seeded generators with known truth, and a TIFF writer (inputs for examples and tests).
 
-def synth_series(width: int = 256, height: int = 256, pixel_size: float = 200e-9,
-                 forces: Optional[Sequence[float]] = None, seed: int = 2018) -> Results:
-    """A synthetic confocal load series (12-bit values in uint16) with known truth: ``images``
-    (loads, rows, columns), ``forces_n`` (N), ``true_area_m2`` (m²) and the true masks
-    ``truth``; pixel size in m. Defaults: the bundled fixture (8 loads, 4–100 mN)."""
+def synth_series(width: Optional[int] = None, height: Optional[int] = None,
+                 pixel_size: Optional[float] = None, forces: Optional[Sequence[float]] = None,
+                 seed: Optional[int] = None) -> Results:
+    """A synthetic confocal load series (12-bit values in uint16) with known truth, as the
+    command line's ``synth-series`` makes it (the same defaults and checks): ``images``
+    (loads, rows, columns), ``forces_n`` (N), ``true_area_m2`` (m²), ``true_contact_pixels``
+    and the true masks ``truth``; pixel size in m. Defaults: the bundled fixture (256 × 256
+    pixels of 200 nm, 8 loads 4–100 mN, seed 2018)."""
     forces = None if forces is None else [float(f) for f in forces]
     return Results(_cs.synth_series(width, height, pixel_size, forces, seed))
 

@@ -133,6 +133,42 @@ def compare(
 ) -> CompareResult: ...
 
 # Height maps and contact mechanics
+class TopographyPixelSize(TypedDict):
+    x: float
+    y: float
+
+class TopographyDetrended(TypedDict):
+    detrend: str
+    pixel_size_x_m: float
+    pixel_size_y_m: float
+    h_rms_m: float
+    h_prime_rms: float
+    h_double_prime_rms_per_m: float
+
+class TopographySummary(TypedDict, total=False):
+    """``topography --json`` in SI units (``note`` only when ``detrended`` is ``None``)."""
+
+    file: str
+    format: str
+    channel: str
+    nx: int
+    ny: int
+    pixel_size_m: TopographyPixelSize
+    valid_points: int
+    height_min_m: float
+    height_max_m: float
+    height_mean_m: float
+    h_rms_m: float
+    slope_rms: Optional[float]
+    curvature_rms: Optional[float]
+    detrended: Optional[TopographyDetrended]
+    note: str
+
+class TopographyResult(TypedDict):
+    summary: TopographySummary
+    notes: List[str]
+    heights: npt.NDArray[np.float64]
+
 def read_topography(
     path: Path,
     pixel_size: Optional[PixelSize] = None,
@@ -140,18 +176,28 @@ def read_topography(
     detrend: str = "plane",
     channel: Optional[str] = None,
     fill_invalid: Optional[str] = None,
-) -> Dict[str, Any]: ...
+) -> TopographyResult: ...
+
+class SurfaceResult(TypedDict):
+    nx: int
+    ny: int
+    pixel_size_m: float
+    h_rms_m: float
+    h_prime_rms: float
+    h_double_prime_rms_per_m: float
+    heights: npt.NDArray[np.float64]
+
 def surface(
     nx: int,
     ny: int,
     pixel_size: float,
-    hurst: float = 0.8,
+    hurst: Optional[float] = None,
     rms_height: Optional[float] = None,
     rms_slope: Optional[float] = None,
     rolloff: Optional[float] = None,
     cutoff: Optional[float] = None,
-    seed: int = 0,
-) -> npt.NDArray[np.float64]: ...
+    seed: Optional[int] = None,
+) -> SurfaceResult: ...
 class SimulatedLoad(TypedDict):
     force_n: float
     area_m2: float
@@ -269,14 +315,133 @@ def fit_hardening(
     periodic: bool = False,
 ) -> FitResult: ...
 
+# Mechanics tests (CSV files)
+class FrictionTrace(TypedDict):
+    file: str
+    normal_force_n: float
+    static_friction_n: float
+    kinetic_friction_n: float
+    slip_at: float
+    slip_at_unit: str
+    slip_sample: int
+    slip_criterion: str
+    mu_static: float
+    mu_kinetic: float
+    noise_n: float
+    drop_threshold_n: float
+    area_m2: Optional[float]
+
+class ShearFit(TypedDict):
+    tau_pa: float
+    tau_se_pa: Optional[float]
+    r2: Optional[float]
+    points: int
+
+class MuTrend(TypedDict):
+    exponent: float
+    exponent_se: Optional[float]
+    relative_spread: float
+    varies: Optional[bool]
+
+class FrictionInputs(TypedDict):
+    traces: List[str]
+    areas: Optional[str]
+    normal_force_n: Optional[float]
+    rotation_radius_m: Optional[float]
+    force_tolerance_fraction: float
+
+class FrictionResult(TypedDict):
+    inputs: FrictionInputs
+    method: Dict[str, Any]
+    tau_pa: Optional[float]
+    tau_se_pa: Optional[float]
+    r2: Optional[float]
+    static_shear_fit: Optional[ShearFit]
+    kinetic_shear_fit: Optional[ShearFit]
+    mu_static_vs_load: Optional[MuTrend]
+    traces: List[FrictionTrace]
+    warnings: List[str]
+
+def friction(
+    traces: Sequence[Path],
+    normal_force: Optional[float] = None,
+    rotation_radius: Optional[float] = None,
+    areas: Optional[Path] = None,
+    force_tolerance: Optional[float] = None,
+) -> FrictionResult: ...
+
+class HertzPrediction(TypedDict):
+    force_n: float
+    contact_radius_m: float
+    contact_area_m2: float
+
+class HertzPoint(TypedDict):
+    force_n: float
+    displacement_m: float
+    delta_m: float
+    fitted_force_n: float
+    residual_n: float
+
+class HertzOffsetFit(TypedDict):
+    contact_modulus_pa: float
+    contact_modulus_se_pa: float
+    r2: float
+    contact_offset_displacement_m: float
+
+class HertzResult(TypedDict):
+    input: str
+    radius_m: float
+    method: Dict[str, str]
+    points_used: int
+    contact_modulus_pa: float
+    contact_modulus_se_pa: float
+    r2: float
+    max_abs_residual_n: float
+    offset_fit: Optional[HertzOffsetFit]
+    predicted: List[HertzPrediction]
+    points: List[HertzPoint]
+
+def hertz(squeeze: Path, radius: float, loads: Optional[Sequence[float]] = None) -> HertzResult: ...
+
+# File descriptions
+class VoxelSize(TypedDict):
+    x: Optional[float]
+    y: Optional[float]
+    z: Optional[float]
+
+class InfoSeries(TypedDict, total=False):
+    """One series (``planes`` only with ``stats=True``)."""
+
+    index: int
+    name: str
+    axes: Dict[str, int]
+    dtype: str
+    pixel_size_m: VoxelSize
+    pixel_size_source: Optional[str]
+    planes: List[Dict[str, Any]]
+
+class InfoResult(TypedDict):
+    file: str
+    format: str
+    series: List[InfoSeries]
+
+def info(path: Path, stats: bool = False) -> InfoResult: ...
+
 # Generators and a writer
+class SynthSeriesResult(TypedDict):
+    forces_n: List[float]
+    true_area_m2: List[float]
+    true_contact_pixels: List[int]
+    truth: npt.NDArray[np.bool_]
+    images: npt.NDArray[np.uint16]
+
 def synth_series(
-    width: int = 256,
-    height: int = 256,
-    pixel_size: float = 200e-9,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
+    pixel_size: Optional[float] = None,
     forces: Optional[Sequence[float]] = None,
-    seed: int = 2018,
-) -> Dict[str, Any]: ...
+    seed: Optional[int] = None,
+) -> SynthSeriesResult: ...
 def synth_beads(
     width: int = 128,
     height: int = 128,

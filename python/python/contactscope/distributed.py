@@ -60,9 +60,9 @@ def _ramp_task(heights: np.ndarray, pixel_size: Any, modulus: float, family: str
 
 def _surface_task(spec: Dict[str, Any], seed: int, threads: int) -> np.ndarray:
     _threads(threads)
-    return _cs.surface(spec["nx"], spec["ny"], spec["pixel_size"], spec.get("hurst", 0.8),
+    return _cs.surface(spec["nx"], spec["ny"], spec["pixel_size"], spec.get("hurst"),
                        spec.get("rms_height"), spec.get("rms_slope"), spec.get("rolloff"),
-                       spec.get("cutoff"), int(seed))
+                       spec.get("cutoff"), int(seed))["heights"]
 
 
 @contextlib.contextmanager

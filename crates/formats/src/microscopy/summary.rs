@@ -17,10 +17,11 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::select::Selection;
-use super::{Axes, MicroscopyFile, PlaneIndex};
+use super::{Axes, MicroscopyFile, PlaneIndex, VoxelSize};
 use crate::binary::bad;
 use crate::error::Result;
 use crate::image::{Plane, Samples};
+use crate::param::Param;
 
 /// `info --json` for one file.
 #[derive(Debug, Clone, Serialize)]
@@ -48,6 +49,10 @@ pub struct SeriesSummary {
     pub pixel_size_um: PixelSizeUm,
     /// The metadata element the x/y size came from (`null` when absent).
     pub pixel_size_source: Option<String>,
+    /// The voxel size in metres as the file states it (`pixel_size_um` is this in µm), for
+    /// callers that write it in other units.
+    #[serde(skip)]
+    pub pixel_size_m: VoxelSize,
     /// Per-plane statistics, with `--stats` only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub planes: Option<Vec<PlaneStats>>,
@@ -132,7 +137,10 @@ pub fn info_summary_selected(
     if let Some(s) = selection.series.filter(|s| *s >= n_series) {
         return Err(bad(
             path,
-            format!("--series {s} requested; the file has {n_series} series"),
+            format!(
+                "{} {s} requested; the file has {n_series} series",
+                Param::Series
+            ),
         ));
     }
     for info in file.series.clone() {
@@ -141,9 +149,9 @@ pub fn info_summary_selected(
         }
         let a = &info.axes;
         for (flag, value, n) in [
-            ("--channel", selection.channel, a.c),
-            ("--z", selection.z, a.z),
-            ("--t", selection.t, a.t),
+            (Param::Channel, selection.channel, a.c),
+            (Param::Z, selection.z, a.z),
+            (Param::T, selection.t, a.t),
         ] {
             if let Some(v) = value.filter(|v| *v >= n) {
                 return Err(bad(
@@ -191,6 +199,7 @@ pub fn info_summary_selected(
                 z: um(info.pixel_size.z_m),
             },
             pixel_size_source: info.pixel_size.source.clone(),
+            pixel_size_m: info.pixel_size.clone(),
             planes,
         });
     }

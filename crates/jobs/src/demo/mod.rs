@@ -27,10 +27,10 @@ use crate::compare::load_micrographs;
 use crate::error::{Error, Result};
 use crate::fit_hardening::files::run_to_folder as fit_to_folder;
 use crate::fit_hardening::{BodyRequest, FitRequest, MeasuredInput};
-use crate::friction::{run_friction, FrictionRequest};
+use crate::friction::{files::run_to_folder as friction_to_folder, FrictionRequest};
 use crate::heights::HeightInput;
 use crate::heights::TopographySource;
-use crate::hertz::{run_hertz, HertzRequest};
+use crate::hertz::{files::run_to_folder as hertz_to_folder, HertzRequest};
 use crate::newton::{run_newton, NewtonRequest};
 use crate::psf::{run_psf, PsfRequest};
 use crate::series::{Micrographs, SeriesSpec};
@@ -525,13 +525,15 @@ fn hertz(work: &Path, data: &Path, p: &DemoParams) -> Result<Recovered> {
     }
     let path = data.join("squeeze.csv");
     write_atomic(&path, text.as_bytes())?;
-    let outcome = run_hertz(&HertzRequest {
-        input: path,
-        radius_m: radius,
-        loads_n: Some(p.loads_n.clone()),
-        out_dir: work.join("hertz"),
-        command_line: vec!["contactscope demo".into()],
-    })?;
+    let (outcome, _) = hertz_to_folder(
+        &HertzRequest {
+            input: path,
+            radius_m: radius,
+            loads_n: Some(p.loads_n.clone()),
+        },
+        &work.join("hertz"),
+        &["contactscope demo".into()],
+    )?;
     Ok(Recovered {
         quantity: "contact modulus E*".into(),
         unit: "GPa".into(),
@@ -578,16 +580,18 @@ fn friction(
         write_atomic(&path, text.as_bytes())?;
         traces.push(path);
     }
-    let outcome = run_friction(&FrictionRequest {
-        traces,
-        normal_force_n: None,
-        rotation_radius_m: None,
-        areas: Some(work.join("analysis").join("areas.csv")),
-        force_tolerance: 0.02,
-        slip: SlipOptions::default(),
-        out_dir: work.join("friction"),
-        command_line: vec!["contactscope demo".into()],
-    })?;
+    let (outcome, _) = friction_to_folder(
+        &FrictionRequest {
+            traces,
+            normal_force_n: None,
+            rotation_radius_m: None,
+            areas: Some(work.join("analysis").join("areas.csv")),
+            force_tolerance: 0.02,
+            slip: SlipOptions::default(),
+        },
+        &work.join("friction"),
+        &["contactscope demo".into()],
+    )?;
     let shear = outcome
         .shear
         .ok_or_else(|| Error::InvalidArgument("no τ fit".into()))?;

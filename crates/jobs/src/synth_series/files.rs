@@ -1,35 +1,16 @@
-//! The `synth-series` job: a seeded synthetic load series ([`contactscope::synth::series`]) written as
-//! TIFFs with `manifest.csv` and `truth.csv`; and [`read_truth`] to read the truth back.
+//! The outputs of `synth-series` as the command line writes them, through a staging folder
+//! (nothing appears unless everything succeeded): the TIFF(s), `manifest.csv` (file, page,
+//! force_mN) and `truth.csv` (true contact pixels and area per image); and [`read_truth`] to read
+//! the truth back.
 
 use std::path::{Path, PathBuf};
 
-use crate::error::{Error, Result};
-use crate::staging::write_atomic;
-use contactscope::synth::series::{generate, SynthParams};
+use contactscope::synth::series::SynthParams;
 use contactscope_formats::tiff::write::{encode_u16_stack_compressed, Compression};
 
-/// Everything `synth-series` needs, already validated.
-#[derive(Debug, Clone)]
-pub struct SynthSeriesRequest {
-    /// What to generate.
-    pub params: SynthParams,
-    /// Output folder.
-    pub out_dir: PathBuf,
-    /// One multi-page file or one file per load.
-    pub layout: Layout,
-    /// TIFF compression.
-    pub compression: Compression,
-}
-
-/// Run `synth-series`: the files written, in order.
-pub fn run_synth_series(request: &SynthSeriesRequest) -> Result<Vec<PathBuf>> {
-    write_series_compressed(
-        &request.params,
-        &request.out_dir,
-        request.layout,
-        request.compression,
-    )
-}
+use super::{run, SynthSeriesOutcome, SynthSeriesRequest};
+use crate::error::{Error, Result};
+use crate::staging::Staging;
 
 /// How a generated series is laid out on disk.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -38,6 +19,59 @@ pub enum Layout {
     MultiPage,
     /// One file per load, `load_01.tif`, `load_02.tif`, …
     Files,
+}
+
+/// Run `synth-series` and write its folder: the outcome and the files written (final paths, in
+/// order: the TIFF(s), `manifest.csv`, `truth.csv`).
+pub fn run_to_folder(
+    request: &SynthSeriesRequest,
+    out_dir: &Path,
+    layout: Layout,
+    compression: Compression,
+) -> Result<(SynthSeriesOutcome, Vec<PathBuf>)> {
+    let outcome = run(request)?;
+    let p = &request.params;
+    let staging = Staging::new(out_dir, &[])?;
+    let size = Some((p.pixel_size_m, p.pixel_size_m));
+    let description = format!(
+        "contactscope synth-series seed={} fwhm_nm={:.0}\n",
+        p.seed,
+        p.psf_fwhm_m * 1e9
+    );
+    let encode = |pages: &[&[u16]]| {
+        encode_u16_stack_compressed(pages, p.width, p.height, size, &description, compression)
+    };
+    let images = &outcome.images;
+    let mut locations = Vec::new();
+    match layout {
+        Layout::MultiPage => {
+            let pages: Vec<&[u16]> = images.iter().map(|im| im.codes.as_slice()).collect();
+            staging.write("series.tif", &encode(&pages)?)?;
+            locations.extend((0..images.len()).map(|i| ("series.tif".to_string(), i)));
+        }
+        Layout::Files => {
+            let digits = images.len().to_string().len().max(2);
+            for (i, im) in images.iter().enumerate() {
+                let name = format!("load_{:0digits$}.tif", i + 1);
+                staging.write(&name, &encode(&[&im.codes])?)?;
+                locations.push((name, 0));
+            }
+        }
+    }
+    let mut manifest = String::from("file,page,force_mN\n");
+    let mut truth = String::from("file,page,force_mN,true_contact_pixels,true_area_um2\n");
+    for ((file, page), im) in locations.iter().zip(images) {
+        let force_mn = im.force_n * 1e3;
+        manifest.push_str(&format!("{file},{page},{force_mn}\n"));
+        truth.push_str(&format!(
+            "{file},{page},{force_mn},{},{:.6}\n",
+            im.true_contact_pixels, im.true_area_um2
+        ));
+    }
+    staging.write("manifest.csv", manifest.as_bytes())?;
+    staging.write("truth.csv", truth.as_bytes())?;
+    let written = staging.commit()?;
+    Ok((outcome, written))
 }
 
 /// Write a generated series into `dir`: the TIFF(s), `manifest.csv` (file, page, force_mN) and
@@ -53,55 +87,8 @@ pub fn write_series_compressed(
     layout: Layout,
     compression: Compression,
 ) -> Result<Vec<PathBuf>> {
-    let images = generate(p)?;
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let size = Some((p.pixel_size_m, p.pixel_size_m));
-    let description = format!(
-        "contactscope synth-series seed={} fwhm_nm={:.0}\n",
-        p.seed,
-        p.psf_fwhm_m * 1e9
-    );
-    let encode = |pages: &[&[u16]]| {
-        encode_u16_stack_compressed(pages, p.width, p.height, size, &description, compression)
-    };
-    let mut written = Vec::new();
-    let mut locations = Vec::new();
-    match layout {
-        Layout::MultiPage => {
-            let pages: Vec<&[u16]> = images.iter().map(|im| im.codes.as_slice()).collect();
-            let bytes = encode(&pages)?;
-            written.push(write_file(dir, "series.tif", &bytes)?);
-            locations.extend((0..images.len()).map(|i| ("series.tif".to_string(), i)));
-        }
-        Layout::Files => {
-            let digits = images.len().to_string().len().max(2);
-            for (i, im) in images.iter().enumerate() {
-                let name = format!("load_{:0digits$}.tif", i + 1);
-                let bytes = encode(&[&im.codes])?;
-                written.push(write_file(dir, &name, &bytes)?);
-                locations.push((name, 0));
-            }
-        }
-    }
-    let mut manifest = String::from("file,page,force_mN\n");
-    let mut truth = String::from("file,page,force_mN,true_contact_pixels,true_area_um2\n");
-    for ((file, page), im) in locations.iter().zip(&images) {
-        let force_mn = im.force_n * 1e3;
-        manifest.push_str(&format!("{file},{page},{force_mn}\n"));
-        truth.push_str(&format!(
-            "{file},{page},{force_mn},{},{:.6}\n",
-            im.true_contact_pixels, im.true_area_um2
-        ));
-    }
-    written.push(write_file(dir, "manifest.csv", manifest.as_bytes())?);
-    written.push(write_file(dir, "truth.csv", truth.as_bytes())?);
-    Ok(written)
-}
-
-fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
-    let path = dir.join(name);
-    write_atomic(&path, bytes)?;
-    Ok(path)
+    let request = SynthSeriesRequest { params: p.clone() };
+    Ok(run_to_folder(&request, dir, layout, compression)?.1)
 }
 
 /// True areas (µm²) from a `truth.csv` written by [`write_series`], in row order.

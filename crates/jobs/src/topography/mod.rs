@@ -1,0 +1,285 @@
+//! The `topography` job: read a height map, summarise it as stored (issue 14 item 3: size, pixel
+//! size, valid points, height range, h_rms, rms slope and curvature over the valid points), and
+//! detrend it and compute its roughness statistics (finite-difference estimators,
+//! `docs/conventions.md`, "Roughness statistics"). Every front-end builds a
+//! [`TopographyRequest`] (the command line from its flags, Python's `read_topography` from its
+//! keywords), [`TopographyRequest::check`] applies the same range checks, and [`run`] returns a
+//! [`TopographyOutcome`]: its `summary` is `topography --json` (lab units; in SI units for
+//! Python, [`crate::lab`]) and its heights are what Python's `read_topography` returns.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::error::{Error, Location, Result};
+use crate::heights::{usable, TopographySource};
+use crate::lab;
+use contactscope::surface::masked::masked_stats;
+use contactscope::surface::stats::SurfaceStats;
+use contactscope::surface::{HeightMap, Topography};
+use contactscope_formats::param::Param;
+use contactscope_formats::topography::{read_height_map, ReadOptions};
+
+/// `topography --json` for one file: the map as stored.
+#[derive(Debug, Clone, Serialize)]
+pub struct TopographySummary {
+    /// The file as named.
+    pub file: String,
+    /// Format name (`ibw`, `park-tiff`, …).
+    pub format: String,
+    /// Channel read.
+    pub channel: String,
+    /// Columns.
+    pub nx: usize,
+    /// Rows.
+    pub ny: usize,
+    /// Pixel size, m.
+    #[serde(rename = "pixel_size_um")]
+    pub pixel_size: PixelSizeXy,
+    /// Points with a height.
+    pub valid_points: usize,
+    /// Lowest valid height, m.
+    #[serde(rename = "height_min_um", serialize_with = "lab::m_as_um")]
+    pub height_min_m: f64,
+    /// Highest valid height, m.
+    #[serde(rename = "height_max_um", serialize_with = "lab::m_as_um")]
+    pub height_max_m: f64,
+    /// Mean valid height, m.
+    #[serde(rename = "height_mean_um", serialize_with = "lab::m_as_um")]
+    pub height_mean_m: f64,
+    /// rms height about the mean, m.
+    #[serde(rename = "h_rms_um", serialize_with = "lab::m_as_um")]
+    pub h_rms_m: f64,
+    /// rms slope (central differences), dimensionless; `null` without an interior point.
+    pub slope_rms: Option<f64>,
+    /// rms full Laplacian (5-point), 1/m; `null` without an interior point.
+    pub curvature_rms: Option<f64>,
+}
+
+/// Lateral pixel size, m (written in µm under `pixel_size_um`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PixelSizeXy {
+    /// Along x, m.
+    #[serde(rename = "x", serialize_with = "lab::m_as_um")]
+    pub x_m: f64,
+    /// Along y, m.
+    #[serde(rename = "y", serialize_with = "lab::m_as_um")]
+    pub y_m: f64,
+}
+
+impl TopographySummary {
+    /// The summary of a map as stored (statistics over its valid points,
+    /// [`contactscope::surface::masked`]).
+    pub fn of(file: &str, map: &HeightMap) -> Self {
+        let s = masked_stats(&map.heights, (map.dx_m, map.dy_m));
+        TopographySummary {
+            file: file.to_string(),
+            format: map.format.name().to_string(),
+            channel: map.channel.clone(),
+            nx: map.nx(),
+            ny: map.ny(),
+            pixel_size: PixelSizeXy {
+                x_m: map.dx_m,
+                y_m: map.dy_m,
+            },
+            valid_points: s.valid_points,
+            height_min_m: s.min_m,
+            height_max_m: s.max_m,
+            height_mean_m: s.mean_m,
+            h_rms_m: s.rms_m,
+            slope_rms: s.slope_rms,
+            curvature_rms: s.curvature_rms_per_m,
+        }
+    }
+
+    /// An error naming `path` when a statistic is not finite (no valid point, or heights or
+    /// pixel sizes so extreme that sums of squares overflow): nothing non-finite is printed.
+    pub fn check_finite(&self, path: &Path) -> Result<()> {
+        let values = [
+            ("pixel size x", Some(self.pixel_size.x_m * 1e6)),
+            ("pixel size y", Some(self.pixel_size.y_m * 1e6)),
+            ("minimum height", Some(self.height_min_m * 1e6)),
+            ("maximum height", Some(self.height_max_m * 1e6)),
+            ("mean height", Some(self.height_mean_m * 1e6)),
+            ("rms height", Some(self.h_rms_m * 1e6)),
+            ("rms slope", self.slope_rms),
+            ("rms curvature", self.curvature_rms),
+        ];
+        match values
+            .iter()
+            .find(|(_, v)| v.is_some_and(|v| !v.is_finite()))
+        {
+            None => Ok(()),
+            Some((what, v)) => Err(Error::bad_input(
+                Location::file(path),
+                format!(
+                    "the {what} of the stored heights is {} ({} valid of {} points; heights up \
+                     to {:e} µm): not a usable height map",
+                    v.unwrap_or(f64::NAN),
+                    self.valid_points,
+                    self.nx * self.ny,
+                    (self.height_min_m * 1e6)
+                        .abs()
+                        .max((self.height_max_m * 1e6).abs())
+                ),
+            )),
+        }
+    }
+}
+
+/// Read a file and summarise it as stored.
+pub fn topography_summary(path: &Path, channel: Option<&str>) -> Result<TopographySummary> {
+    let map = read_height_map(
+        path,
+        &ReadOptions {
+            channel: channel.map(str::to_string),
+            ..ReadOptions::default()
+        },
+    )?;
+    Ok(TopographySummary::of(&path.display().to_string(), &map))
+}
+
+/// The statistics of the map after detrending (`detrended` of `topography --json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct DetrendedFacts {
+    /// Detrending applied.
+    pub detrend: &'static str,
+    /// Pixel size along x, m.
+    #[serde(rename = "pixel_size_x_nm", serialize_with = "lab::m_as_nm")]
+    pub pixel_size_x_m: f64,
+    /// Pixel size along y, m.
+    #[serde(rename = "pixel_size_y_nm", serialize_with = "lab::m_as_nm")]
+    pub pixel_size_y_m: f64,
+    /// rms height, m.
+    #[serde(rename = "h_rms_nm", serialize_with = "lab::m_as_nm")]
+    pub h_rms_m: f64,
+    /// rms slope (central differences).
+    pub h_prime_rms: f64,
+    /// rms full Laplacian (5-point), 1/m.
+    #[serde(
+        rename = "h_double_prime_rms_per_um",
+        serialize_with = "lab::per_m_as_per_um"
+    )]
+    pub h_double_prime_rms_per_m: f64,
+}
+
+/// `topography --json`: the map as stored and, when every point is valid, its statistics after
+/// detrending.
+#[derive(Debug, Clone, Serialize)]
+pub struct TopographyDescription {
+    /// Statistics of the stored heights over the valid points (no detrending).
+    #[serde(flatten)]
+    pub stored: TopographySummary,
+    /// After detrending; `null` when the map cannot be used (`note` says why).
+    pub detrended: Option<DetrendedFacts>,
+    /// Why `detrended` is missing (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// The height map to read and describe.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopographyRequest {
+    /// The file, its overrides (pixel size, height unit), channel, filling and detrending.
+    pub source: TopographySource,
+}
+
+impl TopographyRequest {
+    /// A request with the defaults: the file's own pixel size and height unit, its height
+    /// channel, no filling, plane detrending (as every command that takes a height map).
+    pub fn new(path: std::path::PathBuf) -> Self {
+        TopographyRequest {
+            source: TopographySource {
+                detrend: contactscope::surface::Detrend::Plane,
+                ..TopographySource::new(path)
+            },
+        }
+    }
+
+    /// Every range check, the same for every front-end: the pixel size and the height unit.
+    pub fn check(&self) -> Result<()> {
+        self.source.check()
+    }
+}
+
+/// What `topography` found: the description (`topography --json`) and the heights, filled as
+/// asked and detrended, when the map is usable.
+#[derive(Debug, Clone, Serialize)]
+pub struct TopographyOutcome {
+    /// `topography --json`.
+    pub summary: TopographyDescription,
+    /// Notes for the user (how many invalid points were filled).
+    pub notes: Vec<String>,
+    /// The heights (m, rows = y, filled and detrended) with their pixel size; `None` when the
+    /// map cannot be used (`summary.note` says why).
+    #[serde(skip)]
+    pub heights: Option<Topography>,
+}
+
+impl TopographyOutcome {
+    /// The heights, or an error saying why the map cannot be used (for a map with invalid
+    /// points: how to fill them).
+    pub fn usable_heights(&self) -> Result<&Topography> {
+        if let Some(t) = &self.heights {
+            return Ok(t);
+        }
+        let s = &self.summary;
+        let note = s.note.as_deref().unwrap_or("not a usable height map");
+        Err(Error::InvalidArgument(
+            if s.stored.valid_points < s.stored.nx * s.stored.ny {
+                format!(
+                    "{note}: give {} mean|nearest to fill them",
+                    Param::FillInvalid
+                )
+            } else {
+                note.to_string()
+            },
+        ))
+    }
+}
+
+/// Read, summarise, fill (as asked), detrend, describe; nothing is written.
+pub fn run(request: &TopographyRequest) -> Result<TopographyOutcome> {
+    request.check()?;
+    let source = &request.source;
+    let path = &source.path;
+    let mut map = source.read_raw()?;
+    let stored = TopographySummary::of(&path.display().to_string(), &map);
+    stored.check_finite(path)?;
+    let notes: Vec<String> = source.fill(&mut map).into_iter().collect();
+    let detrend = source.detrend;
+    match usable(path, map) {
+        Ok(mut topography) => {
+            topography.detrend(detrend);
+            let stats = SurfaceStats::finite_differences(&topography)?;
+            Ok(TopographyOutcome {
+                summary: TopographyDescription {
+                    stored,
+                    detrended: Some(DetrendedFacts {
+                        detrend: detrend.name(),
+                        pixel_size_x_m: topography.dx_m,
+                        pixel_size_y_m: topography.dy_m,
+                        h_rms_m: stats.h_rms_m,
+                        h_prime_rms: stats.h_prime_rms,
+                        h_double_prime_rms_per_m: stats.h_double_prime_rms_per_m,
+                    }),
+                    note: None,
+                },
+                notes,
+                heights: Some(topography),
+            })
+        }
+        // Only a vendor map gets here with an error (invalid points, or a pixel size or heights
+        // outside the plausible ranges): its summary as stored still stands, with the reason
+        // it cannot be used for a contact calculation.
+        Err(e) => Ok(TopographyOutcome {
+            summary: TopographyDescription {
+                stored,
+                detrended: None,
+                note: Some(e.to_string()),
+            },
+            notes,
+            heights: None,
+        }),
+    }
+}
