@@ -145,6 +145,10 @@ params! {
     Areas: "--areas", "areas", "the measured areas";
     /// Output folder or file.
     Out: "--out", "out", "the output";
+    /// Saturation level of the detector (`psf`).
+    SaturationLevel: "--saturation-level", "saturation_level", "the saturation level";
+    /// Phase of the Newton-ring maxima.
+    Phase: "--phase", "phase", "the phase of the ring maxima";
 }
 
 impl fmt::Display for Param {
