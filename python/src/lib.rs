@@ -21,6 +21,7 @@ mod convert;
 mod heights;
 mod images;
 mod mechanics;
+mod optics;
 mod series;
 mod simulate;
 mod synth;
@@ -182,6 +183,7 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
     images::register(m)?;
     mechanics::register(m)?;
+    optics::register(m)?;
     series::register(m)?;
     simulate::register(m)?;
     synth::register(m)?;
