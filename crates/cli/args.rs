@@ -212,11 +212,6 @@ pub fn optional_pixel_size(text: &Option<String>, flag: &str) -> Result<Option<(
         .with_context(|| flag.to_string())
 }
 
-/// An optional positive length in metres.
-pub fn optional_length(text: &Option<String>, flag: &str) -> Result<Option<f64>> {
-    optional_quantity(text, flag, Quantity::Length)
-}
-
 /// A length-valued option checked against the plausible range of `quantity`.
 pub fn optional_quantity(
     text: &Option<String>,

@@ -2,11 +2,14 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
-use contactscope_jobs::autocorr::{run_autocorr, AutocorrRequest};
+use contactscope_formats::units::{self, Dimension};
+use contactscope_jobs::autocorr::files::run_to_folder;
+use contactscope_jobs::autocorr::AutocorrRequest;
+use contactscope_jobs::images::ImageInput;
 
-use super::args::{default_out, optional_length, OutputFolder, PixelSizeArg, SelectionArgs};
+use super::args::{default_out, OutputFolder, PixelSizeArg, SelectionArgs};
 use super::common::{command_line, print_warnings, print_written};
 
 default_out!(Out, "contactscope-out/autocorr");
@@ -30,14 +33,16 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let request = AutocorrRequest {
-        inputs: args.inputs.clone(),
         selection: args.select.selection(),
         pixel_size_m: args.pixel_size.metres()?,
-        max_lag_m: optional_length(&args.max_lag, "--max-lag")?,
-        out_dir: args.out.out.clone(),
-        command_line: command_line(),
+        max_lag_m: args
+            .max_lag
+            .as_deref()
+            .map(|t| units::parse_positive(t, Dimension::Length).context("--max-lag"))
+            .transpose()?,
+        ..AutocorrRequest::new(args.inputs.into_iter().map(ImageInput::File).collect())
     };
-    let outcome = run_autocorr(&request)?;
+    let (outcome, written) = run_to_folder(&request, &args.out.out, &command_line())?;
     print_warnings(&outcome.warnings);
     let um = |m: Option<f64>| m.map_or("—".to_string(), |v| format!("{:.3}", v * 1e6));
     println!("{:>12} {:>14}  image", "ξ_1/e (µm)", "first zero (µm)");
@@ -49,6 +54,6 @@ pub fn run(args: Args) -> Result<()> {
             c.label
         );
     }
-    print_written(outcome.written.len(), &args.out.out);
+    print_written(written.len(), &args.out.out);
     Ok(())
 }

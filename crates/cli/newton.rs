@@ -7,7 +7,9 @@ use clap::ValueEnum;
 
 use contactscope::optics::newton::{NewtonOptions, Phase};
 use contactscope_formats::units::{self, Dimension};
-use contactscope_jobs::newton::{run_newton, NewtonRequest};
+use contactscope_jobs::images::ImageInput;
+use contactscope_jobs::newton::files::run_to_folder;
+use contactscope_jobs::newton::{NewtonOutcome, NewtonRequest};
 
 use super::args::{default_out, OutputFolder, PixelSizeArg, SelectionArgs};
 use super::common::command_line;
@@ -41,10 +43,10 @@ pub struct Args {
     #[arg(long, default_value = "488nm")]
     wavelength: String,
     /// Refractive index of the medium in the gap (formamide 1.447).
-    #[arg(long, default_value_t = 1.447)]
+    #[arg(long, default_value_t = NewtonOptions::default().medium_index)]
     medium_index: f64,
     /// Number of line profiles through the centre, evenly spread over 180°.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = NewtonOptions::default().profiles)]
     profiles: usize,
     /// Phase of the reflection maxima.
     #[arg(long, value_enum, default_value = "half")]
@@ -55,17 +57,12 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let request = NewtonRequest {
-        reflection: args.reflection,
-        fluorescence: args.contact,
         pixel_size_m: args.pixel_size.metres()?,
         selection: args.select.selection(),
         contact_channel: args.contact_channel,
         options: NewtonOptions {
-            wavelength_m: contactscope_formats::ranges::Quantity::Wavelength.check_text(
-                units::parse_positive(&args.wavelength, Dimension::Length)
-                    .context("--wavelength")?,
-                "--wavelength",
-            )?,
+            wavelength_m: units::parse_positive(&args.wavelength, Dimension::Length)
+                .context("--wavelength")?,
             medium_index: args.medium_index,
             profiles: args.profiles,
             phase: match args.phase {
@@ -74,10 +71,17 @@ pub fn run(args: Args) -> Result<()> {
             },
             ..NewtonOptions::default()
         },
-        out_dir: args.out.out,
-        command_line: command_line(),
+        ..NewtonRequest::new(
+            ImageInput::File(args.reflection),
+            ImageInput::File(args.contact),
+        )
     };
-    let outcome = run_newton(&request)?;
+    let (outcome, written) = run_to_folder(&request, &args.out.out, &command_line())?;
+    print_outcome(&outcome, &written);
+    Ok(())
+}
+
+fn print_outcome(outcome: &NewtonOutcome, written: &[PathBuf]) {
     let a = &outcome.analysis;
     let sd = |s: Option<f64>, scale: f64| s.map_or("n/a".into(), |v| format!("{:.2}", v * scale));
     println!(
@@ -101,8 +105,7 @@ pub fn run(args: Args) -> Result<()> {
             p.skipped.as_deref().unwrap_or_default()
         );
     }
-    for path in &outcome.written {
+    for path in written {
         println!("wrote {}", path.display());
     }
-    Ok(())
 }

@@ -1,13 +1,16 @@
 //! `contactscope psf`: the microscope PSF from a bead image or z stack.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
 use contactscope::optics::psf::FWHM_PER_SIGMA;
-use contactscope_jobs::psf::{run_psf, PsfRequest};
+use contactscope_formats::units::{self, Dimension};
+use contactscope_jobs::images::ImageInput;
+use contactscope_jobs::psf::files::run_to_folder;
+use contactscope_jobs::psf::{PsfOutcome, PsfRequest};
 
-use super::args::{default_out, optional_length, OutputFolder, PixelSizeArg, SelectionArgs};
+use super::args::{default_out, OutputFolder, PixelSizeArg, SelectionArgs};
 use super::common::command_line;
 
 default_out!(Out, "contactscope-out/psf");
@@ -22,6 +25,11 @@ pub struct Args {
     /// Bead diameter, e.g. 100nm: turns on the finite-bead correction σ² − a²/5.
     #[arg(long)]
     bead_diameter: Option<String>,
+    /// The detector's saturation level in the data's units (beads with two or more window
+    /// pixels at it are skipped); default: from the sample type (8-bit 255, 16-bit 65535, or
+    /// 4095 for 12-bit data in 16 bits, int16 32767; float data: no check).
+    #[arg(long)]
+    saturation_level: Option<f64>,
     #[command(flatten)]
     select: SelectionArgs,
     #[command(flatten)]
@@ -30,19 +38,27 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let request = PsfRequest {
-        input: args.input.clone(),
         selection: args.select.selection(),
         pixel_size_m: args.pixel_size.metres()?,
-        bead_diameter_m: optional_length(&args.bead_diameter, "--bead-diameter")?,
-        out_dir: args.out.out.clone(),
-        command_line: command_line(),
+        bead_diameter_m: args
+            .bead_diameter
+            .as_deref()
+            .map(|t| units::parse_positive(t, Dimension::Length).context("--bead-diameter"))
+            .transpose()?,
+        saturation_level: args.saturation_level,
+        ..PsfRequest::new(ImageInput::File(args.input.clone()))
     };
-    let outcome = run_psf(&request)?;
+    let (outcome, written) = run_to_folder(&request, &args.out.out, &command_line())?;
+    print_outcome(&args.input, &outcome, &written);
+    Ok(())
+}
+
+fn print_outcome(input: &Path, outcome: &PsfOutcome, written: &[PathBuf]) {
     let r = &outcome.report;
     let s = &r.summary;
     println!(
         "{}: {} plane(s), pixel {:.2} nm ({}), {} bead candidate(s), {} used",
-        args.input.display(),
+        input.display(),
         r.planes,
         r.pixel_size.x_m * 1e9,
         r.pixel_size.source.describe(),
@@ -72,8 +88,7 @@ pub fn run(args: Args) -> Result<()> {
         sigma.mean,
         sd(sigma.sd)
     );
-    for path in &outcome.written {
+    for path in written {
         println!("wrote {}", path.display());
     }
-    Ok(())
 }

@@ -25,6 +25,7 @@ mod images;
 mod info;
 mod mechanics;
 mod mechanics_csv;
+mod optics;
 mod series;
 mod simulate;
 mod synth;
@@ -218,6 +219,7 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     info::register(m)?;
     mechanics::register(m)?;
     mechanics_csv::register(m)?;
+    optics::register(m)?;
     series::register(m)?;
     simulate::register(m)?;
     synth::register(m)?;

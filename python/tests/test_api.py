@@ -105,28 +105,131 @@ def test_measure_agrees_with_analyze(series_tif):
         np.testing.assert_array_equal(m.mask, s.images[i] > a.threshold["value"])
 
 
+# The command line writes its JSON files in lab units (force_mN, fwhm_nm_mean); Python returns
+# the same outcome in SI units with SI keys (force_n, fwhm_m_mean).
+_LAB_UNITS = {"mN": ("n", 1e-3), "uN": ("n", 1e-6), "um": ("m", 1e-6), "nm": ("m", 1e-9),
+              "mm": ("m", 1e-3), "um2": ("m2", 1e-12), "um3": ("m3", 1e-18),
+              "MPa": ("pa", 1e6), "GPa": ("pa", 1e9)}
+
+
+def si_key(key):
+    """The SI key of a lab key and the factor from its unit to SI (``fwhm_nm_mean`` →
+    ``fwhm_m_mean``, 1e-9)."""
+    tokens, factor, invert = [], 1.0, False
+    for token in key.split("_"):
+        si, f = _LAB_UNITS.get(token, (token, 1.0))
+        factor *= 1.0 / f if invert else f
+        invert = token == "per"
+        tokens.append(si)
+    return "_".join(tokens), factor
+
+
+def in_si(value, factor=1.0):
+    """A value of the command line's JSON in the SI form the Python result has."""
+    if isinstance(value, dict):
+        return {k: in_si(v, f) for key, v in value.items() for k, f in [si_key(key)]}
+    if isinstance(value, list):
+        return [in_si(v, factor) for v in value]
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and factor != 1.0:
+        return value * factor
+    return value
+
+
+def assert_same_outcome(mine, theirs_lab, rel=1e-12, ignore=()):
+    """Every entry of the command line's JSON (but its version, command line and ``ignore``)
+    is in the Python result, in SI units."""
+    theirs = in_si({k: v for k, v in theirs_lab.items()
+                    if k not in ("contactscope_version", "command_line", *ignore)})
+
+    def same(a, b, where):
+        if isinstance(b, dict):
+            assert isinstance(a, dict), where
+            for k in b:
+                assert k in a, f"{where}.{k} missing"
+                same(a[k], b[k], f"{where}.{k}")
+        elif isinstance(b, list):
+            assert isinstance(a, list) and len(a) == len(b), where
+            for i, (x, y) in enumerate(zip(a, b)):
+                same(x, y, f"{where}[{i}]")
+        elif isinstance(b, float):
+            assert a == pytest.approx(b, rel=rel, abs=0), where
+        else:
+            assert a == b, where
+
+    same(mine, theirs, "result")
+
+
 def test_psf_matches_cli(cli, tmp_path):
     beads = cs.synth_beads(seed=5)
+    assert beads.dtype == np.uint16
     cs.write_tiff(tmp_path / "beads.tif", beads, 1e-7)
     cli("psf", tmp_path / "beads.tif", "--out", tmp_path / "psf")
     theirs = json.loads((tmp_path / "psf" / "psf.json").read_text())
-    mine = cs.psf(beads.astype(np.float64), 1e-7, saturation_level=4095)
-    assert mine.beads_used == theirs["beads_used"]
-    assert mine.fwhm_m * 1e9 == pytest.approx(theirs["fwhm_nm_mean"], rel=1e-9)
+    # The file, read as the command line reads it: the same outcome.
+    from_file = cs.psf(tmp_path / "beads.tif")
+    assert_same_outcome(from_file, theirs)
+    # The array in its stored type (uint16): the same saturation level (12-bit data: 4095), so
+    # the same beads and widths.
+    mine = cs.psf(beads, 1e-7)
+    assert mine.saturation_level == theirs["saturation_level"] == 4095
+    assert_same_outcome(mine, theirs, rel=1e-9, ignore=("input", "pixel_size_source"))
+    assert mine.fwhm_m_mean * 1e9 == pytest.approx(theirs["fwhm_nm_mean"], rel=1e-9)
+    # The rows are beads.csv.
+    rows = read_csv(tmp_path / "psf" / "beads.csv")
+    assert len(mine.rows) == len(rows) == theirs["beads_found"]
+    for m, t in zip(mine.rows, rows):
+        assert m["used"] == (t["used"] == "true")
+        assert m["x_px"] == pytest.approx(float(t["x_px"]), abs=1e-4)
+        if m["used"]:
+            assert m["sigma_m"] * 1e9 == pytest.approx(float(t["sigma_nm"]), abs=1e-3)
+            assert m["fwhm_m"] * 1e9 == pytest.approx(float(t["fwhm_nm"]), abs=1e-3)
+    assert sum(r["used"] for r in mine.rows) == mine.beads_used
     # σ = 1.91 px of 100 nm: FWHM ≈ 450 nm.
-    assert mine.fwhm_m == pytest.approx(2.3548 * 1.91e-7, rel=0.03)
+    assert mine.fwhm_m_mean == pytest.approx(2.3548 * 1.91e-7, rel=0.03)
+    # Float data have no saturation level unless one is given.
+    assert cs.psf(beads.astype(np.float32), 1e-7).saturation_level is None
+    assert cs.psf(beads, 1e-7, saturation_level=65535).saturation_level == 65535
+
+
+def test_psf_of_a_z_stack_matches_cli(cli, tmp_path):
+    stack = cs.synth_beads(planes=5, seed=8)
+    cs.write_tiff(tmp_path / "stack.tif", stack, 1e-7)
+    cli("psf", tmp_path / "stack.tif", "--bead-diameter", "100nm", "--out", tmp_path / "psf")
+    theirs = json.loads((tmp_path / "psf" / "psf.json").read_text())
+    mine = cs.psf(stack, 1e-7, bead_diameter=100e-9)
+    assert mine.planes == theirs["planes"] == 5
+    assert mine.bead_diameter_m == pytest.approx(1e-7) and mine.bead_correction_applied
+    assert_same_outcome(mine, theirs, rel=1e-9, ignore=("input", "pixel_size_source"))
 
 
 def test_autocorrelation_matches_cli(cli, series_tif, tmp_path):
     path, s = series_tif
     cli("autocorr", path, "--out", tmp_path / "ac")
-    theirs = json.loads((tmp_path / "ac" / "autocorr.json").read_text())["images"]
-    rows = [r for r in read_csv(tmp_path / "ac" / "autocorr.csv") if r["image"].endswith("page 0")]
-    mine = cs.autocorrelation(s.images[0].astype(np.float64), 2e-7)
-    assert mine.xi_1e_m * 1e6 == pytest.approx(theirs[0]["correlation_length_um_1e"], rel=1e-9)
-    assert len(mine.c) == len(rows)
-    np.testing.assert_allclose(mine.c, [float(r["acf"]) for r in rows], atol=1e-7)
-    assert mine.c[0] == pytest.approx(1.0)
+    theirs = json.loads((tmp_path / "ac" / "autocorr.json").read_text())
+    rows = read_csv(tmp_path / "ac" / "autocorr.csv")
+    assert_same_outcome(cs.autocorrelation(path), theirs)
+    # The stack as an array: each plane one image, the same numbers.
+    mine = cs.autocorrelation(s.images, 2e-7)
+    # (Labels differ: "images:page 0" for "series.tif:page 0".)
+    assert_same_outcome(mine, theirs, rel=1e-9, ignore=("images", "warnings"))
+    assert len(mine.warnings) == len(theirs["warnings"])
+    assert len(mine.rows) == len(theirs["images"]) == 3
+    for m, t in zip(mine.rows, theirs["images"]):
+        assert m["image"].endswith(t["image"].split(":")[1])  # "images:page 0"
+        assert m["correlation_length_m_1e"] * 1e6 == pytest.approx(
+            t["correlation_length_um_1e"], rel=1e-9)
+        assert m["max_lag_m"] * 1e6 == pytest.approx(t["max_lag_um"], rel=1e-9)
+        curve = [r for r in rows if r["image"] == t["image"]]
+        assert len(m["acf"]) == len(m["lag_m"]) == len(curve)
+        np.testing.assert_allclose(m["acf"], [float(r["acf"]) for r in curve], atol=1e-8)
+        np.testing.assert_allclose(m["lag_m"] * 1e6, [float(r["lag_um"]) for r in curve],
+                                   atol=1e-6)
+        assert m["acf"][0] == pytest.approx(1.0)
+    # One 2-D image, a clamped lag: the warning of the command line, named in Python terms.
+    with pytest.warns(cs.ContactscopeWarning, match="max_lag="):
+        one = cs.autocorrelation(s.images[0], 2e-7, max_lag=1e-3)
+    assert len(one.rows) == 1 and one.rows[0]["max_lag_m"] == pytest.approx(
+        theirs["images"][0]["max_lag_um"] * 1e-6, rel=1e-9)
 
 
 def test_newton_matches_cli(cli, tmp_path):
@@ -135,11 +238,27 @@ def test_newton_matches_cli(cli, tmp_path):
     cs.write_tiff(tmp_path / "f.tif", n.fluorescence, 2e-7)
     cli("newton", tmp_path / "r.tif", "--contact", tmp_path / "f.tif", "--out", tmp_path / "nw")
     theirs = json.loads((tmp_path / "nw" / "newton.json").read_text())
-    mine = cs.newton(n.reflection.astype(float), n.fluorescence.astype(float), 2e-7)
-    assert mine.detection_gap_m["mean"] * 1e9 == pytest.approx(theirs["detection_gap_nm_mean"],
-                                                                 rel=1e-9)
-    assert mine.profiles_used == theirs["profiles_used"]
-    assert mine.detection_gap_m["mean"] == pytest.approx(n.detection_gap_m, abs=2e-9)
+    # The files, read as the command line reads them: the same outcome.
+    from_files = cs.newton(tmp_path / "r.tif", tmp_path / "f.tif")
+    assert_same_outcome(from_files, theirs)
+    # The arrays in their stored type (uint16) with the defaults of the command line.
+    mine = cs.newton(n.reflection, n.fluorescence, 2e-7)
+    assert_same_outcome(mine, theirs, rel=1e-9, ignore=("inputs",))
+    assert mine.wavelength_m == pytest.approx(488e-9) and mine.medium_index == 1.447
+    assert mine.phase == "half" and mine.profiles_total == 20 == len(mine.rows)
+    assert mine.detection_gap_m_mean * 1e9 == pytest.approx(theirs["detection_gap_nm_mean"],
+                                                          rel=1e-9)
+    assert mine.sphere_radius_R_m_mean * 1e3 == pytest.approx(theirs["sphere_radius_R_mm_mean"],
+                                                             rel=1e-9)
+    # The ring points are newton_rings.csv.
+    rings = read_csv(tmp_path / "nw" / "newton_rings.csv")
+    assert len(mine.rings) == len(rings) > 0
+    for m, t in zip(mine.rings, rings):
+        assert (m["profile"], m["side"], m["order"]) == (int(t["profile"]), t["side"],
+                                                          int(t["order"]))
+        assert m["r_m"] * 1e6 == pytest.approx(float(t["r_um"]), rel=1e-9)
+        assert m["gap_m"] * 1e9 == pytest.approx(float(t["gap_nm"]), rel=1e-12)
+    assert mine.detection_gap_m_mean == pytest.approx(n.detection_gap_m, abs=2e-9)
 
 
 def test_blur_and_resample_keeps_area():
@@ -316,8 +435,18 @@ def test_garbage_tiff_is_valueerror(tmp_path):
     lambda h: cs.analyze(np.zeros(8)),
     lambda h: cs.measure(np.zeros((8, 8)), float("nan")),
     lambda h: cs.autocorrelation(np.ones((16, 16)), 1e-7, max_lag=-1.0),
+    lambda h: cs.autocorrelation(np.ones((16, 16))),
+    lambda h: cs.autocorrelation(np.ones((16, 16)), 1e-7, z=1),
+    lambda h: cs.autocorrelation([], 1e-7),
     lambda h: cs.blur_and_resample(np.ones((8, 8)), 1e-7, -1.0, 2e-7),
     lambda h: cs.psf(np.zeros((16, 16)), 1e-7),
+    lambda h: cs.psf(np.zeros((16, 16))),
+    lambda h: cs.psf(np.zeros((16, 16)), 1e-7, bead_diameter=-1e-7),
+    lambda h: cs.psf(np.zeros((16, 16)), 1e-7, saturation_level=float("nan")),
+    lambda h: cs.newton(np.zeros((2, 8, 8)), np.zeros((8, 8)), 1e-7),
+    lambda h: cs.newton(np.zeros((8, 8)), np.zeros((8, 8)), 1e-7, phase="quarter"),
+    lambda h: cs.newton(np.zeros((8, 8)), np.zeros((8, 8)), 1e-7, profiles=0),
+    lambda h: cs.newton(np.zeros((8, 8)), np.zeros((8, 8)), 1e-7, medium_index=-1.0),
     lambda h: cs.fit_hardening([1e-6], [1e-12], h, 1e-7, 1e9, radius=1e-5),
     lambda h: cs.fit_hardening([1e-6, 2e-6], [1e-12, 2e-12], h, 1e-7, 1e9, family="x"),
     lambda h: cs.ramp(h, 1e-7, 1e9, "hardness", None, [1e-6]),
@@ -330,6 +459,16 @@ def test_bad_input_is_valueerror(call):
         call(h)
     assert str(e.value)  # the library's message, never empty
     assert not isinstance(e.value, cs.InternalError)
+
+
+def test_optics_refusals_name_the_keyword():
+    a = np.zeros((8, 8), np.uint16)
+    with pytest.raises(cs.InputError, match="wavelength="):
+        cs.newton(a, a, 2e-7, wavelength=488.0)  # 488 m, not nm
+    with pytest.raises(cs.InputError, match="pixel_size="):
+        cs.psf(a)
+    with pytest.raises(cs.InputError, match="max_lag="):
+        cs.autocorrelation(a, 2e-7, max_lag=-1e-6)
 
 
 def test_results_are_plain_data():

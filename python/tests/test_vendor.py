@@ -82,3 +82,24 @@ def test_invalid_points_refused_unless_filled(cli):
     assert summary["detrended"] is None and "invalid" in summary["note"]
     with pytest.raises(cs.InputError, match="fill_invalid"):
         cs.read_topography(opd, fill_invalid="zero")
+
+
+def test_autocorrelation_of_a_czi_plane_matches_cli(cli, tmp_path):
+    czi = sample("czi/CellDivision_T3_Z5_CH2_X240_Y170.czi")
+    cli("autocorr", czi, "--channel", "1", "--z", "2", "--t", "1", "--out", tmp_path / "ac")
+    theirs = json.loads((tmp_path / "ac" / "autocorr.json").read_text())["images"]
+    mine = cs.autocorrelation(czi, channel=1, z=2, t=1).rows
+    assert len(mine) == len(theirs) == 1
+    m, t = mine[0], theirs[0]
+    assert (m["image"], m["file"], m["page"]) == (t["image"], t["file"], t["page"])
+    assert m["max_lag_m"] * 1e6 == pytest.approx(t["max_lag_um"], rel=1e-12)
+    for key in ("correlation_length_um_1e", "first_zero_um"):
+        si = key.replace("_um", "_m")
+        if t[key] is None:
+            assert m[si] is None
+        else:
+            assert m[si] * 1e6 == pytest.approx(t[key], rel=1e-12)
+    # The same plane read as an array and given its pixel size: the same curve.
+    plane = cs.read_image(czi, channel=1, z=2, t=1)
+    again = cs.autocorrelation(plane.images[0], plane.pixel_size_m).rows[0]
+    np.testing.assert_allclose(again["acf"], m["acf"], rtol=0, atol=1e-12)

@@ -155,6 +155,10 @@ params! {
     Rolloff: "--rolloff", "rolloff", "the roll-off wavelength";
     /// Short-wavelength cutoff of a generated surface.
     Cutoff: "--cutoff", "cutoff", "the short-wavelength cutoff";
+    /// Saturation level of the detector (`psf`).
+    SaturationLevel: "--saturation-level", "saturation_level", "the saturation level";
+    /// Phase of the Newton-ring maxima.
+    Phase: "--phase", "phase", "the phase of the ring maxima";
 }
 
 impl fmt::Display for Param {

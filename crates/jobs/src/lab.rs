@@ -214,11 +214,11 @@ fn unit_token(token: &str) -> Option<(&'static str, f64)> {
         "uN" => ("n", 1e6),
         "um" => ("m", 1e6),
         "nm" => ("m", 1e9),
+        "mm" => ("m", 1e3),
         "um2" => ("m2", 1e12),
         "um3" => ("m3", 1e18),
         "MPa" => ("pa", 1e-6),
         "GPa" => ("pa", 1e-9),
-        "mm" => ("m", 1e3),
         "pct" => ("fraction", 100.0),
         _ => return None,
     })

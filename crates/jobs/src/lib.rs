@@ -11,6 +11,7 @@
 //! |---|---|
 //! | [`series`] | files, folders and manifests (TIFF, CZI, ND2, LIF) → which page or plane is which load; the file-backed plane source of the series analysis |
 //! | [`heights`] | a height-map file read, filled and detrended as every command takes it |
+//! | [`images`] | a micrograph file or planes in memory, as the optics commands take them |
 //! | [`staging`] | output folders written to a staging folder and renamed into place atomically; inputs never overwritten |
 //! | [`table`] | small CSV tables whose column names carry the unit (`force_mN`) |
 //! | [`results`] | one command's outputs read by another: `areas.csv`, a `simulate` folder, `psf.json` |
@@ -21,6 +22,7 @@
 
 pub mod error;
 pub mod heights;
+pub mod images;
 pub mod lab;
 pub mod mechanics_csv;
 pub mod plot;

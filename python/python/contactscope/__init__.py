@@ -295,28 +295,99 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
     return result
 
 
-def psf(beads: Any, pixel_size: PixelSize, bead_diameter: Optional[float] = None,
-        saturation_level: Optional[float] = None) -> Results:
-    """The point-spread function from sub-resolution beads (one image or a z stack; pixel size
-    in m): ``sigma_m`` and ``fwhm_m`` (m; corrected for ``bead_diameter``, m, when given), the
-    per-bead results in ``beads``."""
-    return Results(_cs.psf(_f64(beads, 3, "beads"), pixel_size, bead_diameter, saturation_level))
+def _image(image: Any) -> Any:
+    """A file (path) as its path, anything else as a stack in its stored sample type."""
+    if isinstance(image, (str, os.PathLike)):
+        return os.fspath(image)
+    return _stack(image)
 
 
-def autocorrelation(image: Any, pixel_size: PixelSize, max_lag: Optional[float] = None) -> Results:
-    """Radially averaged intensity autocorrelation C(r) of one image: ``lag_m`` (m), ``c``,
-    ``xi_1e_m`` (first lag with C ≤ 1/e, m) and ``first_zero_m`` (m); lags up to ``max_lag`` m
-    (default half the shorter side)."""
-    return Results(_cs.autocorrelation(_f64(image, 2, "image"), pixel_size, max_lag))
+def psf(beads: Any, pixel_size: Optional[PixelSize] = None,
+        bead_diameter: Optional[float] = None, saturation_level: Optional[float] = None, *,
+        series: Optional[int] = None, channel: Optional[int] = None, z: Optional[int] = None,
+        t: Optional[int] = None, axes: Optional[Dict[str, int]] = None) -> Results:
+    """The point-spread function from sub-resolution beads, the command line's ``psf``.
+
+    ``beads``: a bead image or z stack as a file (TIFF: every page of ``channel``; CZI, ND2,
+    LIF: every z plane of the selection ``series``, ``channel``, ``t``, ``axes``, or the one
+    plane ``z`` names) or as an array (2-D image or 3-D stack) in its stored sample type (uint8,
+    uint16, int16, float32, float64). ``pixel_size`` (m) overrides the file's metadata and is
+    needed for arrays; ``bead_diameter`` (m) turns on the finite-bead correction σ² − a²/5.
+    Beads with two or more window pixels at the detector's saturation level are skipped; the
+    level follows from the sample type as on the command line (uint8 255, uint16 4095 when the
+    data do not exceed it — 12-bit data — else 65535, int16 32767, floats: no check) unless
+    ``saturation_level`` gives it.
+
+    Returns the outcome the command line writes as ``psf.json`` and ``beads.csv``, in SI units:
+    ``sigma_m_mean``, ``sigma_m_sd``, ``fwhm_m_mean``, ``fwhm_m_sd`` (bead-corrected when asked),
+    ``sigma_raw_m_mean``…, ``fwhm_raw_m_mean``…, ``sigma_x_2d_m_mean``…, ``beads_used``,
+    ``beads_found``, ``pixel_size_m``, ``saturation_level``, ``skipped``, ``detection``,
+    ``method`` and ``beads`` (per candidate: ``x_px``, ``y_px``, ``plane``, ``sigma_m``,
+    ``fwhm_m``, ``used``, ``skip_reason``, …; also :attr:`Results.rows`).
+    """
+    return Results(_cs.psf(_image(beads), pixel_size, bead_diameter, saturation_level, series,
+                           channel, z, t, axes), table="beads")
 
 
-def newton(reflection: Any, contact: Any, pixel_size: PixelSize, wavelength: float = 488e-9,
-           medium_index: float = 1.447, profiles: int = 20) -> Results:
-    """The detection gap from Newton rings (reflection image) around the fluorescent contact
-    (same field); pixel size and ``wavelength`` in m. Returns ``detection_gap_m``,
-    ``contact_radius_m``, ``sphere_radius_m``, ``edge_radius_m`` (mean and sd, m)."""
-    return Results(_cs.newton(_f64(reflection, 2, "reflection"), _f64(contact, 2, "contact"),
-                              pixel_size, wavelength, medium_index, profiles))
+def autocorrelation(images: Any, pixel_size: Optional[PixelSize] = None,
+                    max_lag: Optional[float] = None, *, series: Optional[int] = None,
+                    channel: Optional[int] = None, z: Optional[int] = None,
+                    t: Optional[int] = None, axes: Optional[Dict[str, int]] = None) -> Results:
+    """Radially averaged intensity autocorrelation C(r), the command line's ``autocorr``.
+
+    ``images``: one file or a list of files (every page of a multi-page TIFF is one image; a
+    CZI, ND2 or LIF file gives the plane its selection ``series``, ``channel``, ``z``, ``t``,
+    ``axes`` names), or an array (a 2-D image or a 3-D stack, each plane one image) with its
+    ``pixel_size`` (m). Lags go up to ``max_lag`` m (default, and at most, half the shorter
+    side of each image).
+
+    Returns the outcome the command line writes as ``autocorr.json``, in SI units: ``images``
+    (per image: ``image``, ``file``, ``page``, ``pixel_size_x_m``, ``max_lag_m``,
+    ``correlation_length_m_1e`` (first lag with C ≤ 1/e, m), ``first_zero_m`` (m), and the
+    curve as arrays ``lag_m`` (m) and ``acf``; also :attr:`Results.rows`), ``method`` and
+    ``warnings`` (also issued as :class:`ContactscopeWarning`).
+    """
+    if isinstance(images, (list, tuple)) \
+            and all(isinstance(i, (str, os.PathLike)) for i in images):
+        items = [os.fspath(i) for i in images]
+    else:
+        items = [_image(images)]
+    result = Results(_cs.autocorrelation(items, pixel_size, max_lag, series, channel, z, t,
+                                         axes), table="images")
+    _warn(result)
+    return result
+
+
+def newton(reflection: Any, contact: Any, pixel_size: Optional[PixelSize] = None,
+           wavelength: Optional[float] = None, medium_index: Optional[float] = None,
+           profiles: Optional[int] = None, phase: Optional[str] = None, *,
+           contact_channel: Optional[int] = None, series: Optional[int] = None,
+           channel: Optional[int] = None, z: Optional[int] = None, t: Optional[int] = None,
+           axes: Optional[Dict[str, int]] = None) -> Results:
+    """The detection gap from Newton rings around the fluorescent contact, the command line's
+    ``newton``.
+
+    ``reflection`` (the rings) and ``contact`` (the fluorescence image of the same field): files
+    (a single-page TIFF or the plane of a CZI, ND2 or LIF file that ``series``, ``channel``,
+    ``z``, ``t``, ``axes`` select; ``contact_channel`` when the contact image is another
+    channel of the same file) or 2-D arrays in their stored sample type with their
+    ``pixel_size`` (m). Defaults as on the command line: ``wavelength`` 488e-9 m,
+    ``medium_index`` 1.447 (formamide), ``profiles`` 20 lines through the centre, ``phase``
+    "half" (maxima at (m + ½)λ/(2n); "zero" for a sphere of lower index than the medium).
+
+    Returns the outcome the command line writes as ``newton.json`` and ``newton_rings.csv``, in
+    SI units: ``detection_gap_m_mean``, ``detection_gap_m_sd``, ``edge_radius_m``,
+    ``edge_radius_m_sd``, ``contact_radius_a_m_mean``/``_sd``, ``sphere_radius_R_m_mean``/``_sd``,
+    ``profiles_used``, ``profiles_total``, ``centre_x_px``, ``centre_y_px``,
+    ``fluorescence_threshold``, ``ring_gaps_m``, ``inputs``, ``method``, ``profiles`` (per
+    line profile: ``angle_deg``, ``rings``, ``edge_radius_m``, ``a_m``, ``R_m``,
+    ``rms_residual_m``, ``detection_gap_m``, ``used``, ``skipped_reason``, …; also
+    :attr:`Results.rows`), ``skipped_profiles`` and ``rings`` (every ring maximum: ``profile``,
+    ``side``, ``order``, ``r_m``, ``gap_m``, ``fit_gap_m``, ``used``).
+    """
+    return Results(_cs.newton(_image(reflection), _image(contact), pixel_size, wavelength,
+                              medium_index, profiles, phase, contact_channel, series, channel,
+                              z, t, axes), table="profiles")
 
 
 def blur_and_resample(map: Any, pixel_size: PixelSize, fwhm: float,

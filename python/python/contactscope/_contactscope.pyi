@@ -84,23 +84,212 @@ def analyze(
     modulus: Optional[float] = None,
     masks: bool = False,
 ) -> AnalyzeResult: ...
+Selection = Optional[Dict[str, int]]
+
+class PsfBead(TypedDict):
+    """One bead candidate: a row of beads.csv."""
+
+    bead: int
+    x_px: float
+    y_px: float
+    plane: int
+    page: int
+    x_m: float
+    y_m: float
+    peak: float
+    background: Optional[float]
+    centroid_x_px: Optional[float]
+    centroid_y_px: Optional[float]
+    sigma_m: Optional[float]
+    fwhm_m: Optional[float]
+    sigma_raw_m: Optional[float]
+    sigma_x_m: Optional[float]
+    sigma_y_m: Optional[float]
+    ellipticity: Optional[float]
+    fit_rms_rel: Optional[float]
+    used: bool
+    skip_reason: Optional[str]
+
+class PsfSkipped(TypedDict):
+    bead: int
+    x_px: float
+    y_px: float
+    plane: int
+    reason: str
+    detail: str
+
+class PsfDetection(TypedDict):
+    background: float
+    noise: float
+    threshold: float
+    sigma_guess_px: float
+
+class PsfResult(TypedDict):
+    """psf.json in SI units, with the rows of beads.csv."""
+
+    input: str
+    planes: int
+    pixel_size_m: float
+    pixel_size_source: str
+    beads_found: int
+    beads_used: int
+    bead_diameter_m: Optional[float]
+    bead_correction_applied: bool
+    bead_correction: str
+    summary_from: str
+    method: Dict[str, Any]
+    detection: PsfDetection
+    saturation_level: Optional[float]
+    skipped: List[PsfSkipped]
+    sigma_m_mean: float
+    sigma_m_sd: Optional[float]
+    fwhm_m_mean: float
+    fwhm_m_sd: Optional[float]
+    sigma_raw_m_mean: float
+    sigma_raw_m_sd: Optional[float]
+    fwhm_raw_m_mean: float
+    fwhm_raw_m_sd: Optional[float]
+    sigma_x_2d_m_mean: float
+    sigma_x_2d_m_sd: Optional[float]
+    sigma_y_2d_m_mean: float
+    sigma_y_2d_m_sd: Optional[float]
+    beads: List[PsfBead]
+
 def psf(
-    beads: npt.NDArray[np.float64],
-    pixel_size: PixelSize,
+    beads: Union[Path, Stack],
+    pixel_size: Optional[PixelSize] = None,
     bead_diameter: Optional[float] = None,
     saturation_level: Optional[float] = None,
-) -> Dict[str, Any]: ...
+    series: Optional[int] = None,
+    channel: Optional[int] = None,
+    z: Optional[int] = None,
+    t: Optional[int] = None,
+    axes: Selection = None,
+) -> PsfResult: ...
+
+class AutocorrImage(TypedDict):
+    """One image of autocorr.json, with its curve."""
+
+    image: str
+    file: str
+    page: int
+    width_px: int
+    height_px: int
+    pixel_size_x_m: float
+    pixel_size_y_m: float
+    max_lag_m: float
+    correlation_length_m_1e: Optional[float]
+    first_zero_m: Optional[float]
+    lag_m: npt.NDArray[np.float64]
+    acf: npt.NDArray[np.float64]
+
+class AutocorrResult(TypedDict):
+    """autocorr.json in SI units."""
+
+    method: Dict[str, str]
+    images: List[AutocorrImage]
+    warnings: List[str]
+
 def autocorrelation(
-    image: npt.NDArray[np.float64], pixel_size: PixelSize, max_lag: Optional[float] = None
-) -> Dict[str, Any]: ...
+    images: List[Union[Path, Stack]],
+    pixel_size: Optional[PixelSize] = None,
+    max_lag: Optional[float] = None,
+    series: Optional[int] = None,
+    channel: Optional[int] = None,
+    z: Optional[int] = None,
+    t: Optional[int] = None,
+    axes: Selection = None,
+) -> AutocorrResult: ...
+
+class NewtonInputs(TypedDict):
+    reflection: str
+    fluorescence: str
+    pixel_size_x_m: float
+    pixel_size_y_m: float
+
+class NewtonRingGap(TypedDict):
+    order: int
+    gap_m: float
+
+class NewtonProfile(TypedDict):
+    """One line profile (newton.json's profiles; newton_profiles.csv)."""
+
+    profile: int
+    angle_deg: float
+    rings: int
+    edge_radius_m: Optional[float]
+    half_lines_used: int
+    a_m: Optional[float]
+    R_m: Optional[float]
+    rms_residual_m: Optional[float]
+    shifted_rms_residual_m: Optional[float]
+    shifted_residual_ratio: Optional[float]
+    detection_gap_m: Optional[float]
+    used: bool
+    skipped_reason: Optional[str]
+
+class NewtonSkipped(TypedDict):
+    profile: int
+    angle_deg: float
+    reason: str
+
+class NewtonRing(TypedDict):
+    """One ring maximum: a row of newton_rings.csv."""
+
+    profile: int
+    angle_deg: float
+    side: str
+    order: int
+    r_m: float
+    gap_m: float
+    fit_gap_m: Optional[float]
+    used: bool
+
+class NewtonResult(TypedDict):
+    """newton.json in SI units, with the rows of newton_rings.csv."""
+
+    inputs: NewtonInputs
+    detection_gap_m_mean: float
+    detection_gap_m_sd: Optional[float]
+    edge_radius_m: float
+    edge_radius_m_sd: Optional[float]
+    contact_radius_a_m_mean: float
+    contact_radius_a_m_sd: Optional[float]
+    sphere_radius_R_m_mean: float
+    sphere_radius_R_m_sd: Optional[float]
+    profiles_used: int
+    profiles_total: int
+    profiles_needed: int
+    centre_x_px: float
+    centre_y_px: float
+    centre_x_m: float
+    centre_y_m: float
+    fluorescence_threshold: float
+    fluorescence_contact_pixels: int
+    wavelength_m: float
+    medium_index: float
+    phase: str
+    ring_gaps_m: List[NewtonRingGap]
+    method: Dict[str, Any]
+    profiles: List[NewtonProfile]
+    skipped_profiles: List[NewtonSkipped]
+    rings: List[NewtonRing]
+
 def newton(
-    reflection: npt.NDArray[np.float64],
-    contact: npt.NDArray[np.float64],
-    pixel_size: PixelSize,
-    wavelength: float = 488e-9,
-    medium_index: float = 1.447,
-    profiles: int = 20,
-) -> Dict[str, Any]: ...
+    reflection: Union[Path, Stack],
+    contact: Union[Path, Stack],
+    pixel_size: Optional[PixelSize] = None,
+    wavelength: Optional[float] = None,
+    medium_index: Optional[float] = None,
+    profiles: Optional[int] = None,
+    phase: Optional[str] = None,
+    contact_channel: Optional[int] = None,
+    series: Optional[int] = None,
+    channel: Optional[int] = None,
+    z: Optional[int] = None,
+    t: Optional[int] = None,
+    axes: Selection = None,
+) -> NewtonResult: ...
 def blur_and_resample(
     map: npt.NDArray[np.float64], pixel_size: PixelSize, fwhm: float, image_pixel_size: PixelSize
 ) -> npt.NDArray[np.float64]: ...
@@ -111,7 +300,7 @@ class CompareResult(TypedDict):
     simulated_threshold: float
     dihedral_search: bool
     upsample: int
-    force_tolerance_pct: float
+    force_tolerance_fraction: float
     loads_matched: int
     dice_mean: float
     jaccard_mean: float

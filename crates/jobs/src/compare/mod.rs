@@ -165,8 +165,9 @@ pub struct CompareOutcome {
     pub dihedral_search: bool,
     /// Sub-pixel resolution, 1/N px.
     pub upsample: usize,
-    /// Force tolerance, %.
-    pub force_tolerance_pct: f64,
+    /// Force tolerance (a fraction; written in %).
+    #[serde(rename = "force_tolerance_pct", serialize_with = "lab::fraction_as_pct")]
+    pub force_tolerance: f64,
     /// Loads present in both.
     pub loads_matched: usize,
     /// Mean Dice over the matched loads.
@@ -258,7 +259,7 @@ pub fn run_with(request: &CompareRequest, micrographs: &MicrographSet) -> Result
         simulated_threshold,
         dihedral_search: request.dihedral,
         upsample: request.upsample,
-        force_tolerance_pct: request.force_tolerance * 100.0,
+        force_tolerance: request.force_tolerance,
         loads_matched: loads.len(),
         dice_mean: mean(&|l| l.dice),
         jaccard_mean: mean(&|l| l.jaccard),

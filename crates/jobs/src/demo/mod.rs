@@ -31,15 +31,15 @@ use crate::friction::{files::run_to_folder as friction_to_folder, FrictionReques
 use crate::heights::HeightInput;
 use crate::heights::TopographySource;
 use crate::hertz::{files::run_to_folder as hertz_to_folder, HertzRequest};
-use crate::newton::{run_newton, NewtonRequest};
-use crate::psf::{run_psf, PsfRequest};
+use crate::images::ImageInput;
+use crate::newton::{files::run_to_folder as newton_to_folder, NewtonRequest};
+use crate::psf::{files::run_to_folder as psf_to_folder, PsfRequest};
 use crate::series::{Micrographs, SeriesSpec};
 use crate::staging::write_atomic;
 use contactscope::compare::{compare_maps, CompareSettings, Comparison, SimulatedMap};
 use contactscope::mechanics::friction::{SlipOptions, XAxis};
 use contactscope::model_fit::{Family, Imaging, ModelBody, Search};
 use contactscope::optics::blur::Grid;
-use contactscope::optics::newton::NewtonOptions;
 use contactscope::solver::cg::SolverOptions;
 use contactscope::solver::halfspace::Boundary;
 use contactscope::solver::simulate::{sweep, Model, Setup};
@@ -445,14 +445,11 @@ fn psf(work: &Path, data: &Path, p: &DemoParams) -> Result<Recovered> {
     let pages: Vec<&[u16]> = beads.planes.iter().map(Vec::as_slice).collect();
     let tiff = encode_u16_stack(&pages, beads.width, beads.height, Some((pixel, pixel)), "")?;
     write_atomic(&path, &tiff)?;
-    let outcome = run_psf(&PsfRequest {
-        input: path,
-        selection: contactscope_formats::microscopy::select::Selection::default(),
-        pixel_size_m: None,
-        bead_diameter_m: None,
-        out_dir: work.join("psf"),
-        command_line: vec!["contactscope demo".into()],
-    })?;
+    let (outcome, _) = psf_to_folder(
+        &PsfRequest::new(ImageInput::File(path)),
+        &work.join("psf"),
+        &["contactscope demo".into()],
+    )?;
     let s = &outcome.report.summary;
     Ok(Recovered {
         quantity: "PSF FWHM".into(),
@@ -487,16 +484,11 @@ fn newton(work: &Path, data: &Path, p: &DemoParams) -> Result<Vec<Recovered>> {
     };
     let reflection = write("reflection.tif", &synth.reflection)?;
     let fluorescence = write("fluorescence.tif", &synth.fluorescence)?;
-    let outcome = run_newton(&NewtonRequest {
-        reflection,
-        fluorescence,
-        pixel_size_m: None,
-        selection: contactscope_formats::microscopy::select::Selection::default(),
-        contact_channel: None,
-        options: NewtonOptions::default(),
-        out_dir: work.join("newton"),
-        command_line: vec!["contactscope demo".into()],
-    })?;
+    let (outcome, _) = newton_to_folder(
+        &NewtonRequest::new(ImageInput::File(reflection), ImageInput::File(fluorescence)),
+        &work.join("newton"),
+        &["contactscope demo".into()],
+    )?;
     let a = &outcome.analysis;
     Ok(vec![Recovered {
         quantity: "detection gap".into(),
