@@ -114,9 +114,17 @@ fn front_end_crates_stay_out_of_the_libraries_and_the_wheel() {
         );
     }
     let python = &ws["contactscope-python"];
+    let jobs = python
+        .iter()
+        .find(|(d, _, _)| d == "contactscope-jobs")
+        .expect("python uses the jobs");
+    assert!(
+        !jobs.2,
+        "the wheel takes contactscope-jobs without default features (no plots)"
+    );
     for (dep, _, _) in python {
         assert!(
-            !matches!(dep.as_str(), "clap" | "indicatif"),
+            !matches!(dep.as_str(), "clap" | "indicatif" | "plotters"),
             "the wheel depends on {dep}"
         );
     }

@@ -25,6 +25,7 @@ pub mod heights;
 pub mod images;
 pub mod lab;
 pub mod mechanics_csv;
+#[cfg(feature = "plots")]
 pub mod plot;
 pub mod results;
 pub mod series;
@@ -35,6 +36,8 @@ pub mod table;
 pub mod analyze;
 pub mod autocorr;
 pub mod compare;
+/// The demo writes an HTML report with figures: it needs the `plots` feature.
+#[cfg(feature = "plots")]
 pub mod demo;
 pub mod fit_hardening;
 pub mod friction;

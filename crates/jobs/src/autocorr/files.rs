@@ -9,6 +9,7 @@ use contactscope::spectral::autocorrelation::AcfCurve;
 use super::{run, AutocorrOutcome, AutocorrRequest};
 use crate::error::{Error, Result};
 use crate::images::input_files;
+#[cfg(feature = "plots")]
 use crate::plot::{Axes, Chart, Curve, Legend};
 use crate::staging::Staging;
 use crate::summary::summary_json;
@@ -58,6 +59,7 @@ pub fn curves_csv(curves: &[AcfCurve]) -> Result<String> {
     String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
 }
 
+#[cfg(feature = "plots")]
 /// All curves on one linear chart against lag in µm, with the 1/e level as a guide.
 pub fn acf_chart(curves: &[AcfCurve], title: &str) -> Chart {
     let max_lag_um = curves

@@ -9,6 +9,7 @@
 
 pub mod files;
 
+#[cfg(feature = "plots")]
 pub use files::acf_chart;
 
 use serde::Serialize;

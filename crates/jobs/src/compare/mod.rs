@@ -166,7 +166,10 @@ pub struct CompareOutcome {
     /// Sub-pixel resolution, 1/N px.
     pub upsample: usize,
     /// Force tolerance (a fraction; written in %).
-    #[serde(rename = "force_tolerance_pct", serialize_with = "lab::fraction_as_pct")]
+    #[serde(
+        rename = "force_tolerance_pct",
+        serialize_with = "lab::fraction_as_pct"
+    )]
     pub force_tolerance: f64,
     /// Loads present in both.
     pub loads_matched: usize,
