@@ -52,8 +52,17 @@ fn body_request(
     imaging_pixel_size: Option<PixelArg>,
     detrend: &str,
     periodic: bool,
+    file: (Option<f64>, Option<String>, Option<&str>),
 ) -> PyResult<BodyRequest> {
-    let input = height_input(heights, pixel_size, detrend, None, None, None)?;
+    let (height_unit, channel, fill_invalid) = file;
+    let input = height_input(
+        heights,
+        pixel_size,
+        detrend,
+        height_unit,
+        channel,
+        fill_invalid,
+    )?;
     let mut body = BodyRequest::new(input, modulus);
     body.radius_m = radius;
     body.periodic = periodic;
@@ -81,7 +90,7 @@ fn family_of(name: &str) -> PyResult<Family> {
 /// Fit contact models to a measured area–load curve (the command line's `fit-hardening`).
 /// Returns the outcome (SI keys) with each model's search `trace` [(parameter, misfit)].
 #[pyfunction]
-#[pyo3(signature = (measured, heights, pixel_size, modulus, radius=None, families=None, range=None, grid=None, ln_tolerance=None, tolerance=None, max_iterations=None, imaging_fwhm=None, imaging_pixel_size=None, detrend="plane", periodic=false))]
+#[pyo3(signature = (measured, heights, pixel_size, modulus, radius=None, families=None, range=None, grid=None, ln_tolerance=None, tolerance=None, max_iterations=None, imaging_fwhm=None, imaging_pixel_size=None, detrend="plane", periodic=false, height_unit=None, channel=None, fill_invalid=None))]
 #[allow(clippy::too_many_arguments)]
 fn fit_hardening<'py>(
     py: Python<'py>,
@@ -100,6 +109,9 @@ fn fit_hardening<'py>(
     imaging_pixel_size: Option<PixelArg>,
     detrend: &str,
     periodic: bool,
+    height_unit: Option<f64>,
+    channel: Option<String>,
+    fill_invalid: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let body = body_request(
         heights,
@@ -112,6 +124,7 @@ fn fit_hardening<'py>(
         imaging_pixel_size,
         detrend,
         periodic,
+        (height_unit, channel, fill_invalid),
     )?;
     let mut request = FitRequest::new(measured_input(measured)?, body);
     if let Some(names) = families {
@@ -191,6 +204,7 @@ fn ramp<'py>(
         imaging_pixel_size,
         detrend,
         periodic,
+        (None, None, None),
     )?;
     let outcome = compute(py, move || {
         contactscope_jobs::fit_hardening::ramp(&body, family, parameter, &loads)

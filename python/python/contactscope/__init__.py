@@ -608,7 +608,9 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
                   ln_tolerance: Optional[float] = None, tolerance: Optional[float] = None,
                   max_iterations: Optional[int] = None, imaging_fwhm: Optional[float] = None,
                   imaging_pixel_size: Optional[PixelSize] = None, client: Any = None, *,
-                  detrend: str = "plane", periodic: bool = False) -> FitResults:
+                  detrend: str = "plane", periodic: bool = False,
+                  height_unit: Optional[float] = None, channel: Optional[str] = None,
+                  fill_invalid: Optional[str] = None) -> FitResults:
     """Fit contact models to a measured area–load curve: the command line's ``fit-hardening``,
     with its defaults, checks and warnings. The curve: ``forces`` (N) and ``areas`` (m²), or
     ``forces`` an ``areas.csv`` written by ``analyze`` (``areas`` None). The rough sphere:
@@ -617,7 +619,9 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
     ("elastic", "gt", "hardness", "hardening"); "hardening" fits k (Pa/m; default range
     1e14–1e17), "hardness" p_Y (Pa; 1e7–1e10) by a log grid (``grid``, default 7) then Brent's
     method to ``ln_tolerance`` (default 0.01); "elastic" and "gt" are evaluated once.
-    ``imaging_fwhm`` and ``imaging_pixel_size`` count simulated areas as imaged.
+    ``imaging_fwhm`` and ``imaging_pixel_size`` count simulated areas as imaged. A height-map
+    file is read as the command line reads ``--topography`` (``height_unit``, ``channel``,
+    ``fill_invalid``).
 
     Returns a :class:`FitResults` (``parameter``, ``parameter_se``, ``misfit``, ``areas_m2``,
     ``trace`` of the best model; the whole ``fit.json`` in SI units). With a
@@ -647,7 +651,8 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
     result = FitResults(_cs.fit_hardening(measured, _heights(heights), pixel_size,
                                           float(modulus), radius, families, range, grid,
                                           ln_tolerance, tolerance, max_iterations,
-                                          imaging_fwhm, imaging_pixel_size, detrend, periodic))
+                                          imaging_fwhm, imaging_pixel_size, detrend, periodic,
+                                          height_unit, channel, fill_invalid))
     _warn(result)
     return result
 

@@ -357,6 +357,7 @@ class TopographyResult(TypedDict):
     summary: TopographySummary
     notes: List[str]
     heights: npt.NDArray[np.float64]
+    pixel_size_m: Tuple[float, float]
 
 def read_topography(
     path: Path,
@@ -502,6 +503,9 @@ def fit_hardening(
     imaging_pixel_size: Optional[PixelSize] = None,
     detrend: str = "plane",
     periodic: bool = False,
+    height_unit: Optional[float] = None,
+    channel: Optional[str] = None,
+    fill_invalid: Optional[str] = None,
 ) -> FitResult: ...
 
 # Mechanics tests (CSV files)
