@@ -26,6 +26,9 @@ pub(super) struct Facts<'a> {
     pub fits: &'a [ModelFit],
 }
 
+/// contactscope's own methods (`docs/methods.md`), written beside the report it cites them in.
+const METHODS: &str = include_str!("../../../../docs/methods.md");
+
 pub(super) fn write_report(dir: &Path, facts: &Facts) -> Result<()> {
     let panels = write_panels(dir, facts)?;
     write_acf(dir, facts)?;
@@ -33,6 +36,8 @@ pub(super) fn write_report(dir: &Path, facts: &Facts) -> Result<()> {
     let text = serde_json::to_string_pretty(&json)
         .map_err(|e| Error::InvalidArgument(format!("JSON: {e}")))?;
     write_atomic(&dir.join("demo.json"), text.as_bytes())?;
+    // The methods the report cites travel with it (the reader of the report has no checkout).
+    write_atomic(&dir.join("methods.md"), METHODS.as_bytes())?;
     write_atomic(&dir.join("index.html"), page(facts, &panels).as_bytes())
 }
 
@@ -196,7 +201,7 @@ fn page(facts: &Facts, panels: &[(String, usize)]) -> String {
     s.push_str(HEAD);
     let _ = write!(
         s,
-        "<h1>contactscope demo</h1>\n<p>The whole method of Weber et al., <i>Nat. Commun.</i> 9, 888 (2018), on a synthetic experiment with known truth, made by contactscope's own generators and solver (version {}). Inputs below are the generator's; every number under <b>Recovered</b> was measured by the analysis commands from the generated files in <a href=\"data/\">data/</a>.</p>\n",
+        "<h1>contactscope demo</h1>\n<p>The whole method of Weber et al., <i>Nat. Commun.</i> 9, 888 (2018), <a href=\"https://doi.org/10.1038/s41467-018-02981-y\">doi:10.1038/s41467-018-02981-y</a>, on a synthetic experiment with known truth, made by contactscope's own generators and solver (version {}). Inputs below are the generator's; every number under <b>Recovered</b> was measured by the analysis commands from the generated files in <a href=\"data/\">data/</a>.</p>\n",
         env!("CARGO_PKG_VERSION")
     );
     inputs_table(&mut s, p);
@@ -241,7 +246,7 @@ fn page(facts: &Facts, panels: &[(String, usize)]) -> String {
     s.push_str("<h2>Fig. 3a: contact area vs load</h2>\n");
     figure(&mut s, "fit/fit_area_vs_load.png", "Measured areas (analyze) and the four models at their best parameters; simulated areas counted as imaged (blur, resample, Otsu). Table: fit/fit_areas.csv, fit/fit.json.");
     fits_table(&mut s, facts.fits);
-    s.push_str("<p>The micrographs show more area than the simulation's g = 0 pixels (table below): the PSF merges and widens sub-resolution patches before the threshold. That is why the fit counts simulated areas as imaged, like with like (methods.md §7.1).</p>\n");
+    s.push_str("<p>The micrographs show more area than the simulation's g = 0 pixels (table below): the PSF merges and widens sub-resolution patches before the threshold. That is why the fit counts simulated areas as imaged, like with like (<a href=\"methods.md\">methods.md</a> §7.1, in this folder).</p>\n");
     areas_table(&mut s, facts);
     s.push_str("<h2>Fig. 3b: friction</h2>\n");
     figure(
