@@ -21,7 +21,7 @@ pub struct Args {
     /// file's height channel.
     #[arg(long)]
     channel: Option<String>,
-    /// Print JSON: the stored map's summary (issue 14: file, format, channel, nx, ny,
+    /// Print JSON: the stored map's summary (file, format, channel, nx, ny,
     /// pixel_size_um, valid_points, height_*_um, h_rms_um, slope_rms, curvature_rms) and,
     /// under "detrended", the statistics after --detrend.
     #[arg(long)]

@@ -54,7 +54,7 @@ fn json(path: &Path) -> Value {
     serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
 }
 
-/// validation.md B17 through the command: blurred noise has ξ_1/e = 2σ_g; two images with
+/// docs/validation.md B17 through the command: blurred noise has ξ_1/e = 2σ_g; two images with
 /// different pixel sizes share one CSV, JSON and plot.
 #[test]
 fn known_correlation_lengths_of_two_images() {

@@ -1,4 +1,4 @@
-//! Newton rings and the detection gap (validation.md B13/B14 are unit tests in
+//! Newton rings and the detection gap (docs/validation.md B13/B14 are unit tests in
 //! `optics::newton::gap`): synthetic image pairs with known truth through the library and the
 //! command line.
 

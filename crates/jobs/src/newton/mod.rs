@@ -1,5 +1,5 @@
 //! The `newton` job: the detection gap from Newton rings around the fluorescent contact (Weber
-//! et al. 2018, Methods, "Newton rings", Eq. 1; methods.md §7.5; the measurement is
+//! et al. 2018, Methods, "Newton rings", Eq. 1; docs/methods.md §7.5; the measurement is
 //! [`contactscope::optics::newton`]). Every front-end builds a [`NewtonRequest`] (the command
 //! line from two files and the selection flags, Python from files or arrays),
 //! [`NewtonRequest::check`] applies the same range checks, and [`run`] returns a

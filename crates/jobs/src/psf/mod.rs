@@ -1,5 +1,5 @@
 //! The `psf` job: the microscope's point-spread function from sub-resolution beads (Weber et al.
-//! 2018, Methods: Microscopy; methods.md §7.3; the measurement is
+//! 2018, Methods: Microscopy; docs/methods.md §7.3; the measurement is
 //! [`contactscope::optics::psf`]). Every front-end builds a [`PsfRequest`] (the command line
 //! from a file and its selection flags, Python from a file or an array in its stored sample
 //! type), [`PsfRequest::check`] applies the same range checks, and [`run`] returns a
@@ -387,7 +387,7 @@ fn outcome(input: String, report: PsfReport) -> PsfOutcome {
             "radial-profile fit (paper-faithful); 2-D Gaussian fit reported as a cross-check",
         method: PsfMethod {
             reference:
-                "Weber et al., Nat. Commun. 9, 888 (2018), Methods: Microscopy; methods.md §7.3",
+                "Weber et al., Nat. Commun. 9, 888 (2018), Methods: Microscopy; docs/methods.md §7.3",
             window_px: 2 * report.half_window_px + 1,
             background: "median of the window border",
             centre: "centre of intensity over pixels above 0.2 of the peak, 3 re-centring passes",
