@@ -72,9 +72,9 @@ pub fn run(args: Args) -> Result<()> {
         outcome.nx,
         outcome.ny,
         units::format_length(outcome.pixel_size_m),
-        outcome.h_rms_m * 1e9,
-        outcome.h_prime_rms,
-        outcome.h_double_prime_rms_per_m * 1e-6
+        outcome.roughness.h_rms_m * 1e9,
+        outcome.roughness.h_prime_rms,
+        outcome.roughness.h_double_prime_rms_per_m * 1e-6
     );
     Ok(())
 }

@@ -74,14 +74,14 @@ pub fn run(args: Args) -> Result<()> {
         return Ok(());
     };
     println!("detrend:     {detrend}");
-    println!("h_rms:       {:.5} nm", stats.h_rms_m * 1e9);
+    println!("h_rms:       {:.5} nm", stats.roughness.h_rms_m * 1e9);
     println!(
         "h'_rms:      {:.6} (central differences)",
-        stats.h_prime_rms
+        stats.roughness.h_prime_rms
     );
     println!(
         "h''_rms:     {:.6} 1/µm (5-point Laplacian)",
-        stats.h_double_prime_rms_per_m * 1e-6
+        stats.roughness.h_double_prime_rms_per_m * 1e-6
     );
     Ok(())
 }

@@ -7,6 +7,7 @@
 use std::path::PathBuf;
 
 use contactscope::surface::fill::{fill_invalid, FillInvalid};
+use contactscope::surface::stats::SurfaceStats;
 use contactscope::surface::{Detrend, Topography};
 use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
@@ -116,7 +117,24 @@ pub struct HeightFacts {
     pub channel: Option<String>,
     /// How invalid points were filled.
     pub fill_invalid: Option<FillInvalid>,
-    /// rms height after detrending, m.
+    /// Roughness after detrending (written as `h_rms_nm`, `h_prime_rms`,
+    /// `h_double_prime_rms_per_um`).
+    #[serde(flatten)]
+    pub roughness: Roughness,
+    /// Sphere radius added, m.
+    #[serde(
+        rename = "sphere_radius_um",
+        serialize_with = "crate::lab::opt_m_as_um"
+    )]
+    pub sphere_radius_m: Option<f64>,
+}
+
+/// The roughness statistics a summary records of a height map (`docs/conventions.md`,
+/// "Roughness statistics"): one shape for `surface`, `topography`, `simulate` and
+/// `fit-hardening`, written in nm and 1/µm.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Roughness {
+    /// rms height about the mean, m.
     #[serde(rename = "h_rms_nm", serialize_with = "crate::lab::m_as_nm")]
     pub h_rms_m: f64,
     /// rms slope (central differences).
@@ -127,12 +145,16 @@ pub struct HeightFacts {
         serialize_with = "crate::lab::per_m_as_per_um"
     )]
     pub h_double_prime_rms_per_m: f64,
-    /// Sphere radius added, m.
-    #[serde(
-        rename = "sphere_radius_um",
-        serialize_with = "crate::lab::opt_m_as_um"
-    )]
-    pub sphere_radius_m: Option<f64>,
+}
+
+impl From<&SurfaceStats> for Roughness {
+    fn from(stats: &SurfaceStats) -> Self {
+        Roughness {
+            h_rms_m: stats.h_rms_m,
+            h_prime_rms: stats.h_prime_rms,
+            h_double_prime_rms_per_m: stats.h_double_prime_rms_per_m,
+        }
+    }
 }
 
 /// A height-map file with how to read and level it.

@@ -219,6 +219,18 @@ pub fn rows_csv<T: serde::Serialize + ?Sized>(
         .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
 }
 
+/// A CSV written in memory by `write` (header first), as UTF-8 text.
+pub(crate) fn csv_text(
+    write: impl FnOnce(&mut csv::Writer<Vec<u8>>) -> std::result::Result<(), csv::Error>,
+) -> Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    write(&mut w).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
+    String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
+}
+
 /// A number in scientific notation with three significant digits (`1.234e-9`), for residuals.
 pub fn sci3(value: &serde_json::Value) -> String {
     value

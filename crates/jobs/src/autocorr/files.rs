@@ -7,12 +7,13 @@ use std::path::{Path, PathBuf};
 use contactscope::spectral::autocorrelation::AcfCurve;
 
 use super::{run, AutocorrOutcome, AutocorrRequest};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::images::input_files;
 #[cfg(feature = "plots")]
 use crate::plot::{Axes, Chart, Curve, Legend};
 use crate::staging::Staging;
 use crate::summary::summary_json;
+use crate::table::csv_text;
 
 /// Run `autocorr` and write its folder: the outcome and the files written (final paths).
 pub fn run_to_folder(
@@ -39,24 +40,19 @@ pub fn run_to_folder(
 
 /// Long-format table: `image, lag_um, acf`.
 pub fn curves_csv(curves: &[AcfCurve]) -> Result<String> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let csv_err = |e: csv::Error| Error::InvalidArgument(format!("CSV: {e}"));
-    w.write_record(["image", "lag_um", "acf"])
-        .map_err(csv_err)?;
-    for curve in curves {
-        for &(r, c) in &curve.profile {
-            w.write_record([
-                curve.label.clone(),
-                format!("{:.6}", r * 1e6),
-                format!("{c:.8}"),
-            ])
-            .map_err(csv_err)?;
+    csv_text(|w| {
+        w.write_record(["image", "lag_um", "acf"])?;
+        for curve in curves {
+            for &(r, c) in &curve.profile {
+                w.write_record([
+                    curve.label.clone(),
+                    format!("{:.6}", r * 1e6),
+                    format!("{c:.8}"),
+                ])?;
+            }
         }
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
+        Ok(())
+    })
 }
 
 #[cfg(feature = "plots")]

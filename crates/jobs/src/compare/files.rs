@@ -10,10 +10,11 @@ use contactscope::compare::LoadComparison;
 use contactscope::compare::Prepared;
 
 use super::{load_micrographs, run_with, CompareOutcome, CompareRequest, Simulation};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::series::Series;
 use crate::staging::Staging;
 use crate::summary::summary_json;
+use crate::table::csv_text;
 
 /// Run `compare` and write its folder: the outcome and the files written (final paths).
 pub fn run_to_folder(
@@ -53,69 +54,65 @@ fn panel(p: &Prepared, load: &LoadComparison, t_exp: f64) -> Result<Vec<u8>> {
 }
 
 fn compare_csv(loads: &[LoadComparison], pixel: (f64, f64)) -> Result<String> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let csv_err = |e: csv::Error| Error::InvalidArgument(format!("CSV: {e}"));
-    w.write_record([
-        "force_mN",
-        "simulated_force_mN",
-        "transform",
-        "shift_x_px",
-        "shift_y_px",
-        "shift_x_um",
-        "shift_y_um",
-        "correlation_peak",
-        "experiment_area_um2",
-        "simulated_area_um2",
-        "simulated_raw_area_um2",
-        "area_ratio",
-        "dice",
-        "jaccard",
-        "dice_threshold_minus10pct",
-        "dice_threshold_plus10pct",
-        "edge_distance_um",
-        "acf_rms_distance",
-        "experiment_xi_1e_um",
-        "simulated_xi_1e_um",
-        "intensity_gain",
-        "intensity_offset",
-        "micrograph",
-        "simulated_map",
-    ])
-    .map_err(csv_err)?;
-    let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.6}"));
-    for l in loads {
+    csv_text(|w| {
         w.write_record([
-            format!("{:.6}", l.force_n * 1e3),
-            format!("{:.6}", l.simulated_force_n * 1e3),
-            l.transform.name(),
-            format!("{:.3}", l.shift_px.0),
-            format!("{:.3}", l.shift_px.1),
-            format!("{:.4}", l.shift_px.0 * pixel.0 * 1e6),
-            format!("{:.4}", l.shift_px.1 * pixel.1 * 1e6),
-            format!("{:.4}", l.correlation_peak),
-            format!("{:.4}", l.experiment_area_m2 * 1e12),
-            format!("{:.4}", l.simulated_area_m2 * 1e12),
-            format!("{:.4}", l.simulated_raw_area_m2 * 1e12),
-            opt((l.experiment_area_m2 > 0.0).then(|| l.simulated_area_m2 / l.experiment_area_m2)),
-            format!("{:.5}", l.dice),
-            format!("{:.5}", l.jaccard),
-            format!("{:.5}", l.dice_threshold_pm10.0),
-            format!("{:.5}", l.dice_threshold_pm10.1),
-            opt(l.edge_distance_m.map(|d| d * 1e6)),
-            opt(l.acf_rms_distance),
-            opt(l.xi_1e_m.0.map(|v| v * 1e6)),
-            opt(l.xi_1e_m.1.map(|v| v * 1e6)),
-            format!("{:.4}", l.intensity.gain),
-            format!("{:.4}", l.intensity.offset),
-            format!("{}:page {}", l.micrograph.0.display(), l.micrograph.1),
-            l.simulated_map.clone(),
-        ])
-        .map_err(csv_err)?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
+            "force_mN",
+            "simulated_force_mN",
+            "transform",
+            "shift_x_px",
+            "shift_y_px",
+            "shift_x_um",
+            "shift_y_um",
+            "correlation_peak",
+            "experiment_area_um2",
+            "simulated_area_um2",
+            "simulated_raw_area_um2",
+            "area_ratio",
+            "dice",
+            "jaccard",
+            "dice_threshold_minus10pct",
+            "dice_threshold_plus10pct",
+            "edge_distance_um",
+            "acf_rms_distance",
+            "experiment_xi_1e_um",
+            "simulated_xi_1e_um",
+            "intensity_gain",
+            "intensity_offset",
+            "micrograph",
+            "simulated_map",
+        ])?;
+        let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.6}"));
+        for l in loads {
+            w.write_record([
+                format!("{:.6}", l.force_n * 1e3),
+                format!("{:.6}", l.simulated_force_n * 1e3),
+                l.transform.name(),
+                format!("{:.3}", l.shift_px.0),
+                format!("{:.3}", l.shift_px.1),
+                format!("{:.4}", l.shift_px.0 * pixel.0 * 1e6),
+                format!("{:.4}", l.shift_px.1 * pixel.1 * 1e6),
+                format!("{:.4}", l.correlation_peak),
+                format!("{:.4}", l.experiment_area_m2 * 1e12),
+                format!("{:.4}", l.simulated_area_m2 * 1e12),
+                format!("{:.4}", l.simulated_raw_area_m2 * 1e12),
+                opt((l.experiment_area_m2 > 0.0)
+                    .then(|| l.simulated_area_m2 / l.experiment_area_m2)),
+                format!("{:.5}", l.dice),
+                format!("{:.5}", l.jaccard),
+                format!("{:.5}", l.dice_threshold_pm10.0),
+                format!("{:.5}", l.dice_threshold_pm10.1),
+                opt(l.edge_distance_m.map(|d| d * 1e6)),
+                opt(l.acf_rms_distance),
+                opt(l.xi_1e_m.0.map(|v| v * 1e6)),
+                opt(l.xi_1e_m.1.map(|v| v * 1e6)),
+                format!("{:.4}", l.intensity.gain),
+                format!("{:.4}", l.intensity.offset),
+                format!("{}:page {}", l.micrograph.0.display(), l.micrograph.1),
+                l.simulated_map.clone(),
+            ])?;
+        }
+        Ok(())
+    })
 }
 
 fn input_files(request: &CompareRequest, series: &Series) -> Vec<PathBuf> {

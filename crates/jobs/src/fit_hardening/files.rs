@@ -8,12 +8,13 @@ use std::path::{Path, PathBuf};
 use contactscope::model_fit::{Family, Measured, ModelFit, ProgressHook};
 
 use super::{display, run, FitOutcome, FitRequest, MeasuredInput, SweepRow};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::heights::HeightInput;
 #[cfg(feature = "plots")]
 use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
 use crate::staging::Staging;
 use crate::summary::summary_json;
+use crate::table::csv_text;
 
 /// Run `fit-hardening` and write its folder: the outcome and the files written.
 pub fn run_to_folder(
@@ -82,17 +83,6 @@ fn model_label(fit: &ModelFit) -> String {
         ),
     };
     format!("{name} (misfit {:.3})", fit.best.misfit)
-}
-
-fn csv_text(
-    write: impl FnOnce(&mut csv::Writer<Vec<u8>>) -> std::result::Result<(), csv::Error>,
-) -> Result<String> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    write(&mut w).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
 }
 
 fn fit_csv(measured: &Measured, fits: &[ModelFit]) -> Result<String> {

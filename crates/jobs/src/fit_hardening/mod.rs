@@ -20,14 +20,13 @@ use contactscope::model_fit::{
 };
 use contactscope::solver::cg::SolverOptions;
 use contactscope::surface::fill::FillInvalid;
-use contactscope::surface::stats::SurfaceStats;
 use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
 
 pub use sweep::{Sweep, SweepMicrographs, SweepRow};
 
 use crate::error::{Error, Location, Result};
-use crate::heights::HeightInput;
+use crate::heights::{HeightInput, Roughness};
 use crate::lab::{self, OptQ, Qs, Unit, Q};
 use crate::results::read_areas_csv;
 use crate::simulate::{check_loads, check_solver, SimulateRequest};
@@ -232,22 +231,6 @@ fn parameter_quantity(family: Family) -> (Quantity, Param) {
     }
 }
 
-/// The roughness a summary records.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Roughness {
-    /// rms height, m.
-    #[serde(rename = "h_rms_nm", serialize_with = "lab::m_as_nm")]
-    pub h_rms_m: f64,
-    /// rms slope.
-    pub h_prime_rms: f64,
-    /// rms full Laplacian, 1/m.
-    #[serde(
-        rename = "h_double_prime_rms_per_um",
-        serialize_with = "lab::per_m_as_per_um"
-    )]
-    pub h_double_prime_rms_per_m: f64,
-}
-
 /// The measured curve as a summary records it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct MeasuredFacts {
@@ -416,7 +399,7 @@ pub fn run(request: &FitRequest, progress: Option<ProgressHook>) -> Result<FitOu
         fill_invalid,
         radius_m: request.body.radius_m,
         contact_modulus_pa: request.body.e_star_pa,
-        roughness: roughness(&body.stats),
+        roughness: Roughness::from(&body.stats),
         measured: MeasuredFacts {
             forces_n: measured.forces_n.clone(),
             areas_m2: measured.areas_m2.clone(),
@@ -430,14 +413,6 @@ pub fn run(request: &FitRequest, progress: Option<ProgressHook>) -> Result<FitOu
         sweep,
         sweep_family: request.sweep.as_ref().map(|s| s.family),
     })
-}
-
-fn roughness(stats: &SurfaceStats) -> Roughness {
-    Roughness {
-        h_rms_m: stats.h_rms_m,
-        h_prime_rms: stats.h_prime_rms,
-        h_double_prime_rms_per_m: stats.h_double_prime_rms_per_m,
-    }
 }
 
 fn fit_family(

@@ -8,9 +8,10 @@ use std::path::{Path, PathBuf};
 use contactscope::mechanics::friction::XAxis;
 
 use super::{run, FrictionOutcome, FrictionRequest, TraceResult};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::staging::Staging;
 use crate::summary::summary_json;
+use crate::table::csv_text;
 
 /// Run `friction` and write its folder: the outcome and the files written (final paths).
 pub fn run_to_folder(
@@ -69,17 +70,13 @@ pub fn results_csv(traces: &[TraceResult]) -> Result<String> {
     if with_area {
         header.extend(["area_um2".into(), "shear_stress_MPa".into()]);
     }
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let csv_err = |e: csv::Error| Error::InvalidArgument(format!("CSV: {e}"));
-    w.write_record(&header).map_err(csv_err)?;
-    for t in traces {
-        w.write_record(result_row(t, &axes, with_area))
-            .map_err(csv_err)?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
+    csv_text(|w| {
+        w.write_record(&header)?;
+        for t in traces {
+            w.write_record(result_row(t, &axes, with_area))?;
+        }
+        Ok(())
+    })
 }
 
 fn result_row(t: &TraceResult, axes: &[XAxis], with_area: bool) -> Vec<String> {

@@ -5,9 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use super::{run, FitPoint, HertzOutcome, HertzRequest};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::staging::Staging;
 use crate::summary::summary_json_without;
+use crate::table::csv_text;
 
 /// Run `hertz` and write its folder: the outcome and the files written (final paths).
 pub fn run_to_folder(
@@ -31,30 +32,25 @@ pub fn run_to_folder(
 /// `hertz_fit.csv`: force_mN, displacement_um, delta_um, fitted_force_mN, residual_mN, nine
 /// decimals each.
 pub fn fit_csv(points: &[FitPoint]) -> Result<String> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let csv_err = |e: csv::Error| Error::InvalidArgument(format!("CSV: {e}"));
-    w.write_record([
-        "force_mN",
-        "displacement_um",
-        "delta_um",
-        "fitted_force_mN",
-        "residual_mN",
-    ])
-    .map_err(csv_err)?;
-    for p in points {
+    csv_text(|w| {
         w.write_record([
-            format!("{:.9}", p.force_n * 1e3),
-            format!("{:.9}", p.displacement_m * 1e6),
-            format!("{:.9}", p.delta_m * 1e6),
-            format!("{:.9}", p.fitted_force_n * 1e3),
-            format!("{:.9}", p.residual_n * 1e3),
-        ])
-        .map_err(csv_err)?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
+            "force_mN",
+            "displacement_um",
+            "delta_um",
+            "fitted_force_mN",
+            "residual_mN",
+        ])?;
+        for p in points {
+            w.write_record([
+                format!("{:.9}", p.force_n * 1e3),
+                format!("{:.9}", p.displacement_m * 1e6),
+                format!("{:.9}", p.delta_m * 1e6),
+                format!("{:.9}", p.fitted_force_n * 1e3),
+                format!("{:.9}", p.residual_n * 1e3),
+            ])?;
+        }
+        Ok(())
+    })
 }
 
 /// The measured points and the Hertz curve of the fit through the origin.

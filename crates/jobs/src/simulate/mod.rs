@@ -22,7 +22,7 @@ use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
 
 use crate::error::{Error, Result};
-use crate::heights::{HeightFacts, HeightInput};
+use crate::heights::{HeightFacts, HeightInput, Roughness};
 use crate::lab::{self, Unit, Q};
 
 /// Which model to run.
@@ -398,9 +398,7 @@ pub fn run(
             detrend: request.heights.detrend().name(),
             channel,
             fill_invalid,
-            h_rms_m: stats.h_rms_m,
-            h_prime_rms: stats.h_prime_rms,
-            h_double_prime_rms_per_m: stats.h_double_prime_rms_per_m,
+            roughness: Roughness::from(&stats),
             sphere_radius_m: request.radius_m,
         },
         contact_modulus_pa: request.e_star_pa,

@@ -16,6 +16,7 @@ use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
 
 use crate::error::{Error, Result};
+use crate::heights::Roughness;
 use crate::lab;
 
 /// Everything `surface` needs. SI units.
@@ -120,17 +121,9 @@ pub struct SurfaceOutcome {
     /// Pixel size, m.
     #[serde(rename = "pixel_size_nm", serialize_with = "lab::m_as_nm")]
     pub pixel_size_m: f64,
-    /// rms height, m.
-    #[serde(rename = "h_rms_nm", serialize_with = "lab::m_as_nm")]
-    pub h_rms_m: f64,
-    /// rms slope (central differences).
-    pub h_prime_rms: f64,
-    /// rms full Laplacian (5-point), 1/m.
-    #[serde(
-        rename = "h_double_prime_rms_per_um",
-        serialize_with = "lab::per_m_as_per_um"
-    )]
-    pub h_double_prime_rms_per_m: f64,
+    /// Roughness (written as `h_rms_nm`, `h_prime_rms`, `h_double_prime_rms_per_um`).
+    #[serde(flatten)]
+    pub roughness: Roughness,
     /// The heights (m, rows = y) and pixel size.
     #[serde(skip)]
     pub topography: Topography,
@@ -145,9 +138,7 @@ pub fn run(request: &SurfaceRequest) -> Result<SurfaceOutcome> {
         nx: topography.nx(),
         ny: topography.ny(),
         pixel_size_m: topography.dx_m,
-        h_rms_m: stats.h_rms_m,
-        h_prime_rms: stats.h_prime_rms,
-        h_double_prime_rms_per_m: stats.h_double_prime_rms_per_m,
+        roughness: Roughness::from(&stats),
         topography,
     })
 }

@@ -12,7 +12,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::error::{Error, Location, Result};
-use crate::heights::{usable, TopographySource};
+use crate::heights::{usable, Roughness, TopographySource};
 use crate::lab;
 use contactscope::surface::masked::masked_stats;
 use contactscope::surface::stats::SurfaceStats;
@@ -150,17 +150,9 @@ pub struct DetrendedFacts {
     /// Pixel size along y, m.
     #[serde(rename = "pixel_size_y_nm", serialize_with = "lab::m_as_nm")]
     pub pixel_size_y_m: f64,
-    /// rms height, m.
-    #[serde(rename = "h_rms_nm", serialize_with = "lab::m_as_nm")]
-    pub h_rms_m: f64,
-    /// rms slope (central differences).
-    pub h_prime_rms: f64,
-    /// rms full Laplacian (5-point), 1/m.
-    #[serde(
-        rename = "h_double_prime_rms_per_um",
-        serialize_with = "lab::per_m_as_per_um"
-    )]
-    pub h_double_prime_rms_per_m: f64,
+    /// Roughness (written as `h_rms_nm`, `h_prime_rms`, `h_double_prime_rms_per_um`).
+    #[serde(flatten)]
+    pub roughness: Roughness,
 }
 
 /// `topography --json`: the map as stored and, when every point is valid, its statistics after
@@ -259,9 +251,7 @@ pub fn run(request: &TopographyRequest) -> Result<TopographyOutcome> {
                         detrend: detrend.name(),
                         pixel_size_x_m: topography.dx_m,
                         pixel_size_y_m: topography.dy_m,
-                        h_rms_m: stats.h_rms_m,
-                        h_prime_rms: stats.h_prime_rms,
-                        h_double_prime_rms_per_m: stats.h_double_prime_rms_per_m,
+                        roughness: Roughness::from(&stats),
                     }),
                     note: None,
                 },
