@@ -68,6 +68,12 @@ def test_otsu_threshold_matches_cli(cli, series_tif):
     # The threshold separates: the brightest pixels are above, the darkest below.
     t = cs.otsu_threshold(s.images)
     assert s.images.min() < t < s.images.max()
+    # The same levels in any integer type numpy may hand over are the same exact threshold.
+    for dtype in (np.int16, np.int32, np.int64, np.uint32):
+        assert cs.otsu_threshold(s.images.astype(dtype)) == t, dtype
+    # Floats holding those levels take the binned float path, and say so.
+    with pytest.warns(cs.ContactscopeWarning, match="floats holding integer values"):
+        cs.otsu_threshold(s.images.astype(np.float64))
 
 
 def test_analyze_matches_cli(cli, series_tif, tmp_path):
