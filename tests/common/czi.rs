@@ -1,8 +1,8 @@
 //! A small CZI writer for tests (documented in `docs/formats.md`): uncompressed Gray16
 //! subblocks with X, Y, C, S (scene), M (mosaic), T and Z coordinates, a
 //! subblock directory and no metadata segment (so no pixel size). Written from the ZISRAW
-//! layout our reader (`src/io/microscopy/czi.rs`) implements; used by `formats_synthetic.rs`
-//! and `formats_series.rs`. Never a copy of a real sample (the real CZI samples are GPL-3.0).
+//! layout our reader (`crates/formats/src/microscopy/czi.rs`) implements; used by `formats/synthetic.rs`
+//! and `series/vendor.rs`. Never a copy of a real sample (the real CZI samples are GPL-3.0).
 
 /// A 32-byte segment header.
 pub fn segment(id: &str, used: usize) -> Vec<u8> {

@@ -1,6 +1,6 @@
 //! `info --json [--stats]` and `topography --json [--channel]` on the real vendor files of
 //! `../shared/data/real-formats` (skipped with a message when absent): the printed JSON carries
-//! the trusted readers' numbers (the same references as `tests/formats_real.rs`: plane statistics
+//! the trusted readers' numbers (the same references as `tests/formats/real.rs`: plane statistics
 //! in `tests/data/real_formats_planes.csv` from the `nd2` Python package, heights from
 //! SurfaceTopography), and broken files give one clean error line naming the file.
 
@@ -68,7 +68,7 @@ fn topography_json_gives_surface_topographys_numbers() {
     assert_eq!(v["channel"], "HeightTrace");
     assert_eq!((v["nx"].as_u64(), v["ny"].as_u64()), (Some(256), Some(256)));
     assert_eq!(v["valid_points"], 65536);
-    // SurfaceTopography 1.x on the same file (tests/formats_real.rs, HEIGHTS), in µm.
+    // SurfaceTopography 1.x on the same file (tests/formats/real.rs, HEIGHTS), in µm.
     let close = |key: &str, trusted: f64| {
         let got = v[key].as_f64().unwrap();
         assert!(

@@ -307,7 +307,7 @@ fn real_afm_copies_read_the_same() {
             "{a}"
         );
     }
-    // The older formats stay with their readers (tests/surface.rs checks their numbers).
+    // The older formats stay with their readers (tests/mechanics/surface.rs checks their numbers).
     for old in ["di-3.di", "top-1.top"] {
         assert_eq!(detect_file(&afm.join(old)).unwrap(), None, "{old}");
     }

@@ -1,6 +1,6 @@
 //! `simulate` and `fit-hardening` on vendor height maps through the built binary (issue 14,
 //! item 2): `--channel NAME` picks a channel, and a map with invalid points is refused unless
-//! `--fill-invalid mean|nearest` (src/io/topography/fill.rs). Real files from
+//! `--fill-invalid mean|nearest` (crates/algorithms/src/surface/fill.rs). Real files from
 //! `../shared/data/real-formats` (skipped with a message when absent).
 
 use std::path::Path;

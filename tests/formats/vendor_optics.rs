@@ -2,7 +2,7 @@
 //! `autocorr`, `psf`, `newton` and `compare` read the planes the selection flags name and give
 //! exactly the results of the same planes exported to TIFF by our own writer. Real samples from
 //! `../shared/data/real-formats` (skipped with a message when absent); small CZI files from the
-//! test writer in `tests/common/czi.rs`. Load series for `analyze`: `tests/formats_series.rs`.
+//! test writer in `tests/common/czi.rs`. Load series for `analyze`: `tests/series/vendor.rs`.
 
 use std::path::Path;
 

@@ -134,7 +134,7 @@ fn non_finite_output(stdout: &str, out: &Path) -> Option<String> {
 }
 
 /// Whether stderr is warnings followed by exactly one `contactscope: error:` line of at most
-/// 500 characters, or clap's one-line usage error (see `src/main.rs`).
+/// 500 characters, or clap's one-line usage error (see `crates/cli/main.rs`).
 fn clean_error(stderr: &str) -> Result<(), String> {
     let lines: Vec<&str> = stderr
         .lines()

@@ -4,7 +4,7 @@
 //! (`io::tiff::encode_u16_stack`) and analysed the same way: thresholds, contact pixels and
 //! areas must agree. Real samples come from `../shared/data/real-formats` (skipped with a message
 //! when absent; never copied into the repository); small CZI files come from the test writer
-//! in `tests/common/czi.rs`. The optics commands: `tests/formats_vendor_optics.rs`.
+//! in `tests/common/czi.rs`. The optics commands: `tests/formats/vendor_optics.rs`.
 
 use std::path::{Path, PathBuf};
 

@@ -1,5 +1,5 @@
 //! The solver's previous algorithms, kept as the slow reference the standard ones are checked
-//! against ([`super::Method::Reference`]; `tests/solver.rs` compares contact and plastic maps of
+//! against ([`super::Method::Reference`]; `tests/mechanics/solver.rs` compares contact and plastic maps of
 //! whole ramps):
 //!
 //! * [`solve_load_pk`] — elastic load control as Polonsky & Keer 1999 (§2) wrote it, restarting
