@@ -355,9 +355,11 @@ pub fn run(request: &FitRequest, progress: Option<ProgressHook>) -> Result<FitOu
         .find(|(_, a)| **a > map_area)
     {
         return Err(Error::InvalidArgument(format!(
-            "measured area {a:e} m² at {} mN is larger than the height map ({map_area:e} m²): \
-             areas in another unit? (1 µm² is 1e-12 m²)",
-            measured.forces_n[i] * 1e3
+            "measured area {:.4e} µm² at {:.4} mN is larger than the whole height map \
+             ({:.1} µm²): areas in another unit? (1 µm² is 1e-12 m²)",
+            a * 1e12,
+            measured.forces_n[i] * 1e3,
+            map_area * 1e12
         )));
     }
     let micrographs = request
