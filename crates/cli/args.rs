@@ -36,7 +36,7 @@ pub trait DefaultOut: Clone + Send + Sync + 'static {
     const PATH: &'static str;
 }
 
-/// `--out`: the output folder, written all or nothing (`io::staging`).
+/// `--out`: the output folder, written all or nothing (`contactscope_jobs::staging`).
 #[derive(clap::Args, Clone, Debug)]
 pub struct OutputFolder<D: DefaultOut> {
     /// Output folder.
@@ -240,7 +240,7 @@ pub fn fraction(text: &str, flag: &str) -> Result<f64> {
 }
 
 /// `--series`, `--channel`, `--z`, `--t`: which plane(s) of a confocal file, shared by every
-/// command that reads micrographs (rules in `io::microscopy::select`).
+/// command that reads micrographs (rules in `contactscope_formats::microscopy::select`).
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct SelectionArgs {
     /// Series of a CZI (scene) or LIF (image) file; needed when the file has several.

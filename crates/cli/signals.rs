@@ -2,7 +2,7 @@
 //! told what was discarded, and the process exits with 128 + the signal number (130, 143), as a
 //! shell reports a process killed by it. Outputs already committed stay; an output folder is
 //! never left half-written, because staged files reach it only by the all-or-nothing commit of
-//! `io::staging`, which a signal waits for.
+//! `contactscope_jobs::staging`, which a signal waits for.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

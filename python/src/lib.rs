@@ -1,5 +1,5 @@
-//! Python bindings of contactscope (issue 13): a thin layer over the library's in-memory
-//! algorithms (layer (a)) and its readers (layer (b)). numpy arrays in and out, SI units
+//! Python bindings of contactscope: a thin layer over the jobs crate (one request → outcome per
+//! command, as the command line uses them) and the in-memory algorithms. numpy arrays in and out, SI units
 //! everywhere (metres, pascals, newtons), the GIL released while Rust computes, and library
 //! errors raised as Python exceptions that subclass `ValueError` (bad input) or `OSError`
 //! (files) and carry the library's message. A panic never reaches Python as a panic: it becomes

@@ -1,5 +1,5 @@
 //! Every sample file of `../shared/data/real-formats` (and the vendor files of
-//! `../shared/data/real-afm`) read by `contactscope::io` gives the dimensions, pixel sizes and
+//! `../shared/data/real-afm`) read by `contactscope_formats` gives the dimensions, pixel sizes and
 //! statistics that trusted Python readers give; truncated and corrupted copies give one clean
 //! error naming the file. Skipped with a message when the shared data are absent.
 //!

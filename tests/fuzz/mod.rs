@@ -1,14 +1,14 @@
-//! Mutation fuzzer over every command (issue 12), on the stable toolchain: each case copies valid
+//! Mutation fuzzer over every command (`docs/errors.md`), on the stable toolchain: each case copies valid
 //! seed inputs (made fresh by `seeds`) into a folder of its own, mutates one of them (bytes, header
 //! numbers, sizes, truncation, lines; `mutate`) and/or the numbers of its option values, runs the
 //! release binary under a time and memory limit (`run`) and classifies the result: a panic, hang,
 //! abort, partial output, overwritten input, left-over work folder or non-finite number in the
 //! output fails the campaign, and so do more than 0.5 % unclean error messages.
 //!
-//! * `cargo test --release --test fuzz` runs the short campaign (600 cases, seed 1; about a minute
+//! * `cargo test --release --test integration fuzz_short` runs the short campaign (600 cases, seed 1; about a minute
 //!   on 2 cores) that CI runs.
 //! * The long run is documented in `docs/errors.md`:
-//!   `FUZZ_CASES=30000 FUZZ_SEED=7 cargo test --release --test fuzz -- --ignored --nocapture`.
+//!   `FUZZ_CASES=30000 FUZZ_SEED=7 cargo test --release --test integration fuzz_long -- --ignored --nocapture`.
 //!
 //! Environment: `FUZZ_CASES`, `FUZZ_SEED`, `FUZZ_JOBS` (parallel cases, default 2),
 //! `FUZZ_TIMEOUT_S` (default 20), `FUZZ_MEMORY_MIB` (address-space limit, default 4096),

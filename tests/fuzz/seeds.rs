@@ -45,7 +45,7 @@ fn text_matrix(dir: &Path) {
     fs::write(dir.join("t.txt"), text).unwrap();
 }
 
-/// A small WSxM `.top` file as `io::topography::wsxm` documents the format: three text lines,
+/// A small WSxM `.top` file as `crates/formats/src/topography/wsxm.rs` documents the format: three text lines,
 /// an INI-like header, `[Header end]`, then int16 little-endian heights.
 fn wsxm(dir: &Path) {
     let (nx, ny) = (24usize, 20usize);
@@ -79,7 +79,7 @@ fn wsxm(dir: &Path) {
     fs::write(dir.join("t.top"), bytes).unwrap();
 }
 
-/// A small Bruker Nanoscope file (`io::topography::nanoscope`): a `\*File list` text header with a
+/// A small Bruker Nanoscope file (`crates/formats/src/topography/nanoscope.rs`): a `\*File list` text header with a
 /// scan list and one height image of int16 data at its data offset.
 fn nanoscope(dir: &Path) {
     let n = 16usize;

@@ -418,7 +418,7 @@ fn vendor_real_files_read_through_the_content_hook() {
         return;
     };
     // IFD 0 of the Park Systems TIFF is an 8-bit palette preview (README); the heights in its
-    // private tags and the .nid are read by contactscope::io::topography, found from the
+    // private tags and the .nid are read by contactscope_formats::topography, found from the
     // content (tests/formats/real.rs checks their numbers).
     let park = read_topography(&dir.join("example_ps.tiff"), None, None).unwrap();
     assert_eq!((park.nx(), park.ny()), (512, 512));

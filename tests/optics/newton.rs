@@ -424,7 +424,7 @@ fn validation_grid_reduced() {
 /// The whole grid: pixels 100, 150, 200, 250 nm × PSF none / 450 nm × d_det 5, 9, 15 nm ×
 /// noise none / shot × 4 centre offsets = 192 cases.
 #[test]
-#[ignore = "full validation grid, about 20 s in release: cargo test --release --test newton -- --ignored"]
+#[ignore = "full validation grid, about 20 s in release: cargo test --release --test integration validation_grid_full -- --ignored"]
 fn validation_grid_full() {
     assert_grid(&grid(
         &[100e-9, 150e-9, 200e-9, 250e-9],

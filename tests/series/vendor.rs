@@ -1,7 +1,7 @@
 //! Load series from CZI, ND2 and LIF files through the built binary (issue 14, items 1–3): the
 //! selection flags (`--series`, `--channel`, `--z`, `--t`), `--load-axis`, and lists of vendor
 //! files. Every analysis is checked against the same planes exported to TIFF by our own writer
-//! (`io::tiff::encode_u16_stack`) and analysed the same way: thresholds, contact pixels and
+//! (`contactscope_formats::tiff::encode_u16_stack`) and analysed the same way: thresholds, contact pixels and
 //! areas must agree. Real samples come from `../shared/data/real-formats` (skipped with a message
 //! when absent; never copied into the repository); small CZI files come from the test writer
 //! in `tests/common/czi.rs`. The optics commands: `tests/formats/vendor_optics.rs`.

@@ -2,7 +2,7 @@
 //! line, blur kernels, resampled grids and sampled profiles. Every reader and every algorithm
 //! whose work size comes from a number it was given checks that number against [`Limits`] first,
 //! with checked arithmetic, and refuses with a message naming the value instead of allocating
-//! terabytes, looping for ever or wrapping a product to zero (issue 12, classes 1–3). The idea is
+//! terabytes, looping for ever or wrapping a product to zero (`docs/errors.md`). The idea is
 //! image-tiff's `Limits` (a decoding budget); these limits are far above any real image or
 //! simulation and far below what would exhaust a workstation.
 

@@ -1,5 +1,5 @@
 //! Plausible ranges of the physical numbers contactscope accepts, from the command line, from
-//! manifests and from file metadata (issue 12, class 4). A value outside its range is almost
+//! manifests and from file metadata (`docs/errors.md`, "Accepted ranges"). A value outside its range is almost
 //! always a typo or a wrong unit (`1e-300nm`, `400N` for 400 mN) or a corrupt header, and would
 //! otherwise make a kernel, a grid or a plot axis absurdly large; it is refused with a message
 //! naming the value, its source and the range. The ranges are wide: they bound what any contact

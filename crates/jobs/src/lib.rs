@@ -36,7 +36,7 @@ pub mod table;
 pub mod analyze;
 pub mod autocorr;
 pub mod compare;
-/// The demo writes an HTML report with figures: it needs the `plots` feature.
+// The demo writes an HTML report with figures: it needs the `plots` feature.
 #[cfg(feature = "plots")]
 pub mod demo;
 pub mod fit_hardening;

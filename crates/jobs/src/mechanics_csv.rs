@@ -40,7 +40,7 @@ use contactscope_formats::ranges::Quantity;
 const FRICTION_COLUMNS: [(&str, f64); 2] = [("friction_mN", 1e-3), ("friction_N", 1.0)];
 const TORQUE_COLUMNS: [(&str, f64); 2] = [("torque_mNm", 1e-3), ("torque_Nm", 1.0)];
 const NORMAL_COLUMNS: [(&str, f64); 2] = [("normal_force_mN", 1e-3), ("normal_force_N", 1.0)];
-/// Largest |force| read, N (the plausible force range of `io::ranges`).
+/// Largest |force| read, N (the plausible force range of `contactscope_formats::ranges`).
 const MAX_FORCE_N: f64 = Quantity::Force.range().1;
 /// Largest |torque| read, N·m.
 const MAX_TORQUE_NM: f64 = 100.0;

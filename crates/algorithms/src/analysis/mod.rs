@@ -7,7 +7,7 @@
 //!
 //! The analysis never opens a file: it asks its source for planes. A slice of in-memory
 //! [`Plane`]s is a source; the file-backed source of a load series
-//! ([`crate::io::series::SeriesPlanes`]) decodes pages on demand, in parallel runs of images of one
+//! (`contactscope_jobs::series::SeriesPlanes`) decodes pages on demand, in parallel runs of images of one
 //! file, and keeps decoded planes of compressed files between the passes up to a memory budget,
 //! so a 500-image series never needs 500 images in memory.
 

@@ -14,7 +14,7 @@
 
 //!
 //! Everything here works on maps and images in memory; the `compare` command's reading of the
-//! micrographs and of a `simulate` folder, and its outputs, are in [`crate::jobs::compare`].
+//! micrographs and of a `simulate` folder, and its outputs, are in `contactscope_jobs::compare`.
 
 use std::path::PathBuf;
 
@@ -53,7 +53,7 @@ pub struct Micrograph {
 }
 
 /// The experiment side, read once: the micrographs, their global Otsu threshold and pixel size
-/// ([`crate::jobs::compare::load_micrographs`] reads them from files).
+/// (`contactscope_jobs::compare::load_micrographs` reads them from files).
 #[derive(Debug, Clone)]
 pub struct Micrographs {
     /// The micrographs in load order.

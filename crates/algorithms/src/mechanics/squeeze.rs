@@ -7,7 +7,7 @@
 //! Eq. 2 with E* instead of E*² under the cube root, which is not dimensionally consistent; the
 //! form used here is Johnson's (see `docs/mechanics.md`).
 //!
-//! # Input CSV ([`crate::io::mechanics::read_squeeze`])
+//! # Input CSV (`contactscope_jobs::mechanics_csv::read_squeeze`)
 //! `force_mN` (or `force_N`) and `displacement_um`, the total plate displacement 2δ measured
 //! from first contact, one row per sample of the loading curve. Rows with P ≤ 0 (before contact)
 //! are ignored; among the rest, force must not decrease and displacement must increase from row

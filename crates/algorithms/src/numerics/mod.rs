@@ -5,7 +5,7 @@
 //! What was taken from crates instead: erfc (`libm`) and the bead fits' Levenberg–Marquardt
 //! (`levenberg-marquardt`). Kept elsewhere, with the measured reason beside the code: the
 //! complete elliptic integrals and the dense solve of the Greenwood–Tripp model
-//! ([`crate::solver::gt`], speed) and `.npy` reading ([`crate::io::topography`], hostile
+//! ([`crate::solver::gt`], speed) and `.npy` reading (`contactscope_formats::topography`, hostile
 //! input).
 
 pub mod golden;

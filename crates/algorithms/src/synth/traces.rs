@@ -1,5 +1,5 @@
 //! Seeded synthetic rheometer friction traces with known static and kinetic friction, and their
-//! CSV text in the input format of [`crate::io::mechanics::read_trace`].
+//! CSV text in the input format of `contactscope_jobs::mechanics_csv::read_trace`.
 
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -152,7 +152,7 @@ pub struct CsvLayout {
     pub normal_force_n: Option<f64>,
 }
 
-/// A synthetic trace as CSV text in the input format of [`crate::io::mechanics::read_trace`].
+/// A synthetic trace as CSV text in the input format of `contactscope_jobs::mechanics_csv::read_trace`.
 pub fn trace_csv(trace: &SyntheticTrace, layout: &CsvLayout) -> String {
     let r = layout.rotation_radius_m;
     let mut text = String::from(layout.x_axis.column());

@@ -1,8 +1,8 @@
 //! Zeiss CZI, read by our own code from the public format description ("ZISRAW (CZI) File
 //! Format Design Specification", Carl Zeiss Microscopy, v1.2; libCZI documentation).
 //!
-//! The `czi` crate (1.0.0, MIT/Apache) was measured first on the five sample files of
-//! `../shared/data/real-formats/czi` and is not used: it averages the three samples of a Bgr24
+//! The `czi` crate (1.0.0, MIT/Apache) was measured first on five real sample CZI files
+//! (`docs/formats.md`) and is not used: it averages the three samples of a Bgr24
 //! pixel into one grey value (RGB-multichannel.czi: 1 403 058 for channel 0 where the blue,
 //! green and red planes sum to 1 407 155, 1 404 252 and 1 409 920), its public API returns only
 //! `u16` (no float or per-sample planes), and it reports four of the eight Airyscan channels as

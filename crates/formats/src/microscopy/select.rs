@@ -1,6 +1,6 @@
 //! Which planes of a confocal file a command uses: the `--series`, `--channel`, `--z` and `--t`
 //! selection shared by every command that reads confocal images, and the load axis
-//! (`--load-axis t|z|series`) along which one file holds a whole load series (issue 14, item 1).
+//! (`--load-axis t|z|series`) along which one file holds a whole load series (`docs/formats.md`).
 //!
 //! Rules ([`Selection::planes`]): an axis of length 1 defaults to 0; an axis longer than 1 must
 //! be selected unless it is the load axis, otherwise the error names the axis, its length and
@@ -10,7 +10,7 @@
 //! (`info` lists them).
 //!
 //! TIFF files keep their own model (every page of the chosen channel is one image, see
-//! [`crate::io::series`]): on a TIFF only `--channel` applies, and a non-zero `--series`, `--z`
+//! `contactscope_jobs::series`): on a TIFF only `--channel` applies, and a non-zero `--series`, `--z`
 //! or `--t` is refused.
 
 use std::collections::BTreeMap;
@@ -288,7 +288,7 @@ pub fn series_pixel_size(format: MicroscopyFormat, info: &SeriesInfo) -> Option<
         MicroscopyFormat::Czi => PixelSizeSource::CziScaling,
         MicroscopyFormat::Nd2 => PixelSizeSource::Nd2Calibration,
         MicroscopyFormat::Lif => PixelSizeSource::LifDimensions,
-        // TIFF files go through `io::tiff`, which knows the finer source.
+        // TIFF files go through `crate::tiff`, which knows the finer source.
         MicroscopyFormat::Tiff => return None,
     };
     Some(PixelSize {

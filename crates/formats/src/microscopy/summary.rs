@@ -1,5 +1,5 @@
 //! The machine-readable summary that `contactscope info FILE --json [--stats]` prints for every
-//! confocal format (issue 14, item 3):
+//! confocal format (`docs/formats.md`, "Summaries"):
 //!
 //! ```json
 //! {"file": "…", "format": "czi", "series": [{"index": 0, "name": "", "axes": {"T": 3, "Z": 5,

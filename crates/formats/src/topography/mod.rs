@@ -39,7 +39,7 @@
 //! | FRT MicroProf `.frt` | [`frt`] | `FRTM_GLIDERV1.0` | `raw·scale` (m) | block 0x67 size / pixels | raw = 1 |
 //!
 //! **Invalid points** are stored as NaN in [`HeightMap::heights`] and counted in
-//! [`HeightMap::invalid_points`]; [`HeightMap::into_topography`] refuses a map with invalid
+//! [`HeightMap::invalid_points`]; [`HeightMap::check_usable`] refuses a map with invalid
 //! points (a contact calculation needs every height), naming the count.
 //!
 //! **Channels**: [`read`] takes an optional channel name. An exact (case-insensitive) match wins,

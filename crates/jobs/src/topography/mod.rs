@@ -1,4 +1,4 @@
-//! The `topography` job: read a height map, summarise it as stored (issue 14 item 3: size, pixel
+//! The `topography` job: read a height map, summarise it as stored (size, pixel
 //! size, valid points, height range, h_rms, rms slope and curvature over the valid points), and
 //! detrend it and compute its roughness statistics (finite-difference estimators,
 //! `docs/conventions.md`, "Roughness statistics"). Every front-end builds a

@@ -3,7 +3,7 @@
 //! F_s = τ·A (Weber et al. 2018, Fig. 3b: τ ≈ 50 MPa; μ is not constant because A grows
 //! sublinearly with N).
 //!
-//! # Trace CSV format ([`crate::io::mechanics::read_trace`])
+//! # Trace CSV format (`contactscope_jobs::mechanics_csv::read_trace`)
 //! One row per sample, in recording order; column names carry the unit and are the contract:
 //!
 //! * **x** (one of, first found wins in this order): `displacement_um`, `angle_rad`, `time_s`.

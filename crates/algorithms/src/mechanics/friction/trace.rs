@@ -1,6 +1,6 @@
 //! A friction trace in memory: x (displacement, plate angle or time) and friction force per
 //! sample, SI units, with the column names its CSV form uses (read by
-//! [`crate::io::mechanics::read_trace`]).
+//! `contactscope_jobs::mechanics_csv::read_trace`).
 
 /// The quantity on a trace's x axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

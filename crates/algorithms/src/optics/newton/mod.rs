@@ -10,7 +10,7 @@
 //! half-way between its plateaus ([`profile::half_level_edge`]); ring orders come from where the
 //! maxima lie, not from counting them ([`rings::assign_orders`]).
 //!
-//! [`analyse`] does the measurement on two images in memory; [`crate::jobs::newton::run_newton`] reads the files and
+//! [`analyse`] does the measurement on two images in memory; `contactscope_jobs::newton` reads the files and
 //! writes `newton.json`, `newton_rings.csv`, `newton_profiles.csv` and `newton_gap.png`.
 
 pub mod gap;

@@ -2,8 +2,8 @@
 //!
 //! The paper numbers the rings outward from the contact, the innermost being m = 0 (Weber et al.
 //! 2018, Methods). Counting maxima fails as soon as one ring is missed or one noise maximum is
-//! taken for a ring: every order beyond it is off by one and the fit fails (the profiles dropped
-//! in issue 14). Long half-lines reach far out, where the fringes are dense and faint, so they
+//! taken for a ring: every order beyond it is off by one and the fit fails (profiles were dropped
+//! that way before). Long half-lines reach far out, where the fringes are dense and faint, so they
 //! failed most. Here the order of a maximum comes from where it lies: outside the contact the
 //! gap is close to a parabola, so r_m² grows almost linearly with m (for a = 20 µm,
 //! R = 290 µm, extrapolating r² linearly from two rings misplaces the next by at most 0.15 of a
