@@ -22,7 +22,7 @@
 //! cargo bench --bench paper -- --grid 512 --method both              # before/after, maps
 //! ```
 //!
-//! Options: `--grid 512|1024|2048`, `--models elastic,hardness,hardening`, `--loads 4,40,400`
+//! Options: `--grid 512|1024|2048`, `--models elastic,hardness,hardening`, `--forces 4,40,400`
 //! (mN), `--method standard|reference|both`, `--tolerance 1e-8`, `--restart 0.01|every`,
 //! `--applies N` (timings of one operator application, default 10). Unknown arguments (cargo's
 //! `--bench`) are ignored.
@@ -73,10 +73,10 @@ fn parse_args() -> Args {
             "--models" => {
                 args.models = value("--models").split(',').map(String::from).collect();
             }
-            "--loads" => {
-                args.loads_mn = value("--loads")
+            "--forces" => {
+                args.loads_mn = value("--forces")
                     .split(',')
-                    .map(|v| v.parse().expect("--loads in mN"))
+                    .map(|v| v.parse().expect("--forces in mN"))
                     .collect();
             }
             "--method" => {

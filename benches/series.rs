@@ -15,7 +15,7 @@
 //!
 //! The data are generated once per run (fixed seed, the CLI's default 2018) into a temporary
 //! folder with the same parameters as `benches/python/run_comparison.sh` uses through
-//! `contactscope synth-series --size 1024 --loads <40 forces>`; set `CONTACTSCOPE_BENCH_DIR` to
+//! `contactscope synth-series --size 1024 --forces <40 forces>`; set `CONTACTSCOPE_BENCH_DIR` to
 //! keep them in a folder of your choice instead. Run with `cargo bench --bench series`; see
 //! `docs/performance.md`.
 

@@ -50,7 +50,7 @@ machine | tee "$RES/machine.txt"
 
 # ---- data -----------------------------------------------------------------------------------
 gen() { # layout out size forces
-    [[ -e $2/manifest.csv ]] || "$CS" synth-series --size "$3" --loads "$4" --layout "$1" --out "$2" >/dev/null
+    [[ -e $2/manifest.csv ]] || "$CS" synth-series --size "$3" --forces "$4" --layout "$1" --out "$2" >/dev/null
 }
 echo "generating data under $ROOT …"
 gen files "$ROOT/cmp/files_raw" 1024 "$F40"

@@ -12,22 +12,27 @@ use contactscope_jobs::analyze::files::{run_to_folder, ImageOutputs};
 use contactscope_jobs::analyze::{AnalyzeOutcome, AnalyzeRequest, AreaUnit, HertzParams};
 use contactscope_jobs::series::{Micrographs, SeriesSpec, DEFAULT_MEMORY_BUDGET};
 
-use super::args::{default_out, LoadAxisArg, OutputFolder, PixelSizeArg, Quiet, SelectionArgs};
+use super::args::{
+    default_out, frame_forces, Forces, LoadAxisArg, OutputFolder, PixelSizeArg, Quiet,
+    SelectionArgs,
+};
 use super::common::{command_line, progress_bar};
 
-default_out!(Out, "contactscope-out");
+default_out!(Out, "contactscope-out/analyze");
 
 #[derive(clap::Args)]
 pub struct Args {
     /// TIFF, CZI, ND2 or LIF files, or directories of them (natural sort order). Not with
     /// --manifest.
     inputs: Vec<PathBuf>,
-    /// CSV with columns file, [page], force_mN, [friction_mN]; paths relative to the CSV.
+    /// Manifest CSV with columns file, [page], force_mN (or force_N), [friction_mN]; paths
+    /// relative to the CSV. A folder holding manifest.csv (also as the only input) is read as it.
     #[arg(long, conflicts_with_all = ["inputs", "forces"])]
     manifest: Option<PathBuf>,
-    /// Normal forces, one per image, with a unit: 4,10,20,40mN.
-    #[arg(long)]
-    forces: Option<String>,
+    /// Normal forces, one per image: 4,10,20,40mN, 0,4,10mN (0: a reference frame, left out of
+    /// the fits) or 1mN..100mN:12 (log-spaced). Without forces: per-image areas, no fits.
+    #[arg(long, value_parser = frame_forces)]
+    forces: Option<Forces>,
     #[command(flatten)]
     select: SelectionArgs,
     /// Axis of a CZI, ND2 or LIF file whose planes are the loads, in order.
@@ -63,13 +68,7 @@ fn micrographs(args: &Args) -> Result<Micrographs> {
     if args.manifest.is_none() && args.inputs.is_empty() {
         bail!("give image files or directories, or --manifest");
     }
-    let forces_n = match &args.forces {
-        Some(text) => Some(
-            units::parse_quantity_list(text, Dimension::Force)
-                .with_context(|| format!("--forces {text}"))?,
-        ),
-        None => None,
-    };
+    let forces_n = args.forces.as_ref().map(|f| f.0.clone());
     Ok(Micrographs::Files(SeriesSpec {
         inputs: args.inputs.clone(),
         manifest: args.manifest.clone(),
@@ -148,7 +147,7 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
         AreaUnit::Pixel => "px",
     };
     println!(
-        "{:>10} {:>12} {:>8} {:>10}",
+        "{:>10} {:>12} {:>8} {:>10}  image",
         "force_mN",
         format!("area_{unit}"),
         "patches",
@@ -159,7 +158,13 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
         let p = row
             .mean_pressure_mpa
             .map_or("-".into(), |p| format!("{p:.1}"));
-        println!("{f:>10} {:>12.2} {:>8} {p:>10}", row.area, row.patches);
+        let name = Path::new(&row.image)
+            .file_name()
+            .map_or(row.image.clone(), |n| n.to_string_lossy().into_owned());
+        println!(
+            "{f:>10} {:>12.2} {:>8} {p:>10}  {name} p{}",
+            row.area, row.patches, row.page
+        );
     }
     if let Some(fit) = outcome.fits.power_law {
         let se = fit

@@ -30,6 +30,21 @@ impl PixelSizeArg {
     }
 }
 
+/// Normal forces as every command takes them (`--forces`), N: a list `4,10,40mN` or a
+/// log-spaced range `4mN..400mN:12` (`contactscope_formats::units`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Forces(pub Vec<f64>);
+
+/// Forces of micrographs: a 0 in a list is a reference frame (analysed, left out of fits).
+pub fn frame_forces(text: &str) -> std::result::Result<Forces, contactscope_formats::Error> {
+    units::parse_forces(text).map(Forces)
+}
+
+/// Forces of simulated loads and predictions: every value positive.
+pub fn load_forces(text: &str) -> std::result::Result<Forces, contactscope_formats::Error> {
+    units::parse_loads(text).map(Forces)
+}
+
 /// The default output folder of one command.
 pub trait DefaultOut: Clone + Send + Sync + 'static {
     /// Folder used without `--out`.

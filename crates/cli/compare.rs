@@ -10,7 +10,10 @@ use contactscope_jobs::compare::{CompareRequest, Simulation};
 use contactscope_jobs::results::fwhm_from_psf_json;
 use contactscope_jobs::series::{Micrographs, SeriesSpec};
 
-use super::args::{default_out, fraction, LoadAxisArg, OutputFolder, PixelSizeArg, SelectionArgs};
+use super::args::{
+    default_out, fraction, frame_forces, Forces, LoadAxisArg, OutputFolder, PixelSizeArg,
+    SelectionArgs,
+};
 use super::common::{command_line, print_warnings, print_written};
 
 default_out!(Out, "contactscope-out/compare");
@@ -20,11 +23,12 @@ default_out!(Out, "contactscope-out/compare");
 pub struct Args {
     /// The micrographs: a manifest CSV (file, page, force_mN), a folder holding manifest.csv,
     /// or TIFF/CZI/ND2/LIF files or folders together with --forces.
-    #[arg(long, required = true, num_args = 1..)]
-    experiment: Vec<PathBuf>,
-    /// Normal force per micrograph when --experiment names image files (e.g. 4mN,8mN or 4mN..40mN:8).
-    #[arg(long)]
-    forces: Option<String>,
+    #[arg(long, alias = "experiment", required = true, num_args = 1..)]
+    micrographs: Vec<PathBuf>,
+    /// Normal force per micrograph when --micrographs names image files (e.g. 0,4,8mN or
+    /// 4mN..40mN:8; 0 is a reference frame, left out).
+    #[arg(long, value_parser = frame_forces)]
+    forces: Option<Forces>,
     /// Output folder of `contactscope simulate`.
     #[arg(long)]
     simulation: PathBuf,
@@ -55,7 +59,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let single = (args.experiment.len() == 1).then(|| &args.experiment[0]);
+    let single = (args.micrographs.len() == 1).then(|| &args.micrographs[0]);
     let is_manifest = single.is_some_and(|p| {
         p.is_dir() && p.join("manifest.csv").is_file()
             || p.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"))
@@ -64,21 +68,21 @@ pub fn run(args: Args) -> Result<()> {
     let load_axis = args.load_axis.map(LoadAxisArg::axis);
     let spec = match (&args.forces, is_manifest) {
         (None, true) => SeriesSpec {
-            manifest: Some(args.experiment[0].clone()),
+            manifest: Some(args.micrographs[0].clone()),
             selection,
             load_axis,
             ..SeriesSpec::default()
         },
         (Some(_), true) => bail!("--forces goes with TIFF inputs, not with a manifest"),
         (Some(forces), false) => SeriesSpec {
-            inputs: args.experiment.clone(),
+            inputs: args.micrographs.clone(),
             selection,
             load_axis,
-            forces_n: Some(units::parse_loads(forces).context("--forces")?),
+            forces_n: Some(forces.0.clone()),
             ..SeriesSpec::default()
         },
         (None, false) => {
-            bail!("--experiment: give a manifest (or a folder with manifest.csv), or TIFFs with --forces")
+            bail!("--micrographs: give a manifest (or a folder with manifest.csv), or TIFFs with --forces")
         }
     };
     let psf_fwhm_m = match (&args.psf, &args.psf_fwhm) {

@@ -12,6 +12,7 @@ use contactscope_jobs::fit_hardening::{
     BodyRequest, FitRequest, MeasuredInput, Sweep, SweepMicrographs,
 };
 use contactscope_jobs::heights::HeightInput;
+use contactscope_jobs::results::fwhm_from_psf_json;
 use contactscope_jobs::series::{Micrographs, SeriesSpec};
 
 use super::args::{default_out, optional_pixel_size, BodyArgs, OutputFolder, SolverArgs};
@@ -24,9 +25,9 @@ default_out!(Out, "contactscope-out/fit");
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// areas.csv of `contactscope analyze` (force_mN, area_um2).
-    #[arg(long)]
-    experiment: PathBuf,
+    /// Measured areas: areas.csv of `contactscope analyze` (force_mN or force_N, area_um2).
+    #[arg(long, alias = "experiment")]
+    areas: PathBuf,
     #[command(flatten)]
     body: BodyArgs,
     /// Models to fit or score, comma-separated.
@@ -44,7 +45,11 @@ pub struct Args {
     /// Micrographs for Dice in the sweep: a manifest CSV or a folder with manifest.csv.
     #[arg(long)]
     micrographs: Option<PathBuf>,
-    /// PSF FWHM for Dice in the sweep (e.g. 450nm).
+    /// psf.json written by `contactscope psf` (uses fwhm_nm_mean), for Dice in the sweep and
+    /// --imaged-areas.
+    #[arg(long, conflicts_with = "psf_fwhm")]
+    psf: Option<PathBuf>,
+    /// PSF full width at half maximum (e.g. 450nm), instead of --psf.
     #[arg(long)]
     psf_fwhm: Option<String>,
     /// Micrograph pixel size (e.g. 200nm): overrides the micrographs' metadata, and sets the
@@ -112,29 +117,37 @@ fn sweep_micrographs(args: &Args) -> Result<Option<SweepMicrographs>> {
     let Some(path) = &args.micrographs else {
         return Ok(None);
     };
-    let fwhm = args
-        .psf_fwhm
-        .as_deref()
-        .context("--micrographs needs --psf-fwhm")?;
+    let fwhm_m = psf_fwhm_m(args)?.context("--micrographs needs --psf or --psf-fwhm")?;
     Ok(Some(SweepMicrographs {
         micrographs: Micrographs::Files(SeriesSpec {
             manifest: Some(path.clone()),
             ..SeriesSpec::default()
         }),
         pixel_size_m: optional_pixel_size(&args.micrograph_pixel_size, "--micrograph-pixel-size")?,
-        psf_fwhm_m: units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+        psf_fwhm_m: fwhm_m,
     }))
+}
+
+/// The PSF's FWHM, m, from --psf (psf.json) or --psf-fwhm.
+fn psf_fwhm_m(args: &Args) -> Result<Option<f64>> {
+    Ok(match (&args.psf, &args.psf_fwhm) {
+        (Some(json), _) => Some(fwhm_from_psf_json(json)?),
+        (None, Some(text)) => {
+            Some(units::parse_positive(text, Dimension::Length).context("--psf-fwhm")?)
+        }
+        (None, None) => None,
+    })
 }
 
 fn imaging(args: &Args) -> Result<Option<Imaging>> {
     if !args.imaged_areas {
         return Ok(None);
     }
-    let (Some(fwhm), Some(pixel)) = (&args.psf_fwhm, &args.micrograph_pixel_size) else {
-        bail!("--imaged-areas needs --psf-fwhm and --micrograph-pixel-size");
+    let (Some(fwhm_m), Some(pixel)) = (psf_fwhm_m(args)?, &args.micrograph_pixel_size) else {
+        bail!("--imaged-areas needs --psf (or --psf-fwhm) and --micrograph-pixel-size");
     };
     Ok(Some(Imaging {
-        fwhm_m: units::parse_positive(fwhm, Dimension::Length).context("--psf-fwhm")?,
+        fwhm_m,
         pixel_m: units::parse_pixel_size(pixel).context("--micrograph-pixel-size")?,
     }))
 }
@@ -162,7 +175,7 @@ pub fn run(args: Args) -> Result<()> {
         sweep,
         micrographs: sweep_micrographs(&args)?,
         ..FitRequest::new(
-            MeasuredInput::File(args.experiment.clone()),
+            MeasuredInput::File(args.areas.clone()),
             BodyRequest {
                 radius_m: body.radius_m,
                 periodic: args.periodic,

@@ -2,13 +2,13 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 
 use contactscope_formats::units::{self, Dimension};
 use contactscope_jobs::friction::files::run_to_folder;
 use contactscope_jobs::friction::FrictionRequest;
 
-use super::args::{default_out, fraction, OutputFolder};
+use super::args::{default_out, fraction, load_forces, Forces, OutputFolder};
 use super::common::{command_line, print_warnings, print_written};
 
 default_out!(Out, "contactscope-out/friction");
@@ -19,9 +19,9 @@ pub struct Args {
     /// torque_Nm, optional normal_force_mN | normal_force_N.
     #[arg(required = true)]
     traces: Vec<PathBuf>,
-    /// Normal force for traces without a normal-force column (e.g. 40mN).
-    #[arg(long)]
-    normal_force: Option<String>,
+    /// Normal force for traces without a normal-force column (one value, e.g. 40mN).
+    #[arg(long, alias = "normal-force", value_parser = load_forces)]
+    forces: Option<Forces>,
     /// Rotation radius of the sphere on the rheometer plate, turns torque into force (e.g. 5mm).
     #[arg(long)]
     rotation_radius: Option<String>,
@@ -43,7 +43,15 @@ pub fn run(args: Args) -> Result<()> {
             .with_context(|| flag.to_string())
     };
     let request = FrictionRequest {
-        normal_force_n: quantity(&args.normal_force, "--normal-force", Dimension::Force)?,
+        normal_force_n: match args.forces.as_ref().map(|f| f.0.as_slice()) {
+            None => None,
+            Some([one]) => Some(*one),
+            Some(many) => bail!(
+                "--forces: give one normal force for the traces without a normal-force column \
+                 (got {})",
+                many.len()
+            ),
+        },
         rotation_radius_m: quantity(
             &args.rotation_radius,
             "--rotation-radius",

@@ -8,7 +8,7 @@ use contactscope_formats::units::{self, Dimension};
 use contactscope_jobs::hertz::files::run_to_folder;
 use contactscope_jobs::hertz::HertzRequest;
 
-use super::args::{default_out, OutputFolder};
+use super::args::{default_out, load_forces, Forces, OutputFolder};
 use super::common::{command_line, print_written};
 
 default_out!(Out, "contactscope-out/hertz");
@@ -20,9 +20,10 @@ pub struct Args {
     /// Sphere radius (e.g. 290um).
     #[arg(long)]
     radius: String,
-    /// Loads at which to predict the Hertz contact radius (default: the measured forces).
-    #[arg(long)]
-    loads: Option<String>,
+    /// Normal forces at which to predict the Hertz contact radius: 4,40mN or 4mN..400mN:12
+    /// (default: the measured forces).
+    #[arg(long, alias = "loads", value_parser = load_forces)]
+    forces: Option<Forces>,
     #[command(flatten)]
     out: OutputFolder<Out>,
 }
@@ -30,12 +31,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let radius_m = units::parse_positive(&args.radius, Dimension::Length).context("--radius")?;
     let request = HertzRequest {
-        loads_n: args
-            .loads
-            .as_deref()
-            .map(units::parse_loads)
-            .transpose()
-            .context("--loads")?,
+        loads_n: args.forces.as_ref().map(|f| f.0.clone()),
         ..HertzRequest::new(args.input.clone(), radius_m)
     };
     let (outcome, written) = run_to_folder(&request, &args.out.out, &command_line())?;

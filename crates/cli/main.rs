@@ -22,6 +22,8 @@ mod surface;
 mod synth_series;
 mod threshold;
 mod topography;
+#[cfg(test)]
+mod vocabulary;
 
 use std::process::ExitCode;
 
@@ -44,34 +46,77 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Analyse a load series: one global Otsu threshold, contact area per image, fits, plots.
+    #[command(
+        after_help = "Examples:\n  contactscope analyze series.tif --forces 4,10,20,40mN --out results\n  contactscope analyze ramp.czi --load-axis t --forces 1mN..100mN:8 --overlays\n  contactscope analyze my-experiment/   (a folder holding manifest.csv: file,page,force_mN)"
+    )]
     Analyze(analyze::Args),
     /// Print the global Otsu threshold of all pages of all inputs.
+    #[command(
+        after_help = "Examples:\n  contactscope threshold series.tif\n  contactscope threshold ramp.czi --channel 0"
+    )]
     Threshold(threshold::Args),
-    /// Describe a TIFF file: pages, shape, sample type, compression, channels, pixel size.
+    /// Describe a micrograph file (TIFF, CZI, ND2, LIF): series, axes, channels, sample type, pixel size.
+    #[command(
+        after_help = "Examples:\n  contactscope info ramp.czi\n  contactscope info series.tif"
+    )]
     Info(info::Args),
     /// Generate a synthetic load series with known ground truth (seeded).
+    #[command(
+        after_help = "Examples:\n  contactscope synth-series --out synthetic --forces 4mN..100mN:8\n  contactscope analyze synthetic"
+    )]
     SynthSeries(synth_series::Args),
-    /// Analyse the bundled synthetic load series and compare with its ground truth.
+    /// The whole method on a generated paper-regime experiment, with an HTML report.
+    #[command(after_help = "Examples:\n  contactscope demo\n  contactscope demo --out report")]
     Demo(demo::Args),
     /// Simulate contact of a rough topography under a load sweep (elastic, hardness, hardening, gt).
+    #[command(
+        after_help = "Examples:\n  contactscope simulate --topography sphere.npy --pixel-size 32nm --height-unit 1nm --modulus 3.7GPa --model hardening --hardening 4MPa/nm --forces 4mN..400mN:12 --out sim\n  contactscope simulate --topography scan.gwy --radius 290um --modulus 3.7GPa --model elastic --forces 4,40,400mN"
+    )]
     Simulate(simulate::Args),
     /// Generate a self-affine random surface (Fourier filtering, seeded).
+    #[command(
+        after_help = "Examples:\n  contactscope surface --size 1024 --pixel-size 32nm --rms-slope 0.2 --rolloff 8um --out rough.npy"
+    )]
     Surface(surface::Args),
     /// Print a topography's size, pixel size and roughness statistics.
+    #[command(
+        after_help = "Examples:\n  contactscope topography scan.gwy\n  contactscope topography rough.npy --pixel-size 32nm --height-unit 1nm"
+    )]
     Topography(topography::Args),
     /// Radially averaged intensity autocorrelation of images (several go on one plot).
+    #[command(
+        after_help = "Examples:\n  contactscope autocorr contact_4mN.tif contact_40mN.tif --out acf"
+    )]
     Autocorr(autocorr::Args),
     /// Compare simulated contact maps with micrographs load by load (blur, register, score).
+    #[command(
+        after_help = "Examples:\n  contactscope compare --micrographs results/ --simulation sim --psf psf/psf.json --out cmp\n  contactscope compare --micrographs series.tif --forces 4,40,400mN --simulation sim --psf-fwhm 450nm"
+    )]
     Compare(compare::Args),
     /// Fit the hardening coefficient k (and p_Y, and score elastic and GT) to a measured area–load curve.
+    #[command(
+        after_help = "Examples:\n  contactscope fit-hardening --areas results/areas.csv --topography sphere.npy --pixel-size 32nm --height-unit 1nm --modulus 3.7GPa\n  contactscope fit-hardening --areas areas.csv --topography scan.gwy --radius 290um --modulus 3.7GPa --models hardening --psf psf.json --imaged-areas --micrograph-pixel-size 200nm"
+    )]
     FitHardening(fit_hardening::Args),
     /// Detection gap from Newton rings in a reflection image and the fluorescent contact.
+    #[command(
+        after_help = "Examples:\n  contactscope newton reflection.tif --contact fluorescence.tif --wavelength 488nm"
+    )]
     Newton(newton::Args),
     /// Measure the microscope PSF on a bead image or z stack (radial Gaussian fits, FWHM).
+    #[command(
+        after_help = "Examples:\n  contactscope psf beads.tif --bead-diameter 100nm --out psf"
+    )]
     Psf(psf::Args),
     /// Static and kinetic friction from rheometer traces; τ of F = τ·A with measured areas.
+    #[command(
+        after_help = "Examples:\n  contactscope friction trace_4mN.csv trace_40mN.csv --areas results/areas.csv\n  contactscope friction torque.csv --rotation-radius 5mm --forces 40mN"
+    )]
     Friction(friction::Args),
     /// Contact modulus E* from a squeeze test of one sphere between two plates (Hertz).
+    #[command(
+        after_help = "Examples:\n  contactscope hertz squeeze.csv --radius 290um --forces 4mN..400mN:12"
+    )]
     Hertz(hertz::Args),
 }
 

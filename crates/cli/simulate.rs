@@ -10,7 +10,7 @@ use contactscope_jobs::heights::HeightInput;
 use contactscope_jobs::simulate::files::run_to_folder;
 use contactscope_jobs::simulate::{ModelChoice, SimulateRequest};
 
-use super::args::{default_out, BodyArgs, OutputFolder, Quiet, SolverArgs};
+use super::args::{default_out, load_forces, BodyArgs, Forces, OutputFolder, Quiet, SolverArgs};
 use super::common::{command_line, print_warnings, print_written, progress_bar};
 
 default_out!(Out, "contactscope-out/simulate");
@@ -49,9 +49,9 @@ pub struct Args {
     /// Periodic boundaries (nominally flat periodic surfaces); free otherwise.
     #[arg(long)]
     periodic: bool,
-    /// Loads: 4mN,10mN,40mN or 4mN..400mN:12 (log-spaced).
-    #[arg(long)]
-    loads: String,
+    /// Normal forces of the ramp: 4,10,40mN or 4mN..400mN:12 (log-spaced).
+    #[arg(long, alias = "loads", value_parser = load_forces)]
+    forces: Forces,
     #[command(flatten)]
     solver: SolverArgs,
     #[command(flatten)]
@@ -113,7 +113,7 @@ pub fn run(args: Args) -> Result<()> {
         HeightInput::File(body.topography),
         body.e_star_pa,
         model_of(&args)?,
-        units::parse_loads(&args.loads).context("--loads")?,
+        args.forces.0.clone(),
     );
     request.radius_m = body.radius_m;
     request.periodic = args.periodic;

@@ -5,9 +5,10 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::ValueEnum;
 
+use super::args::{load_forces, Forces};
 use contactscope::synth::SynthParams;
 use contactscope_formats::tiff::Compression;
-use contactscope_formats::units::{self, Dimension};
+use contactscope_formats::units;
 use contactscope_jobs::synth_series::{run_to_folder, Layout, SynthSeriesRequest};
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -36,9 +37,9 @@ pub struct Args {
     /// Image size in pixels (square).
     #[arg(long, default_value_t = 256)]
     size: usize,
-    /// Normal forces with a unit.
-    #[arg(long, default_value = "4,6,10,16,25,40,63,100mN")]
-    loads: String,
+    /// Normal forces, one per image: 4,10,40mN or 4mN..100mN:8 (log-spaced).
+    #[arg(long, alias = "loads", value_parser = load_forces, default_value = "4,6,10,16,25,40,63,100mN")]
+    forces: Forces,
     /// Random seed.
     #[arg(long, default_value_t = 2018)]
     seed: u64,
@@ -61,8 +62,7 @@ pub fn run(args: Args) -> Result<()> {
             width: args.size,
             height: args.size,
             pixel_size_m: pixel,
-            forces_n: units::parse_quantity_list(&args.loads, Dimension::Force)
-                .context("--loads")?,
+            forces_n: args.forces.0.clone(),
             seed: args.seed,
             ..defaults.params
         },

@@ -50,7 +50,7 @@ def bench_overhead(size, repeat, tmp):
     loads = ",".join(f"{f * 1e6:g}" for f in LOADS) + "uN"
     cli_args = [str(BIN), "simulate", "--topography", str(npy), "--pixel-size", "100nm",
                 "--detrend", "none", "--radius", "20um", "--modulus", "1GPa",
-                "--model", "hardening", "--hardening", "4MPa/nm", "--loads", loads, "-q"]
+                "--model", "hardening", "--hardening", "4MPa/nm", "--forces", loads, "-q"]
 
     def cli():
         out = tmp / f"sim-{time.monotonic_ns()}"

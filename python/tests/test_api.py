@@ -300,7 +300,7 @@ def test_simulate_matches_cli(cli, surface_npy, tmp_path):
     out = tmp_path / "sim"
     cli("simulate", "--topography", surface_npy, "--pixel-size", "100nm", "--radius", "20um",
         "--modulus", "1GPa", "--model", "hardening", "--hardening", "4MPa/nm",
-        "--loads", "20,40,80uN", "--out", out, "-q")
+        "--forces", "20,40,80uN", "--out", out, "-q")
     rows = read_csv(out / "areas.csv")
     h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
     r = cs.simulate(h, 100e-9, 1e9, [20e-6, 40e-6, 80e-6], "hardening", k=4e15, radius=20e-6)
@@ -344,8 +344,8 @@ def test_compare_matches_cli(cli, series_tif, tmp_path):
         "--out", topo)
     cli("simulate", "--topography", topo, "--pixel-size", "200nm", "--radius", "290um",
         "--modulus", "2GPa", "--model", "hardening", "--hardening", "4MPa/nm",
-        "--loads", "2,4,8mN", "--out", sim, "-q")
-    cli("compare", "--experiment", path, "--forces", "2,4,8mN", "--simulation", sim,
+        "--forces", "2,4,8mN", "--out", sim, "-q")
+    cli("compare", "--micrographs", path, "--forces", "2,4,8mN", "--simulation", sim,
         "--psf-fwhm", "450nm", "--out", tmp_path / "cmp")
     theirs = read_csv(tmp_path / "cmp" / "compare.csv")
     maps = np.stack([cs.read_image(sim / f"load_{i:03}_contact.tif").images[0]
@@ -365,8 +365,8 @@ def test_fit_hardening_matches_cli(cli, surface_npy, tmp_path):
     out = tmp_path / "sim"
     cli("simulate", "--topography", surface_npy, "--pixel-size", "100nm", "--radius", "20um",
         "--modulus", "1GPa", "--model", "hardening", "--hardening", "4MPa/nm",
-        "--loads", "20,40,80uN", "--out", out, "-q")
-    cli("fit-hardening", "--experiment", out / "areas.csv", "--topography", surface_npy,
+        "--forces", "20,40,80uN", "--out", out, "-q")
+    cli("fit-hardening", "--areas", out / "areas.csv", "--topography", surface_npy,
         "--pixel-size", "100nm", "--radius", "20um", "--modulus", "1GPa",
         "--models", "hardening", "--out", tmp_path / "fit", "-q")
     theirs = json.loads((tmp_path / "fit" / "fit.json").read_text())["models"][0]

@@ -44,7 +44,7 @@ NAMED_DIFFERENTLY = {
     ("fit-hardening", "--psf-fwhm"): "Python's fit_hardening calls it imaging_fwhm",
     ("fit-hardening", "--hardening"): "the command line fits k over --k-range",
     ("fit-hardening", "--forces"): "the command line reads the measured forces from "
-                                   "--experiment (areas.csv); Python also takes numbers",
+                                   "--areas (areas.csv); Python also takes numbers",
 }
 
 
@@ -72,13 +72,13 @@ def inputs(tmp_path_factory):
     np.save(d / "h.npy", cs.surface(64, 64, 1e-7, rms_height=5e-8, seed=3))
     sim = d / "sim"
     done = run("simulate", "--topography", d / "h.npy", "--pixel-size", "100nm", "--radius",
-               "20um", "--modulus", "1GPa", "--model", "elastic", "--loads", "20uN,40uN",
+               "20um", "--modulus", "1GPa", "--model", "elastic", "--forces", "20uN,40uN",
                "--out", sim, "-q")
     assert done.returncode == 0, done.stderr
     # Maps at the micrographs' forces, for compare (the contact outgrows the small map: only
     # a warning).
     done = run("simulate", "--topography", d / "h.npy", "--pixel-size", "200nm", "--radius",
-               "290um", "--modulus", "3.7GPa", "--model", "elastic", "--loads", "2,4,8mN",
+               "290um", "--modulus", "3.7GPa", "--model", "elastic", "--forces", "2,4,8mN",
                "--out", d / "sim3", "-q")
     assert done.returncode == 0, done.stderr
     beads = cs.synth_beads(seed=5)
@@ -104,20 +104,20 @@ def bases(i):
         "simulate": [
             (["simulate", "--topography", d / "h.npy", "--pixel-size", "100nm", "--radius",
               "20um", "--modulus", "1GPa", "--model", "hardening", "--hardening", "4MPa/nm",
-              "--initial-hardness", "1MPa", "--height-unit", "1m", "--loads", "20uN", "--out",
+              "--initial-hardness", "1MPa", "--height-unit", "1m", "--forces", "20uN", "--out",
               out],
              ([d / "h.npy", 1e-7, 1e9, [2e-5], "hardening"],
               dict(k=4e15, initial_hardness=1e6, radius=2e-5, height_unit=1.0))),
             (["simulate", "--topography", d / "h.npy", "--pixel-size", "100nm", "--modulus",
-              "1GPa", "--model", "hardness", "--hardness", "370MPa", "--loads", "20uN", "--out",
+              "1GPa", "--model", "hardness", "--hardness", "370MPa", "--forces", "20uN", "--out",
               out],
              ([d / "h.npy", 1e-7, 1e9, [2e-5], "hardness"], dict(hardness=3.7e8))),
         ],
-        "compare": [(["compare", "--experiment", d / "series.tif", "--forces", "2,4,8mN",
+        "compare": [(["compare", "--micrographs", d / "series.tif", "--forces", "2,4,8mN",
                       "--simulation", d / "sim3", "--psf-fwhm", "450nm", "--pixel-size",
                       "200nm", "--out", out],
                      ([i["images"], i["forces"], 2e-7, d / "sim3", None, None, 450e-9], {}))],
-        "fit-hardening": [(["fit-hardening", "--experiment", d / "sim" / "areas.csv",
+        "fit-hardening": [(["fit-hardening", "--areas", d / "sim" / "areas.csv",
                             "--topography", d / "h.npy", "--pixel-size", "100nm", "--radius",
                             "20um", "--modulus", "1GPa", "--height-unit", "1m", "--models",
                             "elastic", "--out", out],
@@ -135,9 +135,9 @@ def bases(i):
                          "1m"], ([d / "h.npy"], dict(pixel_size=1e-7, height_unit=1.0)))],
         "surface": [(["surface", "--size", "32", "--pixel-size", "100nm", "--rms-height", "50nm",
                       "--out", d / "s.npy"], ([32, 32, 1e-7], dict(rms_height=5e-8)))],
-        "friction": [(["friction", d / "trace.csv", "--normal-force", "40mN", "--out", out],
+        "friction": [(["friction", d / "trace.csv", "--forces", "40mN", "--out", out],
                       ([[d / "trace.csv"]], dict(normal_force=40e-3)))],
-        "hertz": [(["hertz", d / "squeeze.csv", "--radius", "290um", "--loads", "4mN", "--out",
+        "hertz": [(["hertz", d / "squeeze.csv", "--radius", "290um", "--forces", "4mN", "--out",
                     out], ([d / "squeeze.csv", 2.9e-4], dict(loads=[4e-3])))],
     }
 
@@ -164,6 +164,11 @@ def test_every_physical_parameter_is_checked_by_both_front_ends(inputs):
         python_keywords = keywords(FUNCTIONS[command])
         for p in PARAMS:
             flag, keyword = p["flag"], p["keyword"]
+            # One flag may stand for parameters Python names apart (`--forces`: forces=,
+            # loads=, normal_force=): the command's Python function has one of them.
+            same_flag = [q["keyword"] for q in PARAMS if q["flag"] == flag]
+            if keyword not in python_keywords and any(k in python_keywords for k in same_flag):
+                continue
             on_cli, in_python = flag in cli_flags, keyword in python_keywords
             if (command, flag) in NAMED_DIFFERENTLY:
                 continue
@@ -224,7 +229,7 @@ def test_warnings_reach_both_front_ends(inputs):
     assert any("beyond any solid contact" in w for w in r.warnings)
     # A contact reaching the border of the map: not a valid free-boundary result.
     done = run("simulate", "--topography", d / "h.npy", "--pixel-size", "100nm", "--modulus",
-               "1GPa", "--model", "elastic", "--loads", "2mN", "--out", d / "w2", "-q")
+               "1GPa", "--model", "elastic", "--forces", "2mN", "--out", d / "w2", "-q")
     assert done.returncode == 0 and "border of the map" in done.stderr
     with pytest.warns(cs.ContactscopeWarning, match="border of the map"):
         cs.simulate(d / "h.npy", 1e-7, 1e9, [2e-3], maps=False)

@@ -57,14 +57,14 @@ def friction_inputs(tmp_path):
 def test_friction_matches_cli(cli, friction_inputs, tmp_path):
     traces, areas = friction_inputs
     out = tmp_path / "fr"
-    cli("friction", *traces, "--normal-force", "40mN", "--areas", areas, "--out", out)
+    cli("friction", *traces, "--forces", "40mN", "--areas", areas, "--out", out)
     theirs = json.loads((out / "summary.json").read_text())
     # normal_force applies to the last trace; the others' columns differ from it: warned, in
     # the terms of each front-end.
     with pytest.warns(cs.ContactscopeWarning, match="differs from normal_force="):
         mine = cs.friction(traces, normal_force=40e-3, areas=areas)
     assert len(mine.warnings) == len(theirs["warnings"]) == 3
-    assert [w.replace("normal_force=", "--normal-force") for w in mine.warnings] \
+    assert [w.replace("normal_force=", "--forces") for w in mine.warnings] \
         == theirs["warnings"]
     # The same keys, in SI units.
     assert set(mine) == {"inputs", "method", "tau_pa", "tau_se_pa", "r2", "static_shear_fit",
@@ -134,7 +134,7 @@ def squeeze_csv(path):
 def test_hertz_matches_cli(cli, tmp_path):
     squeeze = squeeze_csv(tmp_path / "squeeze.csv")
     out = tmp_path / "hz"
-    cli("hertz", squeeze, "--radius", "290um", "--loads", "4mN,40mN", "--out", out)
+    cli("hertz", squeeze, "--radius", "290um", "--forces", "4mN,40mN", "--out", out)
     theirs = json.loads((out / "hertz.json").read_text())
     mine = cs.hertz(squeeze, RADIUS, loads=[4e-3, 40e-3])
     assert mine.contact_modulus_pa == pytest.approx(E_STAR, rel=1e-9)
@@ -253,7 +253,7 @@ def test_surface_defaults_and_stats_match_cli(cli, tmp_path):
 
 def test_synth_series_matches_cli(cli, tmp_path):
     out = tmp_path / "s1"
-    printed = cli("synth-series", "--out", out, "--size", 96, "--loads", "2,4mN", "--seed", 3)
+    printed = cli("synth-series", "--out", out, "--size", 96, "--forces", "2,4mN", "--seed", 3)
     assert printed.split() == [str(out / n) for n in ("series.tif", "manifest.csv",
                                                       "truth.csv")]
     mine = cs.synth_series(96, 96, forces=[2e-3, 4e-3], seed=3)

@@ -27,7 +27,7 @@ fn interrupt(dir: &Path, surface: &Path, signal: &str) -> (Option<i32>, String) 
             "hardening",
             "--hardening",
             "4MPa/nm",
-            "--loads",
+            "--forces",
             "4mN..400mN:200",
             "--out",
             out.to_str().unwrap(),

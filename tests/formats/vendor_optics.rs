@@ -255,7 +255,7 @@ fn compare_reads_a_czi_load_series_as_its_tiff_export() {
         "290um",
         "--modulus",
         "3.7GPa",
-        "--loads",
+        "--forces",
         "0.5mN,1mN",
         "--model",
         "elastic",
@@ -302,7 +302,7 @@ fn compare_reads_a_czi_load_series_as_its_tiff_export() {
         let out = tmp.path().join(out);
         let mut args = vec![
             "compare",
-            "--experiment",
+            "--micrographs",
             s(experiment),
             "--forces",
             "0.5,1mN",

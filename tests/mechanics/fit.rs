@@ -39,7 +39,7 @@ fn truth(dir: &Path) -> (PathBuf, PathBuf) {
         "50um",
         "--modulus",
         "3.7GPa",
-        "--loads",
+        "--forces",
         LOADS,
         "--model",
         "hardening",
@@ -57,7 +57,7 @@ fn truth(dir: &Path) -> (PathBuf, PathBuf) {
 fn fit(topo: &Path, experiment: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
     let mut args = vec![
         "fit-hardening",
-        "--experiment",
+        "--areas",
         s(experiment),
         "--topography",
         s(topo),

@@ -383,7 +383,7 @@ fn mismatched_forces_list_both_sides() {
 fn friction_command_writes_its_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let (traces, areas) = load_series(dir.path());
-    // One trace without a normal-force column takes --normal-force.
+    // One trace without a normal-force column takes --forces.
     let t = synthetic_trace(&params(TAU_PA * area_m2(40.0), 99));
     let bare = write(
         dir.path(),
@@ -395,7 +395,7 @@ fn friction_command_writes_its_outputs() {
     args.extend(traces.iter().map(|p| s(p)));
     args.extend([
         s(&bare),
-        "--normal-force",
+        "--forces",
         "40mN",
         "--areas",
         s(&areas),
@@ -579,7 +579,7 @@ fn hertz_command_writes_its_outputs() {
         s(&input),
         "--radius",
         "290um",
-        "--loads",
+        "--forces",
         "4mN,40mN",
         "--out",
         s(&out),

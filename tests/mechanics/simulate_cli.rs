@@ -66,7 +66,7 @@ fn surface_topography_and_elastic_simulation() {
         "3.7GPa",
         "--model",
         "elastic",
-        "--loads",
+        "--forces",
         "0.002mN..0.01mN:3",
         "--out",
         s(&out),
@@ -134,7 +134,7 @@ fn plastic_models_from_the_command_line() {
             "290um",
             "--modulus",
             "3.7GPa",
-            "--loads",
+            "--forces",
             "0.002mN,0.005mN",
             "--out",
             s(&out),
@@ -199,7 +199,7 @@ fn bad_simulation_inputs_fail_cleanly() {
         assert!(!stderr(&o).contains("panicked"));
         assert!(!out.exists(), "no output on failure");
     };
-    let base = ["--modulus", "3.7GPa", "--loads", "0.002mN"];
+    let base = ["--modulus", "3.7GPa", "--forces", "0.002mN"];
     let with = |extra: &[&str]| -> Vec<String> {
         let mut v: Vec<String> = vec![
             "--topography".into(),
@@ -232,7 +232,7 @@ fn bad_simulation_inputs_fail_cleanly() {
             "elastic",
             "--modulus",
             "3.7GPa",
-            "--loads",
+            "--forces",
             "1mN",
         ],
         "positive",
@@ -255,7 +255,7 @@ fn bad_simulation_inputs_fail_cleanly() {
             "elastic",
             "--modulus",
             "3.7GPa",
-            "--loads",
+            "--forces",
             "1mN",
         ],
         "nan.txt",
@@ -269,7 +269,7 @@ fn bad_simulation_inputs_fail_cleanly() {
             "elastic",
             "--modulus",
             "3.7GPa",
-            "--loads",
+            "--forces",
             "1mN",
         ],
         "rough.npy",
@@ -283,7 +283,7 @@ fn bad_simulation_inputs_fail_cleanly() {
         "plastic",
         "--modulus",
         "3.7GPa",
-        "--loads",
+        "--forces",
         "1mN",
     ]);
     assert_eq!(o.status.code(), Some(2));
@@ -298,7 +298,7 @@ fn bad_simulation_inputs_fail_cleanly() {
             "elastic",
             "--modulus",
             "3.7GPa",
-            "--loads",
+            "--forces",
             "1mN",
         ],
         "map.xyz",

@@ -39,7 +39,7 @@ fn simulation(dir: &Path) -> PathBuf {
         "290um",
         "--modulus",
         "3.7GPa",
-        "--loads",
+        "--forces",
         "0.5mN,1mN,2mN",
         "--model",
         "elastic",
@@ -96,7 +96,7 @@ fn micrographs(dir: &Path, sim: &Path, transform: Dihedral) -> PathBuf {
 fn compare(exp: &Path, sim: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
     let mut args = vec![
         "compare",
-        "--experiment",
+        "--micrographs",
         s(exp),
         "--simulation",
         s(sim),

@@ -89,8 +89,8 @@ params! {
     FillInvalid: "--fill-invalid", "fill_invalid", "the filling of invalid points";
     /// Normal forces, one per image.
     Forces: "--forces", "forces", "the forces";
-    /// Loads of a simulated ramp.
-    Loads: "--loads", "loads", "the loads";
+    /// Normal forces of a simulated ramp (Python's `loads=`).
+    Loads: "--forces", "loads", "the loads";
     /// Manifest CSV of a series.
     Manifest: "--manifest", "manifest", "the manifest";
     /// Threshold method or value.
@@ -115,8 +115,8 @@ params! {
     MaxIterations: "--max-iterations", "max_iterations", "the iteration limit";
     /// Height map of a simulation.
     Topography: "--topography", "heights", "the height map";
-    /// Measured experiment (micrographs or areas).
-    Experiment: "--experiment", "micrographs", "the experiment";
+    /// Micrographs of a measured load series.
+    Experiment: "--micrographs", "micrographs", "the micrographs";
     /// Folder of simulated maps.
     Simulation: "--simulation", "maps", "the simulated maps";
     /// PSF measured by `psf` (psf.json).
@@ -138,7 +138,7 @@ params! {
     /// Largest autocorrelation lag.
     MaxLag: "--max-lag", "max_lag", "the largest lag";
     /// Normal force of friction traces.
-    NormalForce: "--normal-force", "normal_force", "the normal force";
+    NormalForce: "--forces", "normal_force", "the normal force";
     /// Rotation radius of a rheometer.
     RotationRadius: "--rotation-radius", "rotation_radius", "the rotation radius";
     /// Measured areas (areas.csv).
@@ -157,6 +157,8 @@ params! {
     Cutoff: "--cutoff", "cutoff", "the short-wavelength cutoff";
     /// Saturation level of the detector (`psf`).
     SaturationLevel: "--saturation-level", "saturation_level", "the saturation level";
+    /// Size in pixels of a generated map or series (Python: its `nx`, `ny` or `width`, `height`).
+    Size: "--size", "", "the size in pixels";
     /// Phase of the Newton-ring maxima.
     Phase: "--phase", "phase", "the phase of the ring maxima";
 }
@@ -222,11 +224,28 @@ mod tests {
 
     #[test]
     fn names_are_unique_per_front_end() {
-        let mut flags: Vec<_> = Param::ALL.iter().map(|p| p.flag()).collect();
+        // One flag per quantity on the command line: the normal forces are `--forces` in every
+        // command, though Python names them `forces=`, `loads=` or `normal_force=`.
+        let same_quantity = [Param::Forces, Param::Loads, Param::NormalForce];
+        let mut flags: Vec<_> = Param::ALL
+            .iter()
+            .filter(|p| !same_quantity[1..].contains(p))
+            .map(|p| p.flag())
+            .collect();
         flags.sort_unstable();
         let n = flags.len();
         flags.dedup();
         assert_eq!(flags.len(), n);
         assert!(Param::ALL.iter().all(|p| p.flag().starts_with("--")));
+        assert!(same_quantity.iter().all(|p| p.flag() == "--forces"));
+        let mut keywords: Vec<_> = Param::ALL
+            .iter()
+            .map(|p| p.keyword())
+            .filter(|k| !k.is_empty())
+            .collect();
+        keywords.sort_unstable();
+        let n = keywords.len();
+        keywords.dedup();
+        assert_eq!(keywords.len(), n);
     }
 }

@@ -150,6 +150,10 @@ pub fn parse_positive(text: &str, dim: Dimension) -> Result<f64> {
 /// the unit of the next item that has one, so a single trailing unit serves the whole list; a list
 /// with no unit at all is rejected.
 pub fn parse_quantity_list(text: &str, dim: Dimension) -> Result<Vec<f64>> {
+    quantity_list(text, dim, false)
+}
+
+fn quantity_list(text: &str, dim: Dimension, zero_allowed: bool) -> Result<Vec<f64>> {
     let items: Vec<&str> = text.split(',').map(str::trim).collect();
     if items.iter().any(|s| s.is_empty()) {
         return Err(Error::InvalidArgument(format!(
@@ -173,7 +177,7 @@ pub fn parse_quantity_list(text: &str, dim: Dimension) -> Result<Vec<f64>> {
         };
         pending_unit = Some(factor);
         values[i] = scale(value, factor);
-        if dim == Dimension::Force {
+        if dim == Dimension::Force && !(zero_allowed && values[i] == 0.0) {
             Quantity::Force.check_text(values[i], &format!("'{item}'"))?;
         }
     }
@@ -198,37 +202,51 @@ fn range_count(count: &str, text: &str) -> Result<usize> {
 }
 
 /// Parse loads: a list (`4,10,40mN`) or a log-spaced range `4mN..400mN:12` (12 values from 4 to
-/// 400 mN, equal ratios). Returns newtons; every value must be positive.
+/// 400 mN, equal ratios). Returns newtons; every value must be positive (a simulated load of
+/// 0 N has no contact to compute).
 pub fn parse_loads(text: &str) -> Result<Vec<f64>> {
+    force_values(text, false)
+}
+
+/// Parse the forces of micrographs: the syntax of [`parse_loads`], and a list may hold `0`
+/// (a reference frame recorded before loading, analysed and left out of fits and log axes).
+pub fn parse_forces(text: &str) -> Result<Vec<f64>> {
+    force_values(text, true)
+}
+
+fn force_values(text: &str, zero_allowed: bool) -> Result<Vec<f64>> {
     let values = match text.split_once("..") {
         Some((from, rest)) => {
             let (to, count) = rest.split_once(':').ok_or_else(|| {
                 Error::InvalidArgument(format!(
-                    "load range '{text}' needs a count: e.g. 4mN..400mN:12"
+                    "force range '{text}' needs a count: e.g. 4mN..400mN:12"
                 ))
             })?;
             let (a, b) = (
-                parse_quantity(from, Dimension::Force)?,
+                parse_quantity(&with_unit_of(from, to), Dimension::Force)?,
                 parse_quantity(to, Dimension::Force)?,
             );
             let n = range_count(count, text)?;
             if !(a > 0.0 && b > a) {
                 return Err(Error::InvalidArgument(format!(
-                    "load range '{text}' needs 0 < start < end and at least 2 values"
+                    "force range '{text}' needs 0 < start < end (log-spaced values)"
                 )));
             }
             (0..n)
                 .map(|i| a * (b / a).powf(i as f64 / (n - 1) as f64))
                 .collect()
         }
-        None => parse_quantity_list(text, Dimension::Force)?,
+        None => quantity_list(text, Dimension::Force, zero_allowed)?,
     };
-    if let Some(bad) = values.iter().find(|v| **v <= 0.0) {
-        return Err(Error::InvalidArgument(format!(
-            "load {bad} N must be positive"
-        )));
-    }
     for &v in &values {
+        if v == 0.0 && zero_allowed {
+            continue;
+        }
+        if v <= 0.0 {
+            return Err(Error::InvalidArgument(format!(
+                "force {v} N in '{text}' must be positive"
+            )));
+        }
         Quantity::Force.check_text(v, &format!("'{text}'"))?;
     }
     Ok(values)
@@ -410,6 +428,13 @@ mod tests {
         assert!(e.contains("2 to 10000"), "{e}");
         assert!(parse_value_list("1..10MPa/nm:100000", &|t| Ok(t.len() as f64)).is_err());
         assert!(parse_loads("0mN,1mN").is_err());
+        // Micrograph forces: the same syntax, and a 0 mN reference frame.
+        assert_eq!(parse_forces("0,4,10mN").unwrap(), [0.0, 4e-3, 10e-3]);
+        let f = parse_forces("1..100mN:3").unwrap();
+        assert_relative_eq!(f[1], 0.01, max_relative = 1e-12);
+        assert!(parse_forces("0mN..100mN:3").is_err(), "log-spaced from 0");
+        assert!(parse_forces("-1,4mN").is_err());
+        assert!(parse_forces("4,400000mN").is_err(), "400 N is out of range");
         assert_relative_eq!(
             parse_ratio("4MPa/nm", Dimension::Pressure, Dimension::Length).unwrap(),
             4e15,

@@ -11,7 +11,7 @@
 //!   `torque_mNm`, `torque_Nm`. Torque T becomes force F = T / r with the sphere's rotation
 //!   radius r (`rotation_radius_m`), as in the paper's Methods; torque without r is an error.
 //! * **normal force** (optional): `normal_force_mN` or `normal_force_N`; its median is the
-//!   trace's N. Without it the caller's N (`--normal-force`) is used; neither is an error.
+//!   trace's N. Without it the caller's N (`--forces`) is used; neither is an error.
 //!
 //! Values beyond plausible bounds (forces ±100 N, torques ±100 N·m, displacements ±1 m, angles
 //! ±10⁶ rad, times ±10⁹ s) are refused with their line: they are unit mistakes or corruption,

@@ -14,32 +14,40 @@ use contactscope::optics::blur::Grid;
 use contactscope_formats::ranges::Quantity;
 use contactscope_formats::tiff::read_image;
 
-/// (force N, area m²) rows of an `analyze` areas.csv (columns `force_mN`, `area_um2`); a table
-/// in pixels is refused with a hint, as is one without rows.
+/// (force N, area m²) rows of an `analyze` areas.csv (columns `force_mN` or `force_N`, and
+/// `area_um2`); a table in pixels is refused with a hint, as is one without rows. Rows at 0 N
+/// (reference frames recorded before loading) are left out.
 pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
     let table = Table::read(path)?;
-    for column in ["force_mN", "area_um2"] {
-        if !table.header().iter().any(|h| h == column) {
-            let hint = if column == "area_um2" && table.header().iter().any(|h| h == "area_px") {
-                format!(
-                    " (areas are in pixels: run analyze with {})",
-                    contactscope_formats::param::Param::PixelSize
-                )
-            } else {
-                String::new()
-            };
-            return Err(Error::bad_input(
-                table.location(),
-                format!("no {column} column{hint}; columns found: {}", table.found()),
-            ));
-        }
+    let force_column = table
+        .one_of(&["force_mN", "force_N"])?
+        .ok_or_else(|| table.missing("force", &["force_mN", "force_N"]))?;
+    if !table.header().iter().any(|h| h == "area_um2") {
+        let hint = if table.header().iter().any(|h| h == "area_px") {
+            format!(
+                " (areas are in pixels: run analyze with {})",
+                contactscope_formats::param::Param::PixelSize
+            )
+        } else {
+            String::new()
+        };
+        return Err(Error::bad_input(
+            table.location(),
+            format!("no area_um2 column{hint}; columns found: {}", table.found()),
+        ));
     }
-    let forces = table.numbers("force_mN", 1e-3)?;
+    let unit = if force_column == "force_mN" {
+        1e-3
+    } else {
+        1.0
+    };
+    let forces = table.numbers(force_column, unit)?;
     let areas = table.numbers("area_um2", 1e-12)?;
-    if forces.is_empty() {
-        return Err(Error::bad_input(table.location(), "no rows"));
-    }
+    let mut rows = Vec::new();
     for (k, (&force, &area)) in forces.iter().zip(&areas).enumerate() {
+        if force == 0.0 {
+            continue;
+        }
         let at = Location::file(format!("{}:{}", path.display(), table.line(k)));
         Quantity::Force.check_at(force, &at)?;
         // A load without contact gives an infinite stress (friction) and no size to fit.
@@ -53,8 +61,15 @@ pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
                 ),
             ));
         }
+        rows.push((force, area));
     }
-    Ok(forces.into_iter().zip(areas).collect())
+    if rows.is_empty() {
+        return Err(Error::bad_input(
+            table.location(),
+            "no rows with a positive force",
+        ));
+    }
+    Ok(rows)
 }
 
 /// The loads of a `simulate` output folder: `areas.csv` rows and `load_NNN_contact.tif`.

@@ -1,12 +1,15 @@
-//! Writing results without ever leaving a partial output behind.
+//! Writing results without ever leaving a partial output behind, and without mixing two runs.
 //!
 //! Every file of one run is first written into a staging folder next to the output folder; only
-//! when the whole run has succeeded are the files renamed into place. The commit is all or
-//! nothing: every target is checked before the first rename (a directory or other non-file in
-//! the way, or an input of the run, refuses the commit with nothing moved), a file it replaces
-//! is first moved aside, and if a rename still fails the files already moved are taken back and
-//! the replaced ones restored. If the run fails, the staging folder is removed and the output
-//! folder is untouched. Targets that are input files of the run are refused, so an input is
+//! when the whole run has succeeded does the staging folder become the output folder. A run
+//! replaces its output folder as a whole: nothing of an earlier run survives beside the new
+//! files (overlays of other images, maps of other loads). To keep that from ever deleting a
+//! person's own files, the folder is replaced only when it is new, empty, or was written by an
+//! earlier run — recorded in the [`MARKER`] file each run leaves in its folder, which lists the
+//! files it wrote — and holds nothing else. Any other folder, or one that holds an input of the
+//! run, is refused with nothing written. The replacement is two renames (the old folder aside,
+//! the staging folder into place; the old folder is restored if the second fails). If the run
+//! fails, the staging folder is removed and the output folder is untouched. An input file is
 //! never overwritten.
 //!
 //! Staging folders alive in the process are registered, so that a signal handler
@@ -72,74 +75,114 @@ impl Staging {
         Ok(target)
     }
 
-    /// Move every staged file into the output folder: all of them, or none (module docs).
+    /// Make the staged files the output folder, replacing an earlier run's folder as a whole
+    /// (module docs): all of them, or nothing.
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {
-        fs::create_dir_all(&self.out_dir).map_err(|e| output_error(&self.out_dir, e))?;
-        let names = std::mem::take(&mut *self.files.lock().expect("lock"));
-        // Every target first: nothing is moved unless every one can take its file.
-        for name in &names {
-            let target = self.out_dir.join(name);
-            match fs::symlink_metadata(&target) {
-                Ok(meta) if !meta.is_file() => {
-                    return Err(Error::Output {
-                        path: target,
-                        reason: "is in the way (not a regular file); nothing was written".into(),
-                    });
-                }
-                Ok(_) => {
-                    if is_input(&target, &self.protected) {
-                        return Err(input_refusal(target));
-                    }
-                }
-                Err(_) => {}
-            }
-        }
+        let mut names = std::mem::take(&mut *self.files.lock().expect("lock"));
+        names.sort();
+        names.dedup();
+        let marker = serde_json::json!({
+            "written_by": format!("contactscope {}", env!("CARGO_PKG_VERSION")),
+            "files": names,
+        });
+        let marker = serde_json::to_vec_pretty(&marker).expect("a list of names serialises");
+        let marker_path = self.staging_dir.join(MARKER);
+        fs::write(&marker_path, marker).map_err(|e| output_error(&marker_path, e))?;
+        let replaced = self.check_replaceable()?;
         // A signal handler ([`discard_unfinished`]) waits until the renames are done.
         let mut unfinished = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
-        let aside = self.staging_dir.join(".replaced");
-        let mut moved: Vec<(PathBuf, PathBuf, Option<PathBuf>)> = Vec::new();
-        for name in &names {
-            let (staged, target) = (self.staging_dir.join(name), self.out_dir.join(name));
-            let step = || -> std::io::Result<Option<PathBuf>> {
-                let replaced = if target.exists() {
-                    fs::create_dir_all(&aside)?;
-                    let old = aside.join(name);
-                    fs::rename(&target, &old)?;
-                    Some(old)
-                } else {
-                    None
-                };
-                if let Err(e) = fs::rename(&staged, &target) {
-                    if let Some(old) = &replaced {
-                        let _ = fs::rename(old, &target);
-                    }
-                    return Err(e);
-                }
-                Ok(replaced)
-            };
-            match step() {
-                Ok(replaced) => moved.push((staged, target, replaced)),
-                Err(e) => {
-                    // Take back what was moved, newest first, and restore what it replaced.
-                    for (staged, target, replaced) in moved.iter().rev() {
-                        let _ = fs::rename(target, staged);
-                        if let Some(old) = replaced {
-                            let _ = fs::rename(old, target);
-                        }
-                    }
-                    return Err(Error::Output {
-                        path: target,
-                        reason: format!("{e}; nothing was written"),
-                    });
-                }
+        let aside = replaced.then(|| {
+            let name = self
+                .out_dir
+                .file_name()
+                .map_or("out".into(), |n| n.to_string_lossy().into_owned());
+            self.staging_dir
+                .with_file_name(format!(".{name}.replaced-{}", std::process::id()))
+        });
+        if let Some(aside) = &aside {
+            let _ = fs::remove_dir_all(aside);
+            fs::rename(&self.out_dir, aside).map_err(|e| Error::Output {
+                path: self.out_dir.clone(),
+                reason: format!("{e}; nothing was written"),
+            })?;
+        }
+        if let Err(e) = fs::rename(&self.staging_dir, &self.out_dir) {
+            if let Some(aside) = &aside {
+                let _ = fs::rename(aside, &self.out_dir);
             }
+            return Err(Error::Output {
+                path: self.out_dir.clone(),
+                reason: format!("{e}; nothing was written"),
+            });
         }
         self.committed = true;
         unfinished.retain(|d| d != &self.staging_dir);
         drop(unfinished);
-        let _ = fs::remove_dir_all(&self.staging_dir);
-        Ok(moved.into_iter().map(|(_, target, _)| target).collect())
+        if let Some(aside) = &aside {
+            let _ = fs::remove_dir_all(aside);
+        }
+        Ok(names.iter().map(|n| self.out_dir.join(n)).collect())
     }
+
+    /// Whether the output folder exists and may be replaced (true), does not exist (false), or
+    /// must not be touched (an error naming what is in the way).
+    fn check_replaceable(&self) -> Result<bool> {
+        let refuse = |reason: String| Error::Output {
+            path: self.out_dir.clone(),
+            reason: format!(
+                "{reason}; nothing was written (choose another {} or remove it)",
+                contactscope_formats::param::Param::Out
+            ),
+        };
+        match fs::symlink_metadata(&self.out_dir) {
+            Err(_) => return Ok(false),
+            Ok(meta) if !meta.is_dir() => {
+                return Err(refuse("is in the way (not a folder)".into()));
+            }
+            Ok(_) => {}
+        }
+        let entries: Vec<(String, PathBuf)> = fs::read_dir(&self.out_dir)
+            .map_err(|e| output_error(&self.out_dir, e))?
+            .filter_map(|e| e.ok())
+            .map(|e| (e.file_name().to_string_lossy().into_owned(), e.path()))
+            .collect();
+        if entries.is_empty() {
+            return Ok(true);
+        }
+        let earlier = earlier_run_files(&self.out_dir).ok_or_else(|| {
+            refuse(format!(
+                "is not empty and was not written by contactscope (no {MARKER})"
+            ))
+        })?;
+        for (name, path) in &entries {
+            if is_input(path, &self.protected) {
+                return Err(input_refusal(path.clone()));
+            }
+            let is_file = fs::symlink_metadata(path).is_ok_and(|m| m.is_file());
+            if name != MARKER && !(is_file && earlier.contains(name)) {
+                return Err(refuse(format!(
+                    "holds '{name}', which no earlier contactscope run wrote there"
+                )));
+            }
+        }
+        Ok(true)
+    }
+}
+
+/// The file a run leaves in its output folder: JSON with the names of the files it wrote, so
+/// that the next run into the folder knows it may replace them (module docs).
+pub const MARKER: &str = ".contactscope-run.json";
+
+/// The files an earlier run recorded in `dir`'s [`MARKER`], if it has a readable one.
+fn earlier_run_files(dir: &Path) -> Option<Vec<String>> {
+    let text = fs::read(dir.join(MARKER)).ok()?;
+    let value: serde_json::Value = serde_json::from_slice(&text).ok()?;
+    value
+        .get("files")?
+        .as_array()?
+        .iter()
+        .map(|v| v.as_str().map(String::from))
+        .collect()
 }
 
 pub use contactscope_formats::inputs::note_input;
@@ -292,43 +335,79 @@ mod tests {
     }
 
     #[test]
-    fn a_directory_in_the_way_refuses_the_whole_commit() {
+    fn staged_files_appear_only_on_commit_and_are_listed() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("results");
-        fs::create_dir_all(out.join("summary.json")).unwrap();
-        fs::write(out.join("areas.csv"), b"old").unwrap();
+        let staging = Staging::new(&out, &[]).unwrap();
+        staging.write("a.csv", b"x").unwrap();
+        let written = staging.commit().unwrap();
+        assert_eq!(written, [out.join("a.csv")]);
+        assert_eq!(earlier_run_files(&out).unwrap(), ["a.csv"]);
+    }
+
+    #[test]
+    fn a_rerun_replaces_the_earlier_folder_as_a_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("results");
+        let first = Staging::new(&out, &[]).unwrap();
+        first.write("areas.csv", b"old").unwrap();
+        first.write("overlay_001_a.png", b"old").unwrap();
+        first.commit().unwrap();
+        let second = Staging::new(&out, &[]).unwrap();
+        second.write("areas.csv", b"new").unwrap();
+        second.write("overlay_001_b.png", b"new").unwrap();
+        second.commit().unwrap();
+        let mut names: Vec<String> = fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(names, [MARKER, "areas.csv", "overlay_001_b.png"]);
+        assert_eq!(fs::read(out.join("areas.csv")).unwrap(), b"new");
+        assert_eq!(
+            fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "nothing aside"
+        );
+    }
+
+    #[test]
+    fn a_folder_with_files_no_run_wrote_is_refused_untouched() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("results");
+        // A folder of the person's own files, without a marker.
+        fs::create_dir_all(&out).unwrap();
+        fs::write(out.join("notes.txt"), b"mine").unwrap();
         let staging = Staging::new(&out, &[]).unwrap();
         staging.write("areas.csv", b"new").unwrap();
-        staging.write("summary.json", b"{}").unwrap();
         let err = staging.commit().unwrap_err().to_string();
-        assert!(
-            err.contains("summary.json") && err.contains("nothing was written"),
-            "{err}"
-        );
+        assert!(err.contains("not written by contactscope"), "{err}");
+        assert!(err.contains("nothing was written"), "{err}");
+        // An earlier run's folder to which the person added a file.
+        let staging = Staging::new(&out, &[]).unwrap();
+        fs::write(out.join(MARKER), br#"{"files": ["areas.csv"]}"#).unwrap();
+        fs::write(out.join("areas.csv"), b"old").unwrap();
+        staging.write("areas.csv", b"new").unwrap();
+        let err = staging.commit().unwrap_err().to_string();
+        assert!(err.contains("'notes.txt'"), "{err}");
+        assert_eq!(fs::read(out.join("notes.txt")).unwrap(), b"mine");
         assert_eq!(fs::read(out.join("areas.csv")).unwrap(), b"old");
         let left: Vec<_> = fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(left.len(), 1, "only the output folder, no staging folder");
     }
 
     #[test]
-    fn a_failed_rename_takes_back_what_was_moved() {
+    fn a_folder_holding_an_input_is_never_replaced() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("results");
         fs::create_dir_all(&out).unwrap();
-        fs::write(out.join("a.csv"), b"old").unwrap();
-        let staging = Staging::new(&out, &[]).unwrap();
-        staging.write("a.csv", b"new").unwrap();
-        staging.write("b.csv", b"new").unwrap();
-        // The second rename fails after the first has happened.
-        fs::remove_file(staging.staging_dir.join("b.csv")).unwrap();
-        assert!(staging.commit().is_err());
-        assert_eq!(fs::read(out.join("a.csv")).unwrap(), b"old", "restored");
-        assert!(!out.join("b.csv").exists());
-        assert_eq!(fs::read_dir(&out).unwrap().count(), 1);
-        assert_eq!(
-            fs::read_dir(dir.path()).unwrap().count(),
-            1,
-            "staging removed"
-        );
+        let input = out.join("series.tif");
+        fs::write(&input, b"data").unwrap();
+        fs::write(out.join(MARKER), br#"{"files": ["series.tif"]}"#).unwrap();
+        let staging = Staging::new(&out, std::slice::from_ref(&input)).unwrap();
+        staging.write("areas.csv", b"new").unwrap();
+        let err = staging.commit().unwrap_err().to_string();
+        assert!(err.contains("input file"), "{err}");
+        assert_eq!(fs::read(&input).unwrap(), b"data");
     }
 }

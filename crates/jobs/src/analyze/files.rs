@@ -1,6 +1,8 @@
 //! The outputs of `analyze` as the command line writes them, through a staging folder (nothing
 //! appears unless everything succeeded): `areas.csv` (the outcome's rows), `summary.json` (the
-//! rest of the outcome), `area_vs_load.png/.svg` (feature `plots`) and, on request, one overlay
+//! rest of the outcome), `area_vs_load.png/.svg` (feature `plots`; only when an image has a
+//! positive force and contact area: 0 mN frames and images without contact are not on log axes)
+//! and, on request, one overlay
 //! PNG and one mask TIFF per image, written as the images are measured.
 
 use std::path::{Path, PathBuf};
@@ -53,7 +55,7 @@ pub fn run_to_folder(
     let outcome = run_open(request, &open, progress, sink)?;
     staging.write("areas.csv", &areas_csv(&outcome)?)?;
     #[cfg(feature = "plots")]
-    {
+    if has_log_points(&outcome) {
         let plot = area_plot(&outcome, "Contact area versus normal force");
         staging.write("area_vs_load.png", &plot.to_png()?)?;
         staging.write("area_vs_load.svg", plot.to_svg()?.as_bytes())?;
@@ -64,6 +66,16 @@ pub fn run_to_folder(
     )?;
     let written = staging.commit()?;
     Ok((outcome, written))
+}
+
+/// Whether any image has a positive force and contact area: a point on the log–log plot
+/// (without one, `analyze` writes no plot and says why in a warning).
+pub fn has_log_points(outcome: &AnalyzeOutcome) -> bool {
+    outcome
+        .rows
+        .rows
+        .iter()
+        .any(|r| r.force_mn.is_some_and(|f| f > 0.0) && r.area > 0.0)
 }
 
 /// `areas.csv`: one row per image, every column named with its unit.
@@ -145,8 +157,9 @@ pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
         .rows
         .iter()
         .filter_map(|r| r.force_mn.map(|f| (f, r.area)))
+        .filter(|(f, a)| *f > 0.0 && *a > 0.0)
         .collect();
-    let forces: Vec<f64> = measured.iter().map(|p| p.0).filter(|f| *f > 0.0).collect();
+    let forces: Vec<f64> = measured.iter().map(|p| p.0).collect();
     let (lo, hi) = forces
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &f| {

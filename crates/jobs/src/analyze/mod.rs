@@ -139,6 +139,20 @@ pub fn run_open(
             ));
         }
     }
+    if rows.rows.iter().all(|r| r.force_mn.is_none()) {
+        warnings.push(format!(
+            "no forces: areas, intensities and patches per image, but no area–load fits or plot \
+             (give {} or {})",
+            Param::Forces,
+            Param::Manifest
+        ));
+    }
+    if rows.rows.iter().all(|r| r.contact_pixels == 0) {
+        warnings.push(format!(
+            "no image has contact pixels at the threshold ({}): areas are 0, no fits or plot",
+            Param::Threshold
+        ));
+    }
     analysis.warnings = warnings.clone();
     Ok(AnalyzeOutcome {
         inputs: InputFacts::of(series, &analysis),

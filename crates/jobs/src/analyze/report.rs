@@ -330,7 +330,11 @@ pub fn table_and_fits(
             .map(|(slope, n)| (1e3 / slope, n)),
         AreaUnit::Pixel => None,
     };
-    let pressures: Vec<f64> = rows.iter().filter_map(|r| r.mean_pressure_mpa).collect();
+    let pressures: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.force_mn.is_some_and(|f| f > 0.0))
+        .filter_map(|r| r.mean_pressure_mpa)
+        .collect();
     let fits = Fits {
         unit,
         power_law: fit_power_law(&forces, &areas),

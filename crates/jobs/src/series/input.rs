@@ -19,9 +19,11 @@ use crate::error::{Error, Location, Result};
 /// force per image when the files do not come with a manifest.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SeriesSpec {
-    /// TIFF, CZI, ND2 or LIF files, or folders of them (not with a manifest).
+    /// TIFF, CZI, ND2 or LIF files, or folders of them (not with a manifest); a single folder
+    /// holding `manifest.csv` (and no forces) is read as that manifest.
     pub inputs: Vec<PathBuf>,
-    /// A manifest CSV (`file`, `page`, `force_mN`, `friction_mN`).
+    /// A manifest CSV (`file`, `page`, `force_mN` or `force_N`, `friction_mN`), or a folder
+    /// holding `manifest.csv`.
     pub manifest: Option<PathBuf>,
     /// Which planes of confocal files (and the channel of TIFFs).
     pub selection: Selection,
@@ -70,7 +72,20 @@ impl Micrographs {
     pub fn open(&self) -> Result<OpenSeries> {
         match self {
             Micrographs::Files(spec) => {
-                let mut series = match &spec.manifest {
+                // A CSV, or a folder holding `manifest.csv`, given as the only input is that
+                // manifest.
+                let folder_manifest = match (spec.inputs.as_slice(), &spec.forces_n) {
+                    ([only], None) if spec.manifest.is_none() && is_manifest(only) => {
+                        Some(only.clone())
+                    }
+                    _ => None,
+                };
+                let mut series = match folder_manifest.as_ref().or(spec.manifest.as_ref()) {
+                    Some(manifest) if folder_manifest.is_some() => from_manifest_selected(
+                        &manifest_file(manifest)?,
+                        &spec.selection,
+                        spec.load_axis,
+                    )?,
                     Some(manifest) => {
                         if !spec.inputs.is_empty() || spec.forces_n.is_some() {
                             return Err(Error::InvalidArgument(format!(
@@ -97,6 +112,15 @@ impl Micrographs {
             Micrographs::Memory(m) => m.open(),
         }
     }
+}
+
+/// Whether an input path names a manifest: a `.csv` file or a folder holding `manifest.csv`.
+pub fn is_manifest(path: &std::path::Path) -> bool {
+    path.join("manifest.csv").is_file()
+        || (path.is_file()
+            && path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("csv")))
 }
 
 /// The manifest a path names: a CSV, or a folder holding `manifest.csv`.

@@ -328,7 +328,8 @@ fn manifest_number(
     Ok(Some(value))
 }
 
-/// Read a manifest CSV (`file`, optional `page`, `force_mN`, optional `friction_mN`).
+/// Read a manifest CSV (`file`, optional `page`, `force_mN` or `force_N`, optional
+/// `friction_mN` or `friction_N`).
 pub fn from_manifest(manifest: &Path, channel: Option<usize>) -> Result<Series> {
     from_manifest_selected(manifest, &Selection::channel(channel), None)
 }
@@ -351,16 +352,32 @@ pub fn from_manifest_selected(
         .map_err(|e| Error::bad_input(at_manifest.clone(), format!("bad CSV header: {e}")))?
         .clone();
     let column = |name: &str| headers.iter().position(|h| h == name);
-    let (Some(file_col), Some(force_col)) = (column("file"), column("force_mN")) else {
+    let found = || headers.iter().collect::<Vec<_>>().join(", ");
+    // A force column in millinewtons or newtons (one of them): (index, name, newtons per unit).
+    let force_column = |stem: &str| -> Result<Option<(usize, String, f64)>> {
+        let (mn, n) = (format!("{stem}_mN"), format!("{stem}_N"));
+        match (column(&mn), column(&n)) {
+            (Some(_), Some(_)) => Err(Error::bad_input(
+                at_manifest.clone(),
+                format!("columns {mn} and {n} say the same thing; keep one"),
+            )),
+            (Some(i), None) => Ok(Some((i, mn, 1e-3))),
+            (None, Some(i)) => Ok(Some((i, n, 1.0))),
+            (None, None) => Ok(None),
+        }
+    };
+    let (Some(file_col), Some((force_col, force_name, force_unit))) =
+        (column("file"), force_column("force")?)
+    else {
         return Err(Error::bad_input(
             at_manifest,
             format!(
-                "manifest needs columns 'file' and 'force_mN' (found: {})",
-                headers.iter().collect::<Vec<_>>().join(", ")
+                "manifest needs columns 'file' and 'force_mN' (or 'force_N'); found: {}",
+                found()
             ),
         ));
     };
-    let (page_col, friction_col) = (column("page"), column("friction_mN"));
+    let (page_col, friction_col) = (column("page"), force_column("friction")?);
     let base = manifest.parent().unwrap_or(Path::new("."));
     let mut table = FileTable::new(selection.clone(), load_axis);
     let mut images = Vec::new();
@@ -373,20 +390,35 @@ pub fn from_manifest_selected(
             return Err(Error::bad_input(at, "empty 'file'"));
         }
         let path = base.join(file);
-        let force = manifest_number(&row, Some(force_col), "force_mN", &at)?
-            .ok_or_else(|| Error::bad_input(at.clone(), "missing force_mN"))?;
-        Quantity::Force.check_at(force * 1e-3, &at)?;
-        let friction = manifest_number(&row, friction_col, "friction_mN", &at)?;
-        if let Some(f) = friction {
-            Quantity::Force.check_at(f * 1e-3, &at)?;
+        let force = manifest_number(&row, Some(force_col), &force_name, &at)?
+            .ok_or_else(|| Error::bad_input(at.clone(), format!("missing {force_name}")))?
+            * force_unit;
+        // 0 is a reference frame recorded before loading: analysed, left out of the fits.
+        if force != 0.0 {
+            Quantity::Force.check_at(force, &at)?;
         }
-        let (page, plane) = resolve_page(&mut table, &path, &row, page_col, &at)?;
+        let friction = match &friction_col {
+            Some((c, name, unit)) => manifest_number(&row, Some(*c), name, &at)?.map(|f| f * unit),
+            None => None,
+        };
+        if let Some(f) = friction.filter(|f| *f != 0.0) {
+            Quantity::Force.check_at(f, &at)?;
+        }
+        // An error about the row's file (missing, unreadable, no such page) names the row too.
+        let (page, plane) = resolve_page(&mut table, &path, &row, page_col, &at).map_err(|e| {
+            let text = e.to_string();
+            if text.contains(&manifest.display().to_string()) {
+                e
+            } else {
+                Error::bad_input(at.clone(), text)
+            }
+        })?;
         images.push(ImageRef {
             path,
             page,
             plane,
-            force_n: Some(force * 1e-3),
-            friction_n: friction.map(|f| f * 1e-3),
+            force_n: Some(force),
+            friction_n: friction,
         });
     }
     if images.is_empty() {

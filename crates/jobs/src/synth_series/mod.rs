@@ -42,7 +42,7 @@ impl SynthSeriesRequest {
     /// follow in [`run`].)
     pub fn check(&self) -> Result<()> {
         Quantity::PixelSize.check(self.params.pixel_size_m, Param::PixelSize)?;
-        check_loads(&self.params.forces_n, Param::Loads)
+        check_loads(&self.params.forces_n, Param::Forces)
     }
 }
 

@@ -12,7 +12,7 @@
 //!   `torque_mNm`, `torque_Nm`. Torque T becomes force F = T / r with the sphere's rotation
 //!   radius r (`rotation_radius_m`), as in the paper's Methods; torque without r is an error.
 //! * **normal force** (optional): `normal_force_mN` or `normal_force_N`; its median is the
-//!   trace's N. Without it the caller's N (`--normal-force`) is used; neither is an error.
+//!   trace's N. Without it the caller's N (`--forces`) is used; neither is an error.
 //!
 //! Other columns are ignored, except names that start like a known quantity (`friction_`,
 //! `torque_`, `normal_force_`, `time_`, `displacement_`, `angle_`) with an unknown unit, which
