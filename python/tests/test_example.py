@@ -20,6 +20,9 @@ def test_paper_workflow_example(tmp_path):
     done = subprocess.run([sys.executable, str(script), "--out", str(out)], cwd=tmp_path,
                           capture_output=True, text=True, timeout=300, env=dict(os.environ))
     assert done.returncode == 0, done.stderr
+    # The cluster shuts down cleanly: no tracebacks or scheduler errors at exit.
+    for noise in ("Traceback", "CommClosedError", "- ERROR -"):
+        assert noise not in done.stderr, done.stderr[-2000:]
     png = out / "paper_workflow.png"
     assert png.stat().st_size > 10_000
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

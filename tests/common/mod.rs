@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod czi;
+pub mod nulls;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -38,10 +39,14 @@ pub fn cli_names() {
 
 /// Run the contactscope binary.
 pub fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_contactscope"))
+    let out = Command::new(env!("CARGO_BIN_EXE_contactscope"))
         .args(args)
         .output()
-        .expect("binary runs")
+        .expect("binary runs");
+    if out.status.success() {
+        nulls::check_run(Path::new("."), args, &out.stdout);
+    }
+    out
 }
 
 /// Run the binary and insist on success (stderr in the failure message).
@@ -76,11 +81,15 @@ pub fn rough_surface(path: &Path, size: usize, pixel: &str, seed: u64, extra: &[
 
 /// Run in a directory.
 pub fn run_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_contactscope"))
+    let out = Command::new(env!("CARGO_BIN_EXE_contactscope"))
         .current_dir(dir)
         .args(args)
         .output()
-        .expect("binary runs")
+        .expect("binary runs");
+    if out.status.success() {
+        nulls::check_run(dir, args, &out.stdout);
+    }
+    out
 }
 
 /// Standard error as text.

@@ -3,7 +3,8 @@
 //! numbers, sizes, truncation, lines; `mutate`) and/or the numbers of its option values, runs the
 //! release binary under a time and memory limit (`run`) and classifies the result: a panic, hang,
 //! abort, partial output, overwritten input, left-over work folder or non-finite number in the
-//! output fails the campaign, and so do more than 0.5 % unclean error messages.
+//! output fails the campaign, and so do more than 0.5 % unclean error messages and more than
+//! 0.5 % of runs ending in an error that names neither an input file nor a flag.
 //!
 //! * `cargo test --release --test integration fuzz_short` runs the short campaign (600 cases, seed 1; about a minute
 //!   on 2 cores) that CI runs.
@@ -167,7 +168,9 @@ fn campaign(cases: usize, seed: u64) {
                         case.args.join(" ")
                     )
                 };
-                if outcome.class.is_failure() || outcome.class == Class::Unclean {
+                if outcome.class.is_failure()
+                    || matches!(outcome.class, Class::Unclean | Class::Unnamed)
+                {
                     let kept = keep.join(format!("seed{seed}-case{i}"));
                     let _ = fs::remove_dir_all(&kept);
                     copy_tree(&dir, &kept);
@@ -213,7 +216,8 @@ fn campaign(cases: usize, seed: u64) {
         .map(|(_, n)| n)
         .sum();
     let unclean = by_class.get(&Class::Unclean).copied().unwrap_or(0);
-    let errors = unclean + by_class.get(&Class::CleanError).copied().unwrap_or(0);
+    let unnamed = by_class.get(&Class::Unnamed).copied().unwrap_or(0);
+    let errors = unclean + unnamed + by_class.get(&Class::CleanError).copied().unwrap_or(0);
     assert_eq!(
         failed,
         0,
@@ -223,6 +227,11 @@ fn campaign(cases: usize, seed: u64) {
     assert!(
         unclean as f64 <= 0.005 * errors.max(1) as f64,
         "{unclean} of {errors} error exits unclean (at most 0.5 %)"
+    );
+    assert!(
+        unnamed as f64 <= 0.005 * cases as f64,
+        "{unnamed} of {cases} runs end in an error naming neither an input nor a flag (at most \
+         0.5 %)"
     );
 }
 

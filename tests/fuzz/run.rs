@@ -13,8 +13,11 @@ use std::time::{Duration, Instant};
 pub enum Class {
     /// Exit 0, outputs finite, nothing left behind.
     Ok,
-    /// Exit 1 or 2 with one error line, nothing written.
+    /// Exit 1 or 2 with one error line naming an input file or a flag, nothing written.
     CleanError,
+    /// Exit 1 or 2 with one error line that names neither an input file nor a flag: the person
+    /// cannot tell what to change.
+    Unnamed,
     /// An error that is several lines, too long, or lacks the `contactscope: error:` prefix.
     Unclean,
     /// A Rust panic (exit 101).
@@ -38,7 +41,10 @@ pub enum Class {
 impl Class {
     /// Whether the class is a failure the campaign reports.
     pub fn is_failure(self) -> bool {
-        !matches!(self, Class::Ok | Class::CleanError | Class::Unclean)
+        !matches!(
+            self,
+            Class::Ok | Class::CleanError | Class::Unclean | Class::Unnamed
+        )
     }
 }
 
@@ -152,6 +158,14 @@ fn clean_error(stderr: &str) -> Result<(), String> {
     }
 }
 
+/// The `contactscope: error:` line of stderr.
+fn error_line(stderr: &str) -> &str {
+    stderr
+        .lines()
+        .find(|l| l.starts_with("contactscope: error:"))
+        .unwrap_or("")
+}
+
 fn truncate(s: &str, n: usize) -> String {
     if s.len() <= n {
         return s.to_string();
@@ -169,10 +183,31 @@ pub struct Limits {
     pub memory_kib: u64,
 }
 
+/// What an error line may name so that a person knows what to change: the name of every file
+/// and folder of the case's inputs, and every flag of its arguments.
+fn nameable(dir: &Path, args: &[String], out: &Path) -> Vec<String> {
+    let mut names: Vec<String> = snapshot(dir, out)
+        .iter()
+        .flat_map(|(p, _)| {
+            p.strip_prefix(dir)
+                .ok()
+                .into_iter()
+                .flat_map(|rel| rel.iter())
+                .map(|c| c.to_string_lossy().into_owned())
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    names.extend(args.iter().filter(|a| a.starts_with("--")).cloned());
+    names.sort();
+    names.dedup();
+    names
+}
+
 /// Run `args` in `dir` (which holds the case's inputs) and classify the result. `out` is the
 /// output path named in the arguments.
 pub fn run_case(dir: &Path, args: &[String], out: &Path, limits: &Limits) -> Outcome {
     let before = snapshot(dir, out);
+    let names = nameable(dir, args, out);
     let stdout_path = dir.with_extension("stdout");
     let stderr_path = dir.with_extension("stderr");
     let script = format!("ulimit -v {} && exec \"$0\" \"$@\"", limits.memory_kib);
@@ -235,6 +270,13 @@ pub fn run_case(dir: &Path, args: &[String], out: &Path, limits: &Limits) -> Out
                 return outcome(Class::Partial, format!("{} exists: {first}", out.display()));
             }
             match clean_error(&stderr) {
+                Ok(())
+                    if !names
+                        .iter()
+                        .any(|n| error_line(&stderr).contains(n.as_str())) =>
+                {
+                    outcome(Class::Unnamed, first)
+                }
                 Ok(()) => outcome(Class::CleanError, first),
                 Err(why) => outcome(Class::Unclean, why),
             }

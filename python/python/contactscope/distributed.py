@@ -78,8 +78,19 @@ def local_client(n_workers: int = 2, threads_per_worker: int = 1) -> Iterator[An
     try:
         yield client
     finally:
-        client.close()
-        cluster.close()
+        _close_quietly(client, cluster)
+
+
+def _close_quietly(client: Any, cluster: Any) -> None:
+    """Shut a local cluster down with no task left running (a worker still computing when its
+    scheduler goes away logs heartbeat errors and ``CommClosedError`` tracebacks), the client
+    first, then the cluster, which stops its workers before its scheduler."""
+    try:
+        client.cancel(list(client.futures.values()), force=True)
+    except Exception:  # noqa: BLE001 - best effort: closing below still happens
+        pass
+    client.close()
+    cluster.close()
 
 
 class _Serial:

@@ -72,14 +72,21 @@ impl SelfAffineParams {
     pub fn validate(&self) -> Result<()> {
         if self.nx < 4 || self.ny < 4 {
             return Err(invalid(format!(
-                "a self-affine surface needs at least 4 × 4 pixels (got {} × {})",
-                self.nx, self.ny
+                "{}: a self-affine surface needs at least 4 × 4 pixels (got {} × {})",
+                contactscope_formats::param::Param::Size,
+                self.nx,
+                self.ny
             )));
         }
         // The spectrum is complex (16 bytes per value).
         crate::limits::Limits::DEFAULT
             .plane_bytes(self.nx, self.ny, 16)
-            .map_err(|reason| invalid(format!("surface size: {reason}")))?;
+            .map_err(|reason| {
+                invalid(format!(
+                    "{}: {reason}",
+                    contactscope_formats::param::Param::Size
+                ))
+            })?;
         if !(self.dx_m.is_finite() && self.dx_m > 0.0) {
             return Err(invalid(format!(
                 "pixel size must be positive and finite (got {} m)",

@@ -117,9 +117,16 @@ impl SynthParams {
                     ))
                 })
         } else {
-            Err(Error::InvalidArgument(
-                "synthetic series needs at least 8×8 pixels (at most 2^26), a positive pixel size and positive forces".into(),
-            ))
+            use contactscope_formats::param::Param;
+            Err(Error::InvalidArgument(format!(
+                "a synthetic series needs 8×8 to 2^26 pixels ({}: {} × {}), a positive pixel size \
+                 ({}) and positive forces ({})",
+                Param::Size,
+                self.width,
+                self.height,
+                Param::PixelSize,
+                Param::Forces
+            )))
         }
     }
 

@@ -46,7 +46,8 @@ impl Method {
                 .map(Method::Manual)
                 .ok_or_else(|| {
                     Error::InvalidArgument(format!(
-                        "threshold '{other}' is neither 'otsu', 'per-image' nor a number"
+                        "{}: '{other}' is neither 'otsu', 'per-image' nor a finite number",
+                        contactscope_formats::param::Param::Threshold
                     ))
                 }),
         }

@@ -314,7 +314,10 @@ pub(crate) fn required_pixel_size(
     pixel_size_m.ok_or_else(|| {
         bad(
             path,
-            format!("{format} files carry no pixel size; give the pixel size"),
+            format!(
+                "{format} files carry no pixel size; give it with {}",
+                crate::param::Param::PixelSize
+            ),
         )
     })
 }

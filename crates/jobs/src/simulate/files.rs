@@ -36,7 +36,9 @@ pub fn run_to_folder(
     let outcome = run(request, &mut writer, monitor)?;
     staging.write("areas.csv", &areas_csv(&outcome)?)?;
     #[cfg(feature = "plots")]
-    staging.write("area_vs_load.png", &area_plot(&outcome).to_png()?)?;
+    if outcome.loads.iter().any(|l| l.area_m2 > 0.0) {
+        staging.write("area_vs_load.png", &area_plot(&outcome).to_png()?)?;
+    }
     staging.write("summary.json", &summary_json(command_line, &outcome)?)?;
     let written = staging.commit()?;
     Ok((outcome, written))

@@ -365,7 +365,12 @@ pub fn run(
 ) -> Result<SimulateOutcome> {
     request.check()?;
     let (roughness, notes) = request.heights.read_with_notes()?;
-    let stats = SurfaceStats::finite_differences(&roughness)?;
+    let stats = SurfaceStats::finite_differences(&roughness).map_err(|e| {
+        crate::error::Error::bad_input(
+            crate::error::Location::file(request.heights.label()),
+            e.to_string(),
+        )
+    })?;
     let (loads, mut warnings) = match request.model {
         ModelChoice::GreenwoodTripp => run_gt(request, &roughness, &stats, observer)?,
         ModelChoice::HalfSpace(model) => {
@@ -382,6 +387,9 @@ pub fn run(
             "{:.6} mN: no pixel in contact (the contact is smaller than a pixel); mean pressure left empty",
             l.force_n * 1e3
         ));
+    }
+    if loads.iter().all(|l| l.area_m2 <= 0.0) {
+        warnings.push("no load has a contact pixel: no area–load plot".into());
     }
     let (f, a): (Vec<f64>, Vec<f64>) = loads
         .iter()

@@ -243,7 +243,8 @@ pub fn run(request: &TopographyRequest) -> Result<TopographyOutcome> {
     match usable(path, map) {
         Ok(mut topography) => {
             topography.detrend(detrend);
-            let stats = SurfaceStats::finite_differences(&topography)?;
+            let stats = SurfaceStats::finite_differences(&topography)
+                .map_err(|e| Error::bad_input(Location::file(path), e.to_string()))?;
             Ok(TopographyOutcome {
                 summary: TopographyDescription {
                     stored,
