@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod czi;
+pub mod lif;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
