@@ -167,13 +167,8 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
         );
     }
     if let Some(fit) = outcome.fits.power_law {
-        let se = fit
-            .exponent_se
-            .map_or(String::new(), |s| format!(" ± {s:.3}"));
-        println!(
-            "power law: A ∝ N^β, β = {:.3}{se}, R² = {:.4}",
-            fit.exponent, fit.r_squared
-        );
+        let beta = contactscope_jobs::table::value_pm_or(fit.exponent, fit.exponent_se, 3);
+        println!("power law: A ∝ N^β, β = {beta}, R² = {:.4}", fit.r_squared);
     }
     if let Some((p, _)) = outcome.fits.proportional_mpa {
         println!("proportional fit: A = N/p, p = {p:.1} MPa");

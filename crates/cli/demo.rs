@@ -39,14 +39,12 @@ pub fn run(args: Args) -> Result<()> {
         "quantity", "truth", "recovered", "error"
     );
     for r in &outcome.recovered {
-        let unc = r
-            .uncertainty
-            .map_or(String::new(), |u| format!(" ± {u:.3}"));
+        let recovered = contactscope_jobs::table::value_pm_or(r.recovered, r.uncertainty, 3);
         println!(
             "{:<32} {:>12} {:>22} {:>7.1}%  {}",
             r.quantity,
             format!("{:.3} {}", r.truth, r.unit),
-            format!("{:.3}{unc}", r.recovered),
+            recovered,
             100.0 * r.relative_error(),
             r.by
         );

@@ -14,6 +14,7 @@ use contactscope_jobs::fit_hardening::{
 use contactscope_jobs::heights::HeightInput;
 use contactscope_jobs::results::fwhm_from_psf_json;
 use contactscope_jobs::series::{Micrographs, SeriesSpec};
+use contactscope_jobs::table::value_pm;
 
 use super::args::{default_out, optional_pixel_size, BodyArgs, OutputFolder, SolverArgs};
 use indicatif::ProgressStyle;
@@ -214,18 +215,14 @@ pub fn run(args: Args) -> Result<()> {
     println!("{:>10} {:>22} {:>10}", "model", "parameter", "misfit");
     for fit in outcome.fits() {
         let parameter = match (fit.family, fit.best.parameter) {
-            (Family::Hardening, Some(k)) => format!(
-                "k = {:.3} ± {} MPa/nm",
-                k * 1e-15,
-                fit.parameter_se
-                    .map_or("?".into(), |s| format!("{:.3}", s * 1e-15))
-            ),
-            (Family::Hardness, Some(p)) => format!(
-                "p_Y = {:.1} ± {} MPa",
-                p * 1e-6,
-                fit.parameter_se
-                    .map_or("?".into(), |s| format!("{:.1}", s * 1e-6))
-            ),
+            (Family::Hardening, Some(k)) => match fit.parameter_se {
+                Some(s) => format!("k = {} MPa/nm", value_pm(k * 1e-15, s * 1e-15)),
+                None => format!("k = {:.3} ± ? MPa/nm", k * 1e-15),
+            },
+            (Family::Hardness, Some(p)) => match fit.parameter_se {
+                Some(s) => format!("p_Y = {} MPa", value_pm(p * 1e-6, s * 1e-6)),
+                None => format!("p_Y = {:.1} ± ? MPa", p * 1e-6),
+            },
             _ => "—".into(),
         };
         println!(

@@ -7,6 +7,7 @@ use anyhow::{bail, Context, Result};
 use contactscope_formats::units::{self, Dimension};
 use contactscope_jobs::friction::files::run_to_folder;
 use contactscope_jobs::friction::FrictionRequest;
+use contactscope_jobs::table::value_pm_or;
 
 use super::args::{default_out, fraction, load_forces, Forces, OutputFolder};
 use super::common::{command_line, print_warnings, print_written};
@@ -82,24 +83,19 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     if let Some(fit) = &outcome.shear {
-        let se = fit
-            .tau_se_pa
-            .map_or(String::new(), |s| format!(" ± {:.2}", s * 1e-6));
+        let tau = value_pm_or(fit.tau_pa * 1e-6, fit.tau_se_pa.map(|s| s * 1e-6), 2);
         let r2 = fit.r_squared.map_or("—".into(), |r| format!("{r:.4}"));
-        println!("F_s = τ·A: τ = {:.2}{se} MPa (R² {r2})", fit.tau_pa * 1e-6);
+        println!("F_s = τ·A: τ = {tau} MPa (R² {r2})");
     }
     if let Some(m) = &outcome.mu_trend {
-        let se = m
-            .exponent_se
-            .map_or(String::new(), |s| format!(" ± {s:.3}"));
+        let m_exp = value_pm_or(m.exponent, m.exponent_se, 3);
         let verdict = match m.varies {
             Some(true) => "μ depends on N (not Amontons)",
             Some(false) => "μ constant within the scatter",
             None => "too few loads to judge",
         };
         println!(
-            "μ_s ∝ N^m: m = {:.3}{se}, spread {:.1} %: {verdict}",
-            m.exponent,
+            "μ_s ∝ N^m: m = {m_exp}, spread {:.1} %: {verdict}",
             m.relative_spread * 100.0
         );
     }

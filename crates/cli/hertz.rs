@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use contactscope_formats::units::{self, Dimension};
 use contactscope_jobs::hertz::files::run_to_folder;
 use contactscope_jobs::hertz::HertzRequest;
+use contactscope_jobs::table::value_pm;
 
 use super::args::{default_out, load_forces, Forces, OutputFolder};
 use super::common::{command_line, print_written};
@@ -37,17 +38,15 @@ pub fn run(args: Args) -> Result<()> {
     let (outcome, written) = run_to_folder(&request, &args.out.out, &command_line())?;
     let fit = &outcome.fit;
     println!(
-        "E* = {:.4} ± {:.4} GPa (R² {:.5}, {} points, fit through the origin)",
-        fit.e_star_pa * 1e-9,
-        fit.e_star_se_pa * 1e-9,
+        "E* = {} GPa (R² {:.5}, {} points, fit through the origin)",
+        value_pm(fit.e_star_pa * 1e-9, fit.e_star_se_pa * 1e-9),
         fit.r_squared,
         outcome.points.len()
     );
     if let Some(free) = &outcome.offset_fit {
         println!(
-            "with a free contact point: E* = {:.4} ± {:.4} GPa, offset {:.4} µm of plate displacement",
-            free.e_star_pa * 1e-9,
-            free.e_star_se_pa * 1e-9,
+            "with a free contact point: E* = {} GPa, offset {:.4} µm of plate displacement",
+            value_pm(free.e_star_pa * 1e-9, free.e_star_se_pa * 1e-9),
             2.0 * free.offset_m * 1e6
         );
     }

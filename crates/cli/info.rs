@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 
 use contactscope_formats::microscopy::summary::InfoSummary;
+use contactscope_formats::microscopy::Rows;
 use contactscope_formats::units;
 use contactscope_jobs::info::{self as job, tiff_details, InfoRequest};
 
@@ -17,7 +18,7 @@ pub struct Args {
     /// A TIFF, CZI, ND2 or LIF file.
     file: PathBuf,
     /// Print JSON: {"file", "format", "series": [{"index", "name", "axes", "dtype",
-    /// "pixel_size_um": {"x", "y", "z"}, "pixel_size_source", "planes"}]} (docs/formats.md).
+    /// "pixel_size_um": {"x", "y", "z"}, "pixel_size_source", "rows" (X–Z/X–T scans), "planes"}]} (docs/formats.md).
     #[arg(long)]
     json: bool,
     /// Decode every plane and add its min, max, mean and sum ("planes").
@@ -113,6 +114,9 @@ fn print_summary(summary: &InfoSummary) {
             "series {}{name}: T {} × Z {} × C {}{extra} × Y {} × X {}, {}",
             s.index, a.t, a.z, a.c, a.y, a.x, s.dtype
         );
+        if !s.rows.is_y() {
+            println!("  {}", s.rows.describe());
+        }
         let p = &s.pixel_size_um;
         match (p.x, p.y) {
             (Some(x), Some(y)) => println!(
@@ -124,6 +128,10 @@ fn print_summary(summary: &InfoSummary) {
                     units::format_length(z * 1e-6)
                 )),
                 s.pixel_size_source.as_deref().unwrap_or("the file")
+            ),
+            (Some(x), None) if s.rows == Rows::T => println!(
+                "  pixel size: {} along x; rows are time points (no length)",
+                units::format_length(x * 1e-6)
             ),
             _ => println!("  pixel size: none in the metadata (use --pixel-size)"),
         }

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod czi;
+pub mod lif;
 pub mod nulls;
 
 use std::path::{Path, PathBuf};

@@ -231,9 +231,93 @@ pub(crate) fn csv_text(
     String::from_utf8(bytes).map_err(|e| Error::InvalidArgument(format!("CSV: {e}")))
 }
 
+/// `value ± se` as a measurement is written: the uncertainty to two significant digits and the
+/// value to the same decimal place (`0.8712 ± 0.00043` → `0.87120 ± 0.00043`, `153.6 ± 12.3` →
+/// `154 ± 12`, `15360 ± 1234` → `15400 ± 1200`); far from 1 (a value or uncertainty past
+/// 10⁹ or below 10⁻⁸) in scientific notation (`1.500e-12 ± 3.0e-14`). An uncertainty that is
+/// zero or not finite cannot set the digits: the value keeps four significant digits then.
+pub fn value_pm(value: f64, se: f64) -> String {
+    if !value.is_finite() {
+        return format!("{value} ± {se}");
+    }
+    if !(se.is_finite() && se > 0.0) {
+        return format!("{} ± {se}", significant(value, 4));
+    }
+    // The last digit of the rounded uncertainty (0.0996 rounds to 0.10: two digits, not three).
+    let exponent = |v: f64| v.abs().log10().floor() as i32;
+    let last = exponent(se) - 1;
+    let se = round_at(se, last);
+    let last = exponent(se) - 1;
+    let magnitude = exponent(value.abs().max(se));
+    if !(-8..9).contains(&magnitude) || !(-9..9).contains(&last) {
+        let digits = (exponent(value.abs().max(se)) - last).max(1) as usize;
+        return format!("{value:.digits$e} ± {se:.1e}");
+    }
+    let decimals = (-last).max(0) as usize;
+    // `+ 0.0` turns a value rounded to −0 into 0.
+    let value = round_at(value, last) + 0.0;
+    format!("{value:.decimals$} ± {se:.decimals$}")
+}
+
+/// [`value_pm`] when there is an uncertainty, else the value alone to `decimals` places.
+pub fn value_pm_or(value: f64, se: Option<f64>, decimals: usize) -> String {
+    match se {
+        Some(se) => value_pm(value, se),
+        None => format!("{value:.decimals$}"),
+    }
+}
+
+/// `v` rounded to the digit of 10^`at`.
+fn round_at(v: f64, at: i32) -> f64 {
+    if at >= 0 {
+        let unit = 10f64.powi(at);
+        (v / unit).round() * unit
+    } else {
+        let scale = 10f64.powi(-at);
+        (v * scale).round() / scale
+    }
+}
+
+/// `v` to `digits` significant digits, in plain decimals.
+fn significant(v: f64, digits: i32) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    let last = v.abs().log10().floor() as i32 - (digits - 1);
+    format!("{:.*}", (-last).max(0) as usize, round_at(v, last) + 0.0)
+}
+
 /// A number in scientific notation with three significant digits (`1.234e-9`), for residuals.
 pub fn sci3(value: &serde_json::Value) -> String {
     value
         .as_f64()
         .map_or_else(String::new, |v| format!("{v:.3e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uncertainties_keep_two_significant_digits_and_values_their_decimal_place() {
+        assert_eq!(value_pm(0.8712, 0.00043), "0.87120 ± 0.00043");
+        assert_eq!(value_pm(153.6, 12.3), "154 ± 12");
+        assert_eq!(value_pm(0.871, 0.004), "0.8710 ± 0.0040");
+        assert_eq!(value_pm(15360.0, 1234.0), "15400 ± 1200");
+        assert_eq!(value_pm(-2.3456, 0.012), "-2.346 ± 0.012");
+        // 0.0996 rounds to 0.10: two digits after rounding, not three.
+        assert_eq!(value_pm(0.871, 0.0996), "0.87 ± 0.10");
+        assert_eq!(value_pm(3.997, 0.005), "3.9970 ± 0.0050");
+        // A value that rounds to zero is not written −0.
+        assert_eq!(value_pm(-0.0001, 0.012), "0.000 ± 0.012");
+        // Far from 1: scientific notation.
+        assert_eq!(value_pm(1.5e-12, 3e-14), "1.500e-12 ± 3.0e-14");
+        assert_eq!(value_pm(2.5e10, 1.2e8), "2.500e10 ± 1.2e8");
+        // No usable uncertainty: four significant digits and the uncertainty as it is.
+        assert_eq!(value_pm(0.87123, 0.0), "0.8712 ± 0");
+        assert_eq!(value_pm(153.64, f64::NAN), "153.6 ± NaN");
+        assert_eq!(value_pm(f64::INFINITY, 1.0), "inf ± 1");
+        assert_eq!(value_pm_or(0.87123, None, 3), "0.871");
+        assert_eq!(value_pm_or(0.87123, Some(0.00043), 3), "0.87123 ± 0.00043");
+    }
 }

@@ -638,6 +638,7 @@ fn series_info(
             source,
         },
         channels,
+        rows: super::Rows::Y,
     })
 }
 

@@ -356,6 +356,7 @@ fn describe(
             }),
         },
         channels: vec![ChannelInfo::default(); channels.len()],
+        rows: super::Rows::Y,
     };
     Ok((
         info,

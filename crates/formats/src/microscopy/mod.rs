@@ -13,6 +13,13 @@
 //! any other CZI dimension (`R`, `I`, `V`, `B`). CZI mosaic tiles (`M`) are not an axis: they are
 //! placed at their stage offsets into the series' bounding box.
 //!
+//! Scans without a y axis ([`Rows`]): a series of one-pixel-high lines (Y absent or of one
+//! element) along a Z or T axis longer than 1 is an X–Z section or an X–T line scan, as the
+//! acquisition software shows it (LAS X for `XZ`/`XT` modes, ZEN, NIS-Elements): one image per
+//! channel (and per remaining t) whose rows are the scanned axis, read line by line from the
+//! reader's planes. The y pixel size of an X–Z image is the z step; an X–T image has none (a
+//! line time is no length).
+//!
 //! The format is detected from the first bytes of the file ([`detect`]), not the extension.
 
 mod clx;
@@ -141,6 +148,34 @@ pub struct ChannelInfo {
     pub excitation_wavelength_m: Option<f64>,
 }
 
+/// What the rows of a series' images are (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum Rows {
+    /// Lines along y: an X–Y image.
+    #[default]
+    Y,
+    /// Focal planes: an X–Z section (a scan without a y axis); `axes.z` is then 1.
+    Z,
+    /// Time points: an X–T line scan (no y axis, no z); `axes.t` is then 1.
+    T,
+}
+
+impl Rows {
+    /// Whether rows are y (the usual image).
+    pub fn is_y(&self) -> bool {
+        *self == Rows::Y
+    }
+
+    /// `X–Y image`, `X–Z section`, `X–T line scan`, for summaries.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Rows::Y => "X–Y image",
+            Rows::Z => "X–Z section (rows are focal planes)",
+            Rows::T => "X–T line scan (rows are time points)",
+        }
+    }
+}
+
 /// One series (CZI scene, LIF image, the whole ND2 or TIFF file).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SeriesInfo {
@@ -156,6 +191,34 @@ pub struct SeriesInfo {
     pub pixel_size: VoxelSize,
     /// One entry per channel (`axes.c` of them).
     pub channels: Vec<ChannelInfo>,
+    /// What the image rows are: y, or the scanned axis of a scan without y (module docs).
+    #[serde(skip_serializing_if = "Rows::is_y")]
+    pub rows: Rows,
+}
+
+impl SeriesInfo {
+    /// The series as images whose rows are the scanned axis when it has no y axis (Y of one
+    /// element) but a Z (else T) axis longer than 1 (module docs); any other series as it is.
+    /// The y pixel size of an X–Z section is the z step; an X–T scan has none.
+    pub fn as_line_scan(mut self) -> SeriesInfo {
+        let a = &mut self.axes;
+        if a.y != 1 || !self.rows.is_y() {
+            return self;
+        }
+        let p = &mut self.pixel_size;
+        if a.z > 1 {
+            (a.y, a.z, self.rows) = (a.z, 1, Rows::Z);
+            p.y_m = p.z_m.take();
+            if p.y_m.is_some() {
+                let x = p.source.as_deref().unwrap_or("the file");
+                p.source = Some(format!("{x}; y: the z step of the X–Z scan"));
+            }
+        } else if a.t > 1 {
+            (a.y, a.t, self.rows) = (a.t, 1, Rows::T);
+            p.y_m = None;
+        }
+        self
+    }
 }
 
 /// Which plane of a series: `t`, `z`, `c` and the extra axes by name (missing ones are 0).
@@ -253,6 +316,8 @@ pub struct MicroscopyFile {
     pub format: MicroscopyFormat,
     /// Its series.
     pub series: Vec<SeriesInfo>,
+    /// The series as the reader describes them (line scans still one plane per line).
+    stored: Vec<SeriesInfo>,
     backend: Backend,
 }
 
@@ -295,10 +360,21 @@ impl MicroscopyFile {
                 (r.series(), Backend::Tiff(Box::new(r)))
             }
         };
+        // TIFF files keep their own model (one page, one image).
+        let shown = if format == MicroscopyFormat::Tiff {
+            series.clone()
+        } else {
+            series
+                .iter()
+                .cloned()
+                .map(SeriesInfo::as_line_scan)
+                .collect()
+        };
         Ok(MicroscopyFile {
             path: path.to_path_buf(),
             format,
-            series,
+            series: shown,
+            stored: series,
             backend,
         })
     }
@@ -325,12 +401,86 @@ impl MicroscopyFile {
             )
         })?;
         index.check(&self.path, info)?;
-        match &mut self.backend {
+        let stored = &self.stored[series];
+        let axis = info.rows;
+        if axis.is_y() {
+            return self.backend.read_plane(stored, index);
+        }
+        // One line per row: the plane at z (or t) = row of the stored series.
+        let (width, height) = (info.axes.x, info.axes.y);
+        checked_bytes(&self.path, "plane", &[width, height], 4)?;
+        let mut lines = Vec::with_capacity(height);
+        for row in 0..height {
+            let mut at = index.clone();
+            match axis {
+                Rows::Z => at.z = row,
+                Rows::T | Rows::Y => at.t = row,
+            }
+            lines.push(self.backend.read_plane(stored, &at)?);
+        }
+        stack_lines(&self.path, width, lines)
+    }
+}
+
+impl Backend {
+    fn read_plane(&mut self, info: &SeriesInfo, index: &PlaneIndex) -> Result<Plane> {
+        match self {
             Backend::Czi(r) => r.read_plane(info, index),
             Backend::Nd2(r) => r.read_plane(info, index),
             Backend::Lif(r) => r.read_plane(info, index),
             Backend::Tiff(r) => r.read_plane(info, index),
         }
+    }
+}
+
+/// One image from lines (planes of `width` × 1) of one sample type, the first line on top.
+fn stack_lines(path: &Path, width: usize, lines: Vec<Plane>) -> Result<Plane> {
+    let height = lines.len();
+    let first = lines
+        .first()
+        .ok_or_else(|| bad(path, "a line scan of no lines"))?;
+    let (sample_type, offset) = (first.sample_type, int_offset(&first.samples));
+    let mut codes = Vec::new();
+    let mut floats = Vec::new();
+    for line in lines {
+        if line.width != width || line.height != 1 || line.sample_type != sample_type {
+            return Err(bad(
+                path,
+                format!(
+                    "a line of the scan is {}×{} {}, not {width}×1 {}",
+                    line.width,
+                    line.height,
+                    line.sample_type.name(),
+                    sample_type.name()
+                ),
+            ));
+        }
+        match line.samples {
+            Samples::Int {
+                codes: c,
+                offset: o,
+            } if Some(o) == offset => codes.extend(c),
+            Samples::Float(v) if offset.is_none() => floats.extend(v),
+            _ => return Err(bad(path, "the lines of a scan hold different sample kinds")),
+        }
+    }
+    let samples = match offset {
+        Some(offset) => Samples::Int { codes, offset },
+        None => Samples::Float(floats),
+    };
+    Ok(Plane {
+        width,
+        height,
+        sample_type,
+        samples,
+    })
+}
+
+/// The code offset of integer samples, `None` for floats.
+fn int_offset(samples: &Samples) -> Option<i32> {
+    match samples {
+        Samples::Int { offset, .. } => Some(*offset),
+        Samples::Float(_) => None,
     }
 }
 
@@ -450,6 +600,7 @@ mod tests {
             dtype: SampleType::U8,
             pixel_size: VoxelSize::default(),
             channels: vec![],
+            rows: Rows::Y,
         };
         let p = Path::new("x.czi");
         assert!(all[11].check(p, &series).is_ok());
@@ -472,5 +623,60 @@ mod tests {
         let plane = plane_from_le(p, (1, 1), SampleType::I16, &[0xfe, 0xff], 2).unwrap();
         assert_eq!(plane.value(0), -2.0);
         assert!(plane_from_le(p, (2, 2), SampleType::U16, &bytes[..8], 5).is_err());
+    }
+
+    #[test]
+    fn scans_without_y_become_images_whose_rows_are_z_or_t() {
+        let series = |(t, z, y): (usize, usize, usize)| SeriesInfo {
+            index: 0,
+            name: String::new(),
+            axes: Axes {
+                t,
+                z,
+                c: 2,
+                y,
+                x: 128,
+                extra: BTreeMap::new(),
+            },
+            dtype: SampleType::U8,
+            pixel_size: VoxelSize {
+                x_m: Some(1e-7),
+                y_m: None,
+                z_m: Some(5e-7),
+                source: Some("DimID=1".into()),
+            },
+            channels: vec![],
+            rows: Rows::Y,
+        };
+        // X–Z–T: one X–Z image per t, y pixel size the z step.
+        let xz = series((3, 128, 1)).as_line_scan();
+        assert_eq!(
+            (xz.rows, xz.axes.t, xz.axes.z, xz.axes.y),
+            (Rows::Z, 3, 1, 128)
+        );
+        assert_eq!((xz.pixel_size.y_m, xz.pixel_size.z_m), (Some(5e-7), None));
+        assert!(xz.pixel_size.source.as_ref().unwrap().contains("z step"));
+        assert_eq!(xz.axes.planes(), 6);
+        // X–T: rows are time points, no y length.
+        let xt = series((40, 1, 1)).as_line_scan();
+        assert_eq!((xt.rows, xt.axes.t, xt.axes.y), (Rows::T, 1, 40));
+        assert_eq!(xt.pixel_size.y_m, None);
+        // An X–Y image, or a single line, stays as it is.
+        assert_eq!(series((2, 5, 64)).as_line_scan(), series((2, 5, 64)));
+        assert_eq!(series((1, 1, 1)).as_line_scan(), series((1, 1, 1)));
+        // Transforming twice changes nothing more.
+        assert_eq!(xz.clone().as_line_scan(), xz);
+    }
+
+    #[test]
+    fn lines_stack_into_one_plane() {
+        let p = Path::new("x.lif");
+        let line = |v: u16| Plane::from_u16(2, 1, vec![v, v + 1]);
+        let stacked = stack_lines(p, 2, vec![line(1), line(5), line(9)]).unwrap();
+        assert_eq!((stacked.width, stacked.height), (2, 3));
+        assert_eq!(stacked.to_f64(), vec![1.0, 2.0, 5.0, 6.0, 9.0, 10.0]);
+        let err = stack_lines(p, 3, vec![line(1)]).unwrap_err().to_string();
+        assert!(err.contains("x.lif") && err.contains("not 3×1"), "{err}");
+        assert!(stack_lines(p, 2, vec![]).is_err());
     }
 }

@@ -386,5 +386,6 @@ fn series_info(
             source: xy.map(|_| "ND2 ImageMetadataSeqLV|0! SLxPictureMetadata/dCalibration".into()),
         },
         channels,
+        rows: super::Rows::Y,
     }
 }

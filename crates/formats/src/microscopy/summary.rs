@@ -9,7 +9,9 @@
 //! ```
 //!
 //! `planes` is present only when statistics are asked for; extra axes (`H`, `S`, …) appear in
-//! `axes` and as further keys of each plane. Statistics are over finite values (NaN and ±∞ of
+//! `axes` and as further keys of each plane. A scan without a y axis has `"rows": "Z"` (an X–Z
+//! section: `Y` counts focal planes, `pixel_size_um.y` is the z step) or `"rows": "T"` (an X–T
+//! line scan: `Y` counts time points, no y size); other series have no `rows` key. Statistics are over finite values (NaN and ±∞ of
 //! float images are left out); sums of integer images are exact.
 
 use std::path::Path;
@@ -17,7 +19,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::select::Selection;
-use super::{Axes, MicroscopyFile, PlaneIndex, VoxelSize};
+use super::{Axes, MicroscopyFile, PlaneIndex, Rows, VoxelSize};
 use crate::binary::bad;
 use crate::error::Result;
 use crate::image::{Plane, Samples};
@@ -49,6 +51,9 @@ pub struct SeriesSummary {
     pub pixel_size_um: PixelSizeUm,
     /// The metadata element the x/y size came from (`null` when absent).
     pub pixel_size_source: Option<String>,
+    /// What the image rows are: y, or the scanned axis of a scan without y (absent for y).
+    #[serde(skip_serializing_if = "Rows::is_y")]
+    pub rows: Rows,
     /// The voxel size in metres as the file states it (`pixel_size_um` is this in µm), for
     /// callers that write it in other units.
     #[serde(skip)]
@@ -199,6 +204,7 @@ pub fn info_summary_selected(
                 z: um(info.pixel_size.z_m),
             },
             pixel_size_source: info.pixel_size.source.clone(),
+            rows: info.rows,
             pixel_size_m: info.pixel_size.clone(),
             planes,
         });

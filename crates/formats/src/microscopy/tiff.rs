@@ -49,6 +49,7 @@ impl TiffBackend {
             dtype: info.sample_type,
             pixel_size,
             channels: vec![ChannelInfo::default(); info.channels],
+            rows: super::Rows::Y,
         }]
     }
 

@@ -8,7 +8,10 @@
 //! the one in which the version reads 5.
 //!
 //! Heights: the wave's data units (`dataUnits`, or the extended units when longer) must be a
-//! length for a layer to count as heights by unit; the layer name (`Height…`) also counts.
+//! length for a layer to count as heights by unit; the layer name (`Height…`) also counts. A
+//! wave without data units (TN003: an empty string means "no units") is taken to hold metres,
+//! as a Gwyddion field without `si_unit_z` is. A wave of one layer is read whatever its name
+//! (an unlabelled layer is called `layer 0`).
 //! Pixel size: `sfA[0]`, `sfA[1]` in the dimension units (m for Asylum files).
 
 use std::path::Path;
@@ -92,10 +95,12 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
     pos += data_e_units + dim_e_units.iter().sum::<usize>();
     pos += dim_labels[0] + dim_labels[1];
     let labels = slice(path, data, pos, dim_labels[2], "layer labels")?;
-    let unit = if e_units.is_empty() {
-        data_units
-    } else {
+    let unit = if !e_units.is_empty() {
         e_units
+    } else if data_units.trim().is_empty() {
+        "m".to_string()
+    } else {
+        data_units
     };
     let length = length_factor(&unit);
     let channels: Vec<ChannelEntry> = (0..layers)
@@ -137,4 +142,70 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
         heights,
         (sf_a[0] * xy, sf_a[1] * xy),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A little-endian version-5 wave of float64 values, `layers` layers of 2 × 2, no labels.
+    fn wave(unit: &str, layers: usize, values: &[f64]) -> Vec<u8> {
+        let npnts = 4 * layers;
+        assert_eq!(values.len(), npnts);
+        let mut b = vec![0u8; BIN_HEADER + WAVE_HEADER];
+        b[0..2].copy_from_slice(&5i16.to_le_bytes());
+        let wfm = (WAVE_HEADER + 8 * npnts) as i32;
+        b[4..8].copy_from_slice(&wfm.to_le_bytes());
+        let w = BIN_HEADER;
+        b[w + 12..w + 16].copy_from_slice(&(npnts as i32).to_le_bytes());
+        b[w + 16..w + 18].copy_from_slice(&4i16.to_le_bytes());
+        let dims = [2i32, 2, if layers > 1 { layers as i32 } else { 0 }, 0];
+        for (k, d) in dims.iter().enumerate() {
+            b[w + 68 + 4 * k..w + 72 + 4 * k].copy_from_slice(&d.to_le_bytes());
+        }
+        for k in 0..2 {
+            b[w + 84 + 8 * k..w + 92 + 8 * k].copy_from_slice(&1e-6f64.to_le_bytes());
+        }
+        b[w + 148..w + 148 + unit.len()].copy_from_slice(unit.as_bytes());
+        b[w + 152] = b'm';
+        for v in values {
+            b.extend(v.to_le_bytes());
+        }
+        b
+    }
+
+    #[test]
+    fn a_single_unlabelled_layer_is_read_whatever_its_name() {
+        let p = Path::new("one.ibw");
+        let values = [1e-9, 2e-9, 3e-9, 4e-9];
+        let m = read(p, &wave("", 1, &values), None).unwrap();
+        assert_eq!(m.channel, "layer 0");
+        assert_eq!((m.nx(), m.ny()), (2, 2));
+        assert_eq!(m.heights[[1, 0]], 3e-9);
+        assert_eq!((m.dx_m, m.dy_m), (1e-6, 1e-6));
+        let nm = read(p, &wave("nm", 1, &values), None).unwrap();
+        assert!((nm.heights[[0, 1]] - 2e-18).abs() < 1e-30);
+        // One layer in volts is no height map, named or not.
+        let err = read(p, &wave("V", 1, &values), None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("one.ibw") && err.contains("'V', not a length"),
+            "{err}"
+        );
+        // Of two unlabelled layers neither is chosen by itself.
+        let two = read(p, &wave("", 2, &[0.0; 8]), None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            two.contains("no height channel") && two.contains("'layer 1'"),
+            "{two}"
+        );
+        assert_eq!(
+            read(p, &wave("", 2, &[0.0; 8]), Some("layer 1"))
+                .unwrap()
+                .channel,
+            "layer 1"
+        );
+    }
 }

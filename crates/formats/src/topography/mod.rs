@@ -43,9 +43,10 @@
 //! points (a contact calculation needs every height), naming the count.
 //!
 //! **Channels**: [`read`] takes an optional channel name. An exact (case-insensitive) match wins,
-//! else the first channel whose name contains the request; without one, the first channel whose
-//! values are heights (a length unit, or a name with "height", "topograph" or "z-axis"). When no
-//! channel matches, the error lists them all.
+//! else the first channel whose name contains the request; without one, the only channel of a
+//! one-channel file whatever its name, else the first channel whose values are heights (a length
+//! unit, or a name with "height", "topograph" or "z-axis"). When no channel matches, the error
+//! lists them all. The chosen channel's unit must still be a length.
 
 pub mod frt;
 pub mod gwy;

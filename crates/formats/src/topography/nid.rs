@@ -142,7 +142,7 @@ mod tests {
         assert!(m.heights[[0, 1]].abs() < 1e-20);
         assert_eq!((m.dx_m, m.dy_m), (2e-6, 1e-6));
         let err = read(p, &nid("V"), None).unwrap_err().to_string();
-        assert!(err.contains("no height channel"), "{err}");
+        assert!(err.contains("'V', not a length"), "{err}");
         let truncated = nid("m");
         assert!(read(p, &truncated[..truncated.len() - 1], None).is_err());
     }

@@ -257,6 +257,9 @@ pub(crate) fn choose(
                     )
                 })
         }
+        // A file of one channel holds nothing else to choose: its channel is read whatever its
+        // name (the reader still refuses a unit that is not a length).
+        None if channels.len() == 1 => Ok(0),
         None => channels.iter().position(|c| c.height).ok_or_else(|| {
             bad(
                 path,
@@ -386,7 +389,15 @@ mod tests {
             err.contains("'Amplitude', 'HeightTrace', 'HeightRetrace'"),
             "{err}"
         );
-        assert!(choose(p, &entries(&[("Phase", false)]), None).is_err());
+        // One channel is read whatever its name; of several, a height channel is needed.
+        assert_eq!(choose(p, &entries(&[("layer 0", false)]), None).unwrap(), 0);
+        let two = entries(&[("layer 0", false), ("layer 1", false)]);
+        let err = choose(p, &two, None).unwrap_err().to_string();
+        assert!(
+            err.contains("no height channel") && err.contains("a.ibw"),
+            "{err}"
+        );
+        assert!(choose(p, &entries(&[]), None).is_err());
     }
 
     #[test]

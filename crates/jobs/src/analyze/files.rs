@@ -176,10 +176,8 @@ pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
     if let Some(f) = fits.power_law {
         curves.push(Curve {
             label: format!(
-                "power law A ∝ N^β, β = {:.3}{}",
-                f.exponent,
-                f.exponent_se
-                    .map_or(String::new(), |s| format!(" ± {s:.3}"))
+                "power law A ∝ N^β, β = {}",
+                crate::table::value_pm_or(f.exponent, f.exponent_se, 3)
             ),
             xy: grid.iter().map(|&n| (n, f.eval(n))).collect(),
         });

@@ -362,15 +362,12 @@ fn inputs_table(s: &mut String, p: &DemoParams) {
 fn recovered_table(s: &mut String, recovered: &[Recovered]) {
     s.push_str("<h2>Recovered</h2>\n<table>\n<tr><th>quantity</th><th>truth</th><th>recovered</th><th>error</th><th>by</th></tr>\n");
     for r in recovered {
-        let unc = r
-            .uncertainty
-            .map_or(String::new(), |u| format!(" ± {u:.3}"));
+        let recovered = crate::table::value_pm_or(r.recovered, r.uncertainty, 3);
         let _ = writeln!(
             s,
-            "<tr><td>{}</td><td>{:.3} {u}</td><td>{:.3}{unc} {u}</td><td>{:+.1} %</td><td><code>{}</code></td></tr>",
+            "<tr><td>{}</td><td>{:.3} {u}</td><td>{recovered} {u}</td><td>{:+.1} %</td><td><code>{}</code></td></tr>",
             escape(&r.quantity),
             r.truth,
-            r.recovered,
             100.0 * r.relative_error(),
             escape(&r.by),
             u = escape(&r.unit),
@@ -439,16 +436,12 @@ fn fits_table(s: &mut String, fits: &[ModelFit]) {
     for fit in fits {
         let parameter = match (fit.family, fit.best.parameter) {
             (Family::Hardening, Some(k)) => format!(
-                "k = {:.2}{} MPa/nm",
-                k * 1e-15,
-                fit.parameter_se
-                    .map_or(String::new(), |e| format!(" ± {:.2}", e * 1e-15))
+                "k = {} MPa/nm",
+                crate::table::value_pm_or(k * 1e-15, fit.parameter_se.map(|e| e * 1e-15), 2)
             ),
             (Family::Hardness, Some(p)) => format!(
-                "p<sub>Y</sub> = {:.0}{} MPa",
-                p * 1e-6,
-                fit.parameter_se
-                    .map_or(String::new(), |e| format!(" ± {:.0}", e * 1e-6))
+                "p<sub>Y</sub> = {} MPa",
+                crate::table::value_pm_or(p * 1e-6, fit.parameter_se.map(|e| e * 1e-6), 0)
             ),
             _ => "none".into(),
         };

@@ -82,9 +82,8 @@ fn fit_chart(outcome: &HertzOutcome) -> crate::plot::Chart {
         }],
         curves: vec![Curve {
             label: format!(
-                "Hertz, E* = {:.3} ± {:.3} GPa",
-                fit.e_star_pa * 1e-9,
-                fit.e_star_se_pa * 1e-9
+                "Hertz, E* = {} GPa",
+                crate::table::value_pm(fit.e_star_pa * 1e-9, fit.e_star_se_pa * 1e-9)
             ),
             xy: curve,
         }],

@@ -82,6 +82,9 @@ impl Serialize for SeriesJson<'_> {
         m.serialize_entry("dtype", &series.dtype)?;
         m.serialize_entry("pixel_size_um", &VoxelJson(series))?;
         m.serialize_entry("pixel_size_source", &series.pixel_size_source)?;
+        if !series.rows.is_y() {
+            m.serialize_entry("rows", &series.rows)?;
+        }
         if let Some(planes) = &series.planes {
             m.serialize_entry("planes", planes)?;
         }

@@ -1,7 +1,5 @@
 //! Line-and-marker charts with units on both axes, drawn with plotters to PNG or SVG.
 
-use std::cell::Cell;
-
 use std::sync::OnceLock;
 
 use plotters::coord::ranged1d::ValueFormatter;
@@ -183,9 +181,11 @@ impl Chart {
             .y_label_area_size(80);
         match self.axes {
             Axes::LogLog => {
-                let chart = builder
-                    .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-                    .map_err(plot_err)?;
+                // Our own ticks: plotters' log key points start at the first power of ten
+                // inside the range, leaving the lowest points of an axis unlabelled.
+                let x = (x0..x1).log_scale().with_key_points(log_ticks(x0, x1));
+                let y = (y0..y1).log_scale().with_key_points(log_ticks(y0, y1));
+                let chart = builder.build_cartesian_2d(x, y).map_err(plot_err)?;
                 self.draw(chart, data)
             }
             Axes::Linear => {
@@ -214,25 +214,17 @@ impl Chart {
             .label_style((FONT, 15))
             .axis_desc_style((FONT, 18));
         let log = matches!(self.axes, Axes::LogLog);
-        // plotters lists each power of ten twice among many log key points: label it once.
-        let (x_last, y_last) = (Cell::new(f64::NAN), Cell::new(f64::NAN));
         let x_label = |v: &f64| match log {
-            true if x_last.replace(*v) == *v => String::new(),
-            true => log_tick_label(*v, data.x_range),
+            true => tick_label(*v),
             false => tick_label(snap_zero(*v, data.x_range)),
         };
         let y_label = |v: &f64| match log {
-            true if y_last.replace(*v) == *v => String::new(),
-            true => log_tick_label(*v, data.y_range),
+            true => tick_label(*v),
             false => tick_label(snap_zero(*v, data.y_range)),
         };
         if log {
-            // plotters labels log axes only at powers of ten unless asked for many key points;
-            // it then puts one at every 1…9 × 10^k, and `log_tick_label` keeps the readable ones.
-            mesh.x_labels(LOG_KEY_POINTS)
-                .y_labels(LOG_KEY_POINTS)
-                .max_light_lines(0)
-                .bold_line_style(BLACK.mix(0.15));
+            // The key points are `log_ticks`, every one labelled, with a light grid line.
+            mesh.max_light_lines(0).bold_line_style(BLACK.mix(0.15));
         }
         mesh.x_label_formatter(&x_label)
             .y_label_formatter(&y_label)
@@ -313,14 +305,21 @@ fn padded_ranges<'a>(points: impl Iterator<Item = &'a (f64, f64)>, axes: Axes) -
     Ok((pad(x0, x1)?, pad(y0, y1)?))
 }
 
-/// Pads `lo..hi` by ×0.8 / ×1.25. A range inside one decade is widened down to the power of ten
-/// below it, because plotters puts log-axis ticks only from a power of ten upwards and would
-/// otherwise leave the axis without any labels.
+/// Pads `lo..hi` by ×0.8 / ×1.25, so that markers are not cut by the frame, and each end out to
+/// a 1, 2 or 5 × 10^k within a further factor 1.3 (so that the axis starts and ends at a label
+/// where that costs little room). A range too narrow for two [`log_ticks`] is widened out to
+/// the nearest 1…9 × 10^k on either side, so that every log axis has at least two labels.
 fn pad_log(lo: f64, hi: f64) -> Result<(f64, f64)> {
-    let (mut a, b) = (lo * 0.8, hi * 1.25);
-    let decade = 10f64.powf(a.log10().floor());
-    if decade > 0.0 && decade * 10.0 > b {
-        a = decade;
+    let (mut a, mut b) = (lo * 0.8, hi * 1.25);
+    let (a125, b125) = (snap_125(a, false), snap_125(b, true));
+    if a125 > 0.0 && a125 * 1.3 >= a {
+        a = a125;
+    }
+    if b125.is_finite() && b125 <= b * 1.3 {
+        b = b125;
+    }
+    if a > 0.0 && b.is_finite() && a < b && log_ticks(a, b).len() < 2 {
+        (a, b) = (round_mantissa(a, f64::floor), round_mantissa(b, f64::ceil));
     }
     if a > 0.0 && b.is_finite() && a < b {
         Ok((a, b))
@@ -362,34 +361,65 @@ fn snap_zero(v: f64, (lo, hi): (f64, f64)) -> f64 {
     }
 }
 
-/// Key points asked of a log axis: enough for a tick at every 1…9 × 10^k over the few
-/// decades a chart spans (plotters fills in 9 per decade once asked for 10 per decade).
-const LOG_KEY_POINTS: usize = 100;
+/// Decades beyond which a log axis is labelled at powers of ten only.
+const LOG_DECADES_125: f64 = 4.0;
+/// Most labels on a log axis spanning many decades (every n-th power of ten beyond).
+const LOG_MAX_DECADE_LABELS: usize = 12;
 
-/// The label of a log-axis tick at `v`: 1, 2 and 5 × 10^k over up to three decades (1 × 10^k
-/// only beyond, every integer mantissa within one), empty for the other ticks.
-fn log_tick_label(v: f64, (lo, hi): (f64, f64)) -> String {
-    if v.is_nan() || v <= 0.0 {
-        return String::new();
+/// The labelled ticks of a log axis over `lo..hi` (both positive), increasing: 1, 2 and
+/// 5 × 10^k in every decade the range touches (10^k only when it spans more than four
+/// decades, every n-th of them beyond a dozen), or every integer mantissa 1…9 × 10^k when
+/// 1-2-5 leaves fewer than two inside the range. Empty for an empty or non-positive range.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && hi.is_finite() && lo < hi) {
+        return Vec::new();
     }
     let decades = (hi / lo).log10();
-    let mantissa = v / 10f64.powf(v.log10().floor());
-    let nearest = mantissa.round();
-    if (mantissa - nearest).abs() > 1e-6 * mantissa {
-        return String::new();
-    }
-    let shown: &[f64] = if decades <= 1.2 {
-        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
-    } else if decades <= 3.5 {
-        &[1.0, 2.0, 5.0]
-    } else {
-        &[1.0]
+    let ladder = |mantissas: &[f64], every: i32| -> Vec<f64> {
+        let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        let tolerance = 1e-9;
+        (k0..=k1)
+            .filter(|k| k.rem_euclid(every) == 0)
+            .flat_map(|k| mantissas.iter().map(move |m| m * 10f64.powi(k)))
+            .filter(|v| *v >= lo * (1.0 - tolerance) && *v <= hi * (1.0 + tolerance))
+            .collect()
     };
-    if shown.contains(&nearest) || nearest == 10.0 {
-        tick_label(v)
-    } else {
-        String::new()
+    if decades > LOG_DECADES_125 {
+        let every = (decades / LOG_MAX_DECADE_LABELS as f64).ceil().max(1.0) as i32;
+        return ladder(&[1.0], every);
     }
+    let ticks = ladder(&[1.0, 2.0, 5.0], 1);
+    if ticks.len() >= 2 {
+        return ticks;
+    }
+    ladder(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0], 1)
+}
+
+/// The nearest 1, 2 or 5 × 10^k at or below `v` (`up` false) or at or above it.
+fn snap_125(v: f64, up: bool) -> f64 {
+    let decade = 10f64.powf(v.log10().floor());
+    let steps = [0.5, 1.0, 2.0, 5.0, 10.0, 20.0].map(|m| m * decade);
+    let near = |t: f64| (t - v).abs() <= 1e-9 * v;
+    if up {
+        steps.into_iter().find(|&t| t >= v || near(t))
+    } else {
+        steps.into_iter().rev().find(|&t| t <= v || near(t))
+    }
+    .unwrap_or(v)
+}
+
+/// `v` rounded down (`f64::floor`) or up (`f64::ceil`) to a one-digit mantissa: 1…9 × 10^k.
+fn round_mantissa(v: f64, round: fn(f64) -> f64) -> f64 {
+    let decade = 10f64.powf(v.log10().floor());
+    let mantissa = v / decade;
+    // A mantissa that is an integer up to rounding (300 / 100 = 2.9999…) stays that integer.
+    let nearest = mantissa.round();
+    let digit = if (mantissa - nearest).abs() < 1e-9 {
+        nearest
+    } else {
+        round(mantissa)
+    };
+    digit * decade
 }
 
 /// Tick text without floating-point noise: plain decimals for moderate magnitudes, otherwise
@@ -571,35 +601,97 @@ mod tests {
     }
 
     #[test]
-    fn ranges_are_padded_and_reach_a_power_of_ten() {
+    fn ranges_are_padded_and_keep_two_labels() {
         assert_eq!(pad_log(1.0, 100.0).unwrap(), (0.8, 125.0));
+        // 2…4e-10 padded to 1.6…5e-10 holds 2e-10 and 5e-10: nothing more to do.
         let (a, b) = pad_log(2.0e-10, 4.0e-10).unwrap();
         assert!(
-            (a - 1e-10).abs() < 1e-22 && (b - 5e-10).abs() < 1e-22,
+            (a - 1.6e-10).abs() < 1e-22 && (b - 5e-10).abs() < 1e-22,
             "{a} {b}"
         );
+        // 1.1…1.15 padded to 0.88…1.44 holds only 0.9 and 1: two labels, no widening.
+        assert_eq!(log_ticks(0.88, 1.4375).len(), 2);
+        // 11.5…12 padded to 9.2…15 holds 10 alone: widened to 9…20.
+        let (a, b) = pad_log(11.5, 12.0).unwrap();
+        assert!(
+            (a - 9.0).abs() < 1e-12 && (b - 20.0).abs() < 1e-12,
+            "{a} {b}"
+        );
+        // Every padded range holds its data and has at least two labelled ticks.
+        for i in 0..400 {
+            let lo = 10f64.powf(f64::from(i) * 0.037 - 6.0);
+            for ratio in [1.0, 1.01, 1.3, 2.5, 9.0, 40.0, 1e3, 1e7] {
+                let hi = lo * ratio;
+                let (a, b) = pad_log(lo, hi).unwrap();
+                assert!(a <= lo && b >= hi, "{lo} {hi}: {a} {b}");
+                let ticks = log_ticks(a, b);
+                assert!(ticks.len() >= 2, "{lo}…{hi} padded to {a}…{b}: {ticks:?}");
+                assert!(ticks.windows(2).all(|w| w[0] < w[1]), "{ticks:?}");
+            }
+        }
+        // Ends within a factor 1.3 of a 1-2-5 tick move out to it: 20.9…775 → 20…1000.
+        let (a, b) = pad_log(26.1, 620.0).unwrap();
+        assert!(
+            (a - 20.0).abs() < 1e-12 && (b - 1000.0).abs() < 1e-9,
+            "{a} {b}"
+        );
+        assert_eq!(snap_125(0.3, true), 0.5);
+        assert_eq!(snap_125(0.3, false), 0.2);
+        assert_eq!(snap_125(200.0, false), 200.0);
         assert!(pad_log(1.0, f64::MAX).is_err());
         assert_eq!(pad_linear(0.0, 10.0).unwrap(), (-0.5, 10.5));
         assert_eq!(pad_linear(0.0, 0.0).unwrap(), (-1.0, 1.0));
         assert!(pad_linear(-f64::MAX, f64::MAX).is_err());
     }
 
+    fn labels(lo: f64, hi: f64) -> Vec<String> {
+        log_ticks(lo, hi).into_iter().map(tick_label).collect()
+    }
+
     #[test]
-    fn log_ticks_are_labelled_at_one_two_five() {
-        let two_decades = (3.0, 500.0);
-        let labels: Vec<String> = [5.0, 6.0, 10.0, 20.0, 30.0, 50.0, 100.0, 200.0, 300.0]
-            .iter()
-            .map(|&v| log_tick_label(v, two_decades))
-            .collect();
-        assert_eq!(labels, ["5", "", "10", "20", "", "50", "100", "200", ""]);
-        // Over many decades only the powers of ten; within one, every integer mantissa.
-        assert_eq!(log_tick_label(2.0, (1.0, 1e6)), "");
-        assert_eq!(log_tick_label(1000.0, (1.0, 1e6)), "1000");
-        assert_eq!(log_tick_label(3.0, (2.0, 8.0)), "3");
-        // Not a key point of a 1…9 × 10^k ladder, or not positive: no label.
-        assert_eq!(log_tick_label(2.5, two_decades), "");
-        assert_eq!(log_tick_label(0.0, two_decades), "");
-        assert_eq!(log_tick_label(f64::NAN, two_decades), "");
+    fn log_ticks_are_one_two_five_in_every_decade_the_data_cover() {
+        // The areas of the synthetic series, 37…620 µm²: 50 is labelled, below 100.
+        assert_eq!(labels(37.0, 620.0), ["50", "100", "200", "500"]);
+        assert_eq!(labels(4.0, 400.0), ["5", "10", "20", "50", "100", "200"]);
+        assert_eq!(labels(3.2, 125.0), ["5", "10", "20", "50", "100"]);
+        assert_eq!(
+            labels(0.0015, 0.3),
+            ["0.002", "0.005", "0.01", "0.02", "0.05", "0.1", "0.2"]
+        );
+        // Ends that are ticks are kept despite rounding.
+        assert_eq!(labels(1.0, 10.0), ["1", "2", "5", "10"]);
+        // Within less than a factor of 2.5: every integer mantissa.
+        assert_eq!(labels(30.0, 70.0), ["30", "40", "50", "60", "70"]);
+        // Over more than four decades, powers of ten only; over very many, every n-th.
+        assert_eq!(labels(0.5, 2e5), ["1", "10", "100", "1000", "10000", "1e5"]);
+        assert_eq!(log_ticks(1e-9, 1e-2).len(), 8);
+        let wide = log_ticks(1e-100, 1e100);
+        assert!(wide.len() <= 13 && wide.len() >= 8, "{}", wide.len());
+        // No ticks for a range no log axis shows.
+        assert!(log_ticks(0.0, 1.0).is_empty());
+        assert!(log_ticks(2.0, 1.0).is_empty());
+        assert!(log_ticks(1.0, f64::INFINITY).is_empty());
+        assert_eq!(round_mantissa(0.0123, f64::floor), 0.01);
+        assert!((round_mantissa(0.0123, f64::ceil) - 0.02).abs() < 1e-15);
+        assert_eq!(round_mantissa(300.0, f64::ceil), 300.0);
+    }
+
+    #[test]
+    fn log_axis_labels_reach_below_the_first_power_of_ten() {
+        // Areas 37…620 µm² (forces 4…100 mN): labels on both sides of 100 µm² and of 10 mN.
+        let chart = Chart {
+            axes: Axes::LogLog,
+            points: vec![PointSet {
+                label: String::new(),
+                xy: vec![(4.0, 37.5), (10.0, 85.4), (100.0, 620.2)],
+            }],
+            ..Chart::default()
+        };
+        let svg = chart.to_svg().unwrap();
+        let texts: Vec<&str> = svg.lines().filter(|l| !l.starts_with('<')).collect();
+        for label in ["5", "10", "20", "50", "100", "200", "500"] {
+            assert!(texts.contains(&label), "no tick label {label}: {texts:?}");
+        }
     }
 
     #[test]
