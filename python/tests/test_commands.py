@@ -271,7 +271,7 @@ def test_synth_series_matches_cli(cli, tmp_path):
                                                                  100)], rel=1e-15)
     with pytest.raises(cs.InputError, match="pixel_size="):
         cs.synth_series(pixel_size=-1.0)
-    with pytest.raises(cs.InputError, match="loads="):
+    with pytest.raises(cs.InputError, match="forces="):
         cs.synth_series(forces=[1e3])
     # The generator's own refusal, as the command line's.
     with pytest.raises(cs.InputError, match="more than half"):

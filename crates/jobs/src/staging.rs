@@ -78,9 +78,10 @@ impl Staging {
     /// Make the staged files the output folder, replacing an earlier run's folder as a whole
     /// (module docs): all of them, or nothing.
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {
+        // In the order written (a name written twice counts once).
         let mut names = std::mem::take(&mut *self.files.lock().expect("lock"));
-        names.sort();
-        names.dedup();
+        let mut seen = std::collections::HashSet::new();
+        names.retain(|n| seen.insert(n.clone()));
         let marker = serde_json::json!({
             "written_by": format!("contactscope {}", env!("CARGO_PKG_VERSION")),
             "files": names,
