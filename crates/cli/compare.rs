@@ -105,6 +105,15 @@ pub fn run(args: Args) -> Result<()> {
         "thresholds: experiment {:.1}, simulation {:.4} (blurred contact fraction)",
         outcome.experiment_threshold, outcome.simulated_threshold
     );
+    let r = &outcome.series_registration;
+    println!(
+        "series registration: {}, shift ({:.2}, {:.2}) px, mean correlation peak {:.3}; each load refined within ±{} px",
+        r.transform.name(),
+        r.shift_px.0,
+        r.shift_px.1,
+        r.correlation_peak,
+        r.window_px
+    );
     println!(
         "{:>10} {:>10} {:>12} {:>12} {:>7} {:>7} {:>6}",
         "force_mN", "transform", "A_exp_µm²", "A_sim_µm²", "Dice", "Jaccard", "peak"
