@@ -109,20 +109,30 @@ pub fn run(args: Args) -> Result<()> {
         "thresholds: experiment {:.1}, simulation {:.4} (blurred contact fraction)",
         outcome.experiment_threshold, outcome.simulated_threshold
     );
+    let r = &outcome.series_registration;
     println!(
-        "{:>10} {:>10} {:>12} {:>12} {:>7} {:>7} {:>6}",
-        "force_mN", "transform", "A_exp_µm²", "A_sim_µm²", "Dice", "Jaccard", "peak"
+        "series registration: {}, shift ({:.2}, {:.2}) px, mean correlation peak {:.3}; each load refined within ±{} px",
+        r.transform.name(),
+        r.shift_px.0,
+        r.shift_px.1,
+        r.correlation_peak,
+        r.window_px
+    );
+    println!(
+        "{:>10} {:>16} {:>12} {:>12} {:>7} {:>7} {:>6}  refinement",
+        "force_mN", "shift_px", "A_exp_µm²", "A_sim_µm²", "Dice", "Jaccard", "peak"
     );
     for l in &outcome.loads {
         println!(
-            "{:>10.3} {:>10} {:>12.2} {:>12.2} {:>7.3} {:>7.3} {:>6.3}",
+            "{:>10.3} {:>16} {:>12.2} {:>12.2} {:>7.3} {:>7.3} {:>6.3}  {}",
             l.force_n * 1e3,
-            l.transform.name(),
+            format!("({:.2}, {:.2})", l.shift_px.0, l.shift_px.1),
             l.experiment_area_m2 * 1e12,
             l.simulated_area_m2 * 1e12,
             l.dice,
             l.jaccard,
-            l.correlation_peak
+            l.correlation_peak,
+            l.refinement.name()
         );
     }
     print_written(written.len(), &args.out.out);

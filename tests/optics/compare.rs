@@ -156,6 +156,36 @@ fn recovers_the_offset_and_overlaps_the_simulation() {
         serde_json::from_str(&fs::read_to_string(out.join("compare.json")).unwrap()).unwrap();
     assert_eq!(summary["loads_matched"], 3);
     assert_eq!(summary["psf_fwhm_nm"].as_f64().unwrap().round(), 450.0);
+    // One shift for the series, each load refined near it; shifts in µm at 200 nm pixels.
+    let f = |v: &serde_json::Value| v.as_f64().unwrap();
+    let series = &summary["series_registration"];
+    assert_eq!(series["transform"], "identity");
+    assert_eq!(series["window_px"], 3);
+    assert!(
+        (f(&series["shift_x_px"]) - 7.0).abs() <= 0.1
+            && (f(&series["shift_y_px"]) + 4.0).abs() <= 0.1,
+        "{series}"
+    );
+    assert!(f(&series["correlation_peak"]) > 0.05, "{series}");
+    let loads = summary["loads"].as_array().unwrap();
+    for item in loads.iter().chain([series]) {
+        for axis in ["x", "y"] {
+            let (px, um) = (
+                f(&item[format!("shift_{axis}_px")]),
+                f(&item[format!("shift_{axis}_um")]),
+            );
+            assert!((um - 0.2 * px).abs() < 1e-9, "{item}");
+        }
+    }
+    for l in loads {
+        assert_eq!(l["refinement"], "refined", "{l}");
+        assert!(f(&l["correlation_peak"]) > 0.05, "{l}");
+    }
+    assert!(
+        summary["warnings"].as_array().unwrap().is_empty(),
+        "{}",
+        summary["warnings"]
+    );
 }
 
 #[test]
@@ -176,6 +206,9 @@ fn a_mirrored_micrograph_needs_the_dihedral_search() {
     let (header, rows) = read_csv(&with.join("compare.csv"));
     let t = header.iter().position(|h| h == "transform").unwrap();
     assert!(rows.iter().all(|r| r[t] == "flip-x"), "{rows:?}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(with.join("compare.json")).unwrap()).unwrap();
+    assert_eq!(summary["series_registration"]["transform"], "flip-x");
     let dice_with = column(&header, &rows, "dice");
     assert!(dice_with.iter().all(|&d| d > 0.85), "{dice_with:?}");
 

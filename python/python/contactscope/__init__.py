@@ -414,8 +414,10 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
 
     Returns the outcome the command line writes as ``compare.json`` (SI units): ``loads`` (per
     matched load: ``force_n``, ``dice``, ``jaccard``, ``experiment_area_m2``,
-    ``simulated_area_m2``, ``shift_x_px``, ``edge_distance_m``, …; also
-    :attr:`Results.rows`), ``dice_mean``, the thresholds and ``warnings``.
+    ``simulated_area_m2``, ``shift_x_px``, ``shift_x_m``, ``correlation_peak``,
+    ``refinement``, ``edge_distance_m``, …; also :attr:`Results.rows`),
+    ``series_registration`` (the one transform and shift of the whole series, each load
+    refined within ``window_px`` of it), ``dice_mean``, the thresholds and ``warnings``.
     """
     if isinstance(micrographs, Series) and pixel_size is None:
         pixel_size = micrographs._pixel_size

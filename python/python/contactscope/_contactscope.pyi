@@ -293,6 +293,17 @@ def newton(
 def blur_and_resample(
     map: npt.NDArray[np.float64], pixel_size: PixelSize, fwhm: float, image_pixel_size: PixelSize
 ) -> npt.NDArray[np.float64]: ...
+class CompareSeriesRegistration(TypedDict):
+    """One transform and shift for the whole series (each load refined within ``window_px``)."""
+
+    transform: str
+    shift_x_px: float
+    shift_y_px: float
+    shift_x_m: float
+    shift_y_m: float
+    correlation_peak: float
+    window_px: int
+
 class CompareResult(TypedDict):
     simulation: str
     psf_fwhm_m: float
@@ -304,6 +315,7 @@ class CompareResult(TypedDict):
     loads_matched: int
     dice_mean: float
     jaccard_mean: float
+    series_registration: CompareSeriesRegistration
     method: Dict[str, str]
     loads: List[Dict[str, Any]]
     warnings: List[str]

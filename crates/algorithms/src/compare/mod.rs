@@ -3,14 +3,17 @@
 //!
 //! Per load present in both (matched by force): the simulated contact map (pixels with g = 0) is
 //! blurred with the PSF and integrated onto the micrograph's pixels ([`crate::optics::blur`]),
-//! placed at the centre of a canvas the size of the micrograph, registered to it by phase
-//! correlation (optionally over the 8 dihedral transforms; [`crate::spectral::register`]), and
-//! both are thresholded: the micrographs with one exact Otsu threshold over the whole experiment
-//! series (as `analyze`), the simulated images with one Otsu threshold over all of them (the
-//! same procedure on the simulated series). Scores are computed on the region the simulation
-//! covers after registration: Dice, Jaccard, the area ratio, their sensitivity to ±10 % of the
-//! experiment's threshold, and the RMS distance between the radially averaged intensity
-//! autocorrelations of the two images.
+//! placed at the centre of a canvas the size of the micrograph, and registered to it by phase
+//! correlation once for the whole series: the sample does not move between loads, so one shift
+//! (and one dihedral transform, when they are searched) comes from the mean cross-power spectrum
+//! of all matched loads, and each load is then refined within ±[`REFINE_WINDOW_PX`] pixels of
+//! it ([`crate::spectral::register::series`]; docs/methods.md §8). Both are thresholded: the
+//! micrographs with one exact Otsu threshold over the whole experiment series (as `analyze`),
+//! the simulated images with one Otsu threshold over all of them (the same procedure on the
+//! simulated series). Scores are computed on the region the simulation covers after
+//! registration: Dice, Jaccard, the area ratio, their sensitivity to ±10 % of the experiment's
+//! threshold, and the RMS distance between the radially averaged intensity autocorrelations of
+//! the two images.
 
 //!
 //! Everything here works on maps and images in memory; the `compare` command's reading of the
@@ -23,7 +26,9 @@ use crate::image::Plane;
 use crate::measure::distance::squared_distance;
 use crate::optics::blur::{microscope_image, Grid, IntensityScale};
 use crate::spectral::autocorrelation::AcfCurve;
-use crate::spectral::register::{register, translate, Dihedral, Shift};
+use crate::spectral::register::{
+    register_series, translate, Dihedral, LoadShift, Refinement, SeriesOptions,
+};
 use crate::threshold::otsu_of_values;
 
 /// How simulated maps are imaged, registered and matched to micrographs.
@@ -88,12 +93,18 @@ pub struct LoadComparison {
     pub micrograph: (PathBuf, usize),
     /// Where the simulated map came from.
     pub simulated_map: String,
-    /// Transform applied to the simulated image.
+    /// Transform applied to the simulated image (the series').
     pub transform: Dihedral,
-    /// Translation applied after the transform, micrograph pixels (x, y).
+    /// Translation applied after the transform, micrograph pixels (x, y): the series shift
+    /// refined for this load.
     pub shift_px: (f64, f64),
-    /// Normalised phase-correlation peak (1 = perfect).
+    /// The same translation, m (x, y).
+    pub shift_m: (f64, f64),
+    /// This load's normalised phase correlation at its shift (1 = perfect).
     pub correlation_peak: f64,
+    /// Where the shift comes from: the load's own peak near the series shift, or the series
+    /// shift itself (the load's peak too weak, or on the window's edge).
+    pub refinement: Refinement,
     /// Experimental contact area inside the compared region, m².
     pub experiment_area_m2: f64,
     /// Blurred-and-thresholded simulated contact area inside the region, m².
@@ -130,7 +141,7 @@ pub struct Prepared {
     simulated: Vec<f64>,
     footprint: Vec<bool>,
     transform: Dihedral,
-    shift: Shift,
+    shift: LoadShift,
     raw_area_m2: f64,
 }
 
@@ -171,8 +182,30 @@ impl Prepared {
     }
 }
 
-/// Below this correlation peak a registration is reported as doubtful.
+/// Below this peak of the series' mean correlation surface the registration is reported as
+/// doubtful; below it, a load's own peak does not move the load away from the series shift (on
+/// the demo's 432² micrographs, the highest point of a load whose map matches nowhere is 0.011).
 const WEAK_PEAK: f64 = 0.05;
+
+/// Half-width, micrograph pixels, of the window around the series shift within which each load's
+/// registration is refined (a load cannot move further from the others).
+pub const REFINE_WINDOW_PX: usize = 3;
+
+/// The series registration: one transform and one shift for every load.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SeriesShift {
+    /// Transform applied to every simulated image.
+    pub transform: Dihedral,
+    /// The series shift applied to the simulated images, micrograph pixels (x, y).
+    pub shift_px: (f64, f64),
+    /// The same, m (x, y).
+    pub shift_m: (f64, f64),
+    /// Peak of the mean phase-correlation surface of the matched loads (the mean of their
+    /// normalised correlations at the series shift; 1 = perfect).
+    pub correlation_peak: f64,
+    /// Half-width of the per-load refinement window, micrograph pixels.
+    pub window_px: usize,
+}
 
 /// The result of [`compare_maps`].
 #[derive(Debug, Clone)]
@@ -181,6 +214,8 @@ pub struct Comparison {
     pub loads: Vec<LoadComparison>,
     /// The registered pairs, for panels.
     pub prepared: Vec<Prepared>,
+    /// The series registration.
+    pub registration: SeriesShift,
     /// Otsu threshold of the blurred simulated maps (covered fraction).
     pub simulated_threshold: f64,
     /// The micrographs' series threshold (grey levels); contact is value > t.
@@ -189,7 +224,8 @@ pub struct Comparison {
     pub warnings: Vec<String>,
 }
 
-/// Match, render, register, threshold and score. Errors when no load matches.
+/// Match, render, register (once for the series), threshold and score. Errors when no load
+/// matches or the matched micrographs differ in size.
 pub fn compare_maps(
     micrographs: &Micrographs,
     simulated: &[SimulatedMap],
@@ -197,30 +233,67 @@ pub fn compare_maps(
 ) -> Result<Comparison> {
     let pairs = match_loads(&micrographs.images, simulated, settings.force_tolerance)?;
     let mut warnings = micrographs.warnings.clone();
-    let prepared: Vec<Prepared> = pairs
+    let rendered: Vec<Rendered> = pairs
         .into_iter()
-        .map(|(image, sim)| prepare(settings, micrographs, image, sim))
+        .map(|(image, sim)| render(settings, micrographs, image, sim))
         .collect::<Result<_>>()?;
+    let size = rendered[0].size;
+    let inputs: Vec<(&[f64], &[f64])> = rendered
+        .iter()
+        .map(|r| (r.experiment.as_slice(), r.canvas.as_slice()))
+        .collect();
+    let options = SeriesOptions {
+        upsample: settings.upsample,
+        dihedral: settings.dihedral,
+        window_px: REFINE_WINDOW_PX,
+        min_load_peak: WEAK_PEAK,
+    };
+    let registration = register_series(&inputs, size, &options)?;
+    let pixel = micrographs.pixel_m;
+    let series = registration.series;
+    let registration_summary = SeriesShift {
+        transform: registration.transform,
+        shift_px: (-series.dx, -series.dy),
+        shift_m: (-series.dx * pixel.0, -series.dy * pixel.1),
+        correlation_peak: series.peak,
+        window_px: registration.window_px,
+    };
+    let prepared: Vec<Prepared> = rendered
+        .into_iter()
+        .zip(&registration.loads)
+        .map(|(r, &shift)| r.align(registration.transform, shift))
+        .collect();
     let sim_sets: Vec<Vec<f64>> = prepared.iter().map(inside_footprint).collect();
     let refs: Vec<&[f64]> = sim_sets.iter().map(Vec::as_slice).collect();
     let sim_threshold = otsu_of_values(&refs, "the blurred simulated maps")?;
-    let pixel = micrographs.pixel_m;
     let loads: Vec<LoadComparison> = prepared
         .iter()
         .map(|p| score(p, micrographs.threshold, sim_threshold, pixel))
         .collect::<Result<_>>()?;
-    for l in &loads {
-        if l.correlation_peak < WEAK_PEAK {
-            warnings.push(format!(
-                "{:.3} mN: weak registration (correlation peak {:.3}); check the overlay panel",
-                l.force_n * 1e3,
-                l.correlation_peak
-            ));
-        }
+    if series.peak < WEAK_PEAK {
+        warnings.push(format!(
+            "weak registration of the series (mean correlation peak {:.3} over {} loads, shift ({:.2}, {:.2}) px); check the overlay panels",
+            series.peak,
+            loads.len(),
+            registration_summary.shift_px.0,
+            registration_summary.shift_px.1,
+        ));
+    }
+    for l in loads
+        .iter()
+        .filter(|l| l.refinement == Refinement::WindowEdge)
+    {
+        warnings.push(format!(
+            "{:.3} mN: this load's registration peak lies on the edge of the ±{} px window around the series shift; the series shift is used (correlation {:.3} there); check the overlay panel",
+            l.force_n * 1e3,
+            registration.window_px,
+            l.correlation_peak
+        ));
     }
     Ok(Comparison {
         loads,
         prepared,
+        registration: registration_summary,
         simulated_threshold: sim_threshold,
         experiment_threshold: micrographs.threshold,
         warnings,
@@ -261,15 +334,68 @@ fn match_loads<'a>(
     Ok(pairs)
 }
 
-fn prepare(
+/// A matched pair rendered on the micrograph's grid, before registration.
+struct Rendered {
+    force_n: f64,
+    simulated_force_n: f64,
+    source: String,
+    micrograph: (PathBuf, usize),
+    size: (usize, usize),
+    experiment: Vec<f64>,
+    /// The simulated image centred on a micrograph-sized canvas.
+    canvas: Vec<f64>,
+    /// 1 where the simulation lies on the canvas.
+    frame: Vec<f64>,
+    raw_area_m2: f64,
+}
+
+impl Rendered {
+    /// The simulated image and its footprint transformed and shifted onto the micrograph.
+    fn align(self, transform: Dihedral, shift: LoadShift) -> Prepared {
+        let (w, h) = self.size;
+        let align = |img: &[f64]| {
+            let (t, _, _) = transform.apply(img, w, h);
+            translate(&t, (w, h), (-shift.shift.dx, -shift.shift.dy), 0.0)
+        };
+        let simulated = align(&self.canvas);
+        let footprint = align(&self.frame).iter().map(|&v| v > 0.999).collect();
+        Prepared {
+            force_n: self.force_n,
+            simulated_force_n: self.simulated_force_n,
+            source: self.source,
+            micrograph: self.micrograph,
+            size: self.size,
+            experiment: self.experiment,
+            simulated,
+            footprint,
+            transform,
+            shift,
+            raw_area_m2: self.raw_area_m2,
+        }
+    }
+}
+
+/// The simulated map blurred, resampled and centred on a canvas of the micrograph's size.
+fn render(
     settings: &CompareSettings,
     micrographs: &Micrographs,
     index: usize,
     sim: &SimulatedMap,
-) -> Result<Prepared> {
+) -> Result<Rendered> {
     let image = &micrographs.images[index];
     let plane = &image.plane;
     let (w, h) = (plane.width, plane.height);
+    let first = &micrographs.images[0].plane;
+    let side = 2 * REFINE_WINDOW_PX + 1;
+    if (w, h) != (first.width, first.height) || w.min(h) < side {
+        return Err(Error::bad_input(
+            Location::page(&image.path, image.page),
+            format!(
+                "the micrograph is {w}×{h} pixels; registering a series needs micrographs of one size (the first is {}×{}) and at least {side}×{side} pixels",
+                first.width, first.height
+            ),
+        ));
+    }
     let at = || Location::file(&sim.source);
     let raw_area_m2 = sim.map.integral();
     let rendered = microscope_image(&sim.map, settings.psf_fwhm_m, micrographs.pixel_m)
@@ -284,32 +410,15 @@ fn prepare(
         ));
     }
     let (canvas, frame) = centred(&rendered, w, h);
-    let experiment = plane.to_f64();
-    let (transform, shift) = register(
-        &experiment,
-        &canvas,
-        (w, h),
-        settings.upsample,
-        settings.dihedral,
-    )
-    .map_err(|e| Error::bad_input(Location::page(&image.path, image.page), e.to_string()))?;
-    let align = |img: &[f64]| {
-        let (t, _, _) = transform.apply(img, w, h);
-        translate(&t, (w, h), (-shift.dx, -shift.dy), 0.0)
-    };
-    let simulated = align(&canvas);
-    let footprint = align(&frame).iter().map(|&v| v > 0.999).collect();
-    Ok(Prepared {
+    Ok(Rendered {
         force_n: image.force_n.unwrap_or(f64::NAN),
         simulated_force_n: sim.force_n,
         source: sim.source.clone(),
         micrograph: (image.path.clone(), image.page),
         size: (w, h),
-        experiment,
-        simulated,
-        footprint,
-        transform,
-        shift,
+        experiment: plane.to_f64(),
+        canvas,
+        frame,
         raw_area_m2,
     })
 }
@@ -445,8 +554,10 @@ fn score(p: &Prepared, t_exp: f64, t_sim: f64, pixel: (f64, f64)) -> Result<Load
         micrograph: p.micrograph.clone(),
         simulated_map: p.source.clone(),
         transform: p.transform,
-        shift_px: (-p.shift.dx, -p.shift.dy),
-        correlation_peak: p.shift.peak,
+        shift_px: (-p.shift.shift.dx, -p.shift.shift.dy),
+        shift_m: (-p.shift.shift.dx * pixel.0, -p.shift.shift.dy * pixel.1),
+        correlation_peak: p.shift.shift.peak,
+        refinement: p.shift.refinement,
         experiment_area_m2: counts.0 as f64 * pixel_area,
         simulated_area_m2: counts.1 as f64 * pixel_area,
         simulated_raw_area_m2: p.raw_area_m2,
@@ -472,6 +583,7 @@ fn score(p: &Prepared, t_exp: f64, t_sim: f64, pixel: (f64, f64)) -> Result<Load
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spectral::register::Shift;
 
     fn bands(a: std::ops::Range<usize>, b: std::ops::Range<usize>) -> Prepared {
         let (w, h) = (16, 6);
@@ -490,10 +602,13 @@ mod tests {
             simulated: band(&b),
             footprint: vec![true; w * h],
             transform: Dihedral::IDENTITY,
-            shift: Shift {
-                dx: 0.0,
-                dy: 0.0,
-                peak: 1.0,
+            shift: LoadShift {
+                shift: Shift {
+                    dx: 0.0,
+                    dy: 0.0,
+                    peak: 1.0,
+                },
+                refinement: Refinement::Refined,
             },
             raw_area_m2: 0.0,
         }

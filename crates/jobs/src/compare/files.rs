@@ -26,10 +26,7 @@ pub fn run_to_folder(
     let (series, micrographs) = load_micrographs(&request.micrographs, request.pixel_size_m)?;
     let outcome = run_with(request, &micrographs)?;
     let staging = Staging::new(out_dir, &input_files(request, &series))?;
-    staging.write(
-        "compare.csv",
-        compare_csv(&outcome.loads, outcome.pixel_m)?.as_bytes(),
-    )?;
+    staging.write("compare.csv", compare_csv(&outcome.loads)?.as_bytes())?;
     #[cfg(feature = "plots")]
     for (i, p) in outcome.prepared.iter().enumerate() {
         staging.write(
@@ -53,7 +50,7 @@ fn panel(p: &Prepared, load: &LoadComparison, t_exp: f64) -> Result<Vec<u8>> {
     crate::plot::edge_panels_png(&[p.micrograph(), &simulated], w, h, &mask, scale)
 }
 
-fn compare_csv(loads: &[LoadComparison], pixel: (f64, f64)) -> Result<String> {
+fn compare_csv(loads: &[LoadComparison]) -> Result<String> {
     csv_text(|w| {
         w.write_record([
             "force_mN",
@@ -64,6 +61,7 @@ fn compare_csv(loads: &[LoadComparison], pixel: (f64, f64)) -> Result<String> {
             "shift_x_um",
             "shift_y_um",
             "correlation_peak",
+            "refinement",
             "experiment_area_um2",
             "simulated_area_um2",
             "simulated_raw_area_um2",
@@ -89,9 +87,10 @@ fn compare_csv(loads: &[LoadComparison], pixel: (f64, f64)) -> Result<String> {
                 l.transform.name(),
                 format!("{:.3}", l.shift_px.0),
                 format!("{:.3}", l.shift_px.1),
-                format!("{:.4}", l.shift_px.0 * pixel.0 * 1e6),
-                format!("{:.4}", l.shift_px.1 * pixel.1 * 1e6),
+                format!("{:.4}", l.shift_m.0 * 1e6),
+                format!("{:.4}", l.shift_m.1 * 1e6),
                 format!("{:.4}", l.correlation_peak),
+                l.refinement.name().to_string(),
                 format!("{:.4}", l.experiment_area_m2 * 1e12),
                 format!("{:.4}", l.simulated_area_m2 * 1e12),
                 format!("{:.4}", l.simulated_raw_area_m2 * 1e12),

@@ -15,7 +15,7 @@ use serde::{Serialize, Serializer};
 use contactscope::analysis::{global_threshold, PlaneSource};
 use contactscope::compare::{
     compare_maps, CompareSettings, Comparison, LoadComparison, Micrograph,
-    Micrographs as MicrographSet, Prepared, SimulatedMap,
+    Micrographs as MicrographSet, Prepared, SeriesShift, SimulatedMap,
 };
 use contactscope::image::pixel_size_or;
 use contactscope::spectral::register::MAX_UPSAMPLE;
@@ -142,7 +142,7 @@ pub struct MethodWords {
 
 const METHOD: MethodWords = MethodWords {
     simulated_image: "contact map (g = 0) blurred by a Gaussian PSF on the simulation grid, integrated over micrograph pixels (area fraction), centred on a micrograph-sized canvas",
-    registration: "phase correlation with Hann window, upsampled-DFT sub-pixel refinement",
+    registration: "one shift for the series: the highest peak of the mean normalised cross-power spectrum of all matched loads (Hann window, upsampled-DFT sub-pixel refinement); each load refined within the window around it, keeping the series shift where its own peak is weak or on the window's edge",
     thresholds: "experiment: exact Otsu over all micrographs of the series; simulation: Otsu over all blurred simulated images (4096 bins)",
     scores: "on the region covered by the simulation after registration",
     edge_distance_um: "mean of the two mean distances from each contact-edge pixel to the other map's nearest edge pixel (exact Euclidean distance transform)",
@@ -177,6 +177,9 @@ pub struct CompareOutcome {
     pub dice_mean: f64,
     /// Mean Jaccard index.
     pub jaccard_mean: f64,
+    /// The registration of the whole series.
+    #[serde(serialize_with = "series_json")]
+    pub series_registration: SeriesShift,
     /// How it was done.
     pub method: MethodWords,
     /// One entry per matched load, in experiment order.
@@ -190,6 +193,20 @@ pub struct CompareOutcome {
     /// Each matched pair, registered, for the panels.
     #[serde(skip)]
     pub prepared: Vec<Prepared>,
+}
+
+/// The series registration as `compare.json` writes it.
+fn series_json<S: Serializer>(r: &SeriesShift, s: S) -> std::result::Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let mut m = s.serialize_map(None)?;
+    m.serialize_entry("transform", &r.transform.name())?;
+    m.serialize_entry("shift_x_px", &r.shift_px.0)?;
+    m.serialize_entry("shift_y_px", &r.shift_px.1)?;
+    m.serialize_entry("shift_x_um", &Q(r.shift_m.0, Unit::MAsUm))?;
+    m.serialize_entry("shift_y_um", &Q(r.shift_m.1, Unit::MAsUm))?;
+    m.serialize_entry("correlation_peak", &r.correlation_peak)?;
+    m.serialize_entry("window_px", &r.window_px)?;
+    m.end()
 }
 
 /// The loads as `compare.json` lists them.
@@ -208,7 +225,10 @@ fn loads_json<S: Serializer>(
             m.serialize_entry("transform", &l.transform.name())?;
             m.serialize_entry("shift_x_px", &l.shift_px.0)?;
             m.serialize_entry("shift_y_px", &l.shift_px.1)?;
+            m.serialize_entry("shift_x_um", &Q(l.shift_m.0, Unit::MAsUm))?;
+            m.serialize_entry("shift_y_um", &Q(l.shift_m.1, Unit::MAsUm))?;
             m.serialize_entry("correlation_peak", &l.correlation_peak)?;
+            m.serialize_entry("refinement", l.refinement.name())?;
             m.serialize_entry(
                 "experiment_area_um2",
                 &Q(l.experiment_area_m2, Unit::M2AsUm2),
@@ -248,6 +268,7 @@ pub fn run_with(request: &CompareRequest, micrographs: &MicrographSet) -> Result
     let Comparison {
         loads,
         prepared,
+        registration,
         simulated_threshold,
         warnings,
         ..
@@ -266,6 +287,7 @@ pub fn run_with(request: &CompareRequest, micrographs: &MicrographSet) -> Result
         loads_matched: loads.len(),
         dice_mean: mean(&|l| l.dice),
         jaccard_mean: mean(&|l| l.jaccard),
+        series_registration: registration,
         method: METHOD,
         warnings,
         pixel_m: micrographs.pixel_m,

@@ -15,7 +15,12 @@
 //! 200 nm micrographs); it takes one to two minutes on 2 cores, most of it in `fit-hardening`
 //! (about 30 load ramps). [`DemoParams::reduced`] (`--small`) is a 10 µm toy for the tests.
 
+mod experiment;
 mod html;
+
+pub use experiment::{
+    compare_model, model_body, synthetic_experiment, Experiment, MICROGRAPH_OFFSET_PX,
+};
 
 use std::path::{Path, PathBuf};
 
@@ -23,7 +28,6 @@ use serde::Serialize;
 
 use crate::analyze::files::{run_to_folder as analyze_to_folder, ImageOutputs};
 use crate::analyze::AnalyzeRequest;
-use crate::compare::load_micrographs;
 use crate::error::{Error, Result};
 use crate::fit_hardening::files::run_to_folder as fit_to_folder;
 use crate::fit_hardening::{BodyRequest, FitRequest, MeasuredInput};
@@ -36,21 +40,13 @@ use crate::newton::{files::run_to_folder as newton_to_folder, NewtonRequest};
 use crate::psf::{files::run_to_folder as psf_to_folder, PsfRequest};
 use crate::series::{Micrographs, SeriesSpec};
 use crate::staging::write_atomic;
-use contactscope::compare::{compare_maps, CompareSettings, Comparison, SimulatedMap};
+use contactscope::compare::Comparison;
 use contactscope::mechanics::friction::{SlipOptions, XAxis};
-use contactscope::model_fit::{Family, Imaging, ModelBody, Search};
-use contactscope::optics::blur::Grid;
-use contactscope::solver::cg::SolverOptions;
-use contactscope::solver::halfspace::Boundary;
-use contactscope::solver::simulate::{sweep, Model, Setup};
-use contactscope::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
-use contactscope::surface::Topography;
+use contactscope::model_fit::{Family, Imaging, Search};
 use contactscope::synth::beads::{synth_beads, BeadParams};
 use contactscope::synth::rings::{synth_newton, NewtonSynthParams};
 use contactscope::synth::traces::{synthetic_trace, trace_csv, CsvLayout, TraceParams};
-use contactscope::synth::{render_micrograph, MicrographParams};
 use contactscope_formats::tiff::write::encode_u16_stack;
-use contactscope_formats::topography::encode_npy;
 
 /// The synthetic experiment's truth and sizes. SI units.
 #[derive(Debug, Clone, Serialize)]
@@ -239,20 +235,11 @@ fn replace_folder(work: &Path, out_dir: &Path) -> Result<()> {
 
 fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutcome> {
     let data = work.join("data");
-    std::fs::create_dir_all(&data).map_err(|e| Error::io(&data, e))?;
-    progress("rough sphere and the hardening load ramp (truth)");
-    let roughness = roughness(p)?;
-    write_atomic(
-        &data.join("topography.npy"),
-        &encode_npy(&roughness.heights),
-    )?;
-    let truth = truth_ramp(p, &roughness)?;
-    progress("rendering the confocal stack");
-    let manifest = write_micrographs(p, &truth.maps, &data)?;
+    let experiment = synthetic_experiment(p, &data, progress)?;
     let mut recovered = Vec::new();
 
     progress("analyze: global Otsu threshold, contact areas");
-    let measured = analyze(work, &manifest)?;
+    let measured = analyze(work, &experiment.manifest)?;
 
     progress("psf: beads");
     recovered.push(psf(work, &data, p)?);
@@ -268,7 +255,7 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
     recovered.push(fit.k.clone());
 
     progress("compare: simulated maps against the micrographs");
-    let comparisons = compare_models(p, &roughness, &manifest, &fit)?;
+    let comparisons = compare_models(p, &experiment, &fit)?;
     let dice = comparisons
         .iter()
         .map(|(name, c)| {
@@ -281,7 +268,7 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
         recovered: &recovered,
         comparisons: &comparisons,
         measured: &measured,
-        truth_areas_m2: &truth.areas_m2,
+        truth_areas_m2: &experiment.truth_areas_m2,
         fits: &fit.fits,
     };
     html::write_report(work, &facts)?;
@@ -291,118 +278,6 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
         out_dir: work.to_path_buf(),
         index: work.join("index.html"),
     })
-}
-
-fn roughness(p: &DemoParams) -> Result<Topography> {
-    Ok(self_affine(&SelfAffineParams {
-        nx: p.size,
-        ny: p.size,
-        dx_m: p.sim_pixel_m,
-        hurst: p.hurst,
-        rolloff_wavelength_m: Some(p.rolloff_m),
-        short_cutoff_wavelength_m: Some(p.cutoff_m),
-        target: RmsTarget::Slope(p.rms_slope),
-        seed: p.seed,
-    })?)
-}
-
-/// The hardening ramp at the true k: areas and contact maps.
-struct Truth {
-    areas_m2: Vec<f64>,
-    maps: Vec<Grid>,
-}
-
-fn solver_options() -> SolverOptions<'static> {
-    SolverOptions {
-        max_iterations: 5000,
-        tolerance: 1e-8,
-        monitor: None,
-        ..SolverOptions::default()
-    }
-}
-
-fn truth_ramp(p: &DemoParams, roughness: &Topography) -> Result<Truth> {
-    let mut body = roughness.clone();
-    body.add_sphere(p.radius_m)?;
-    let setup = Setup {
-        topography: &body,
-        e_star_pa: p.e_star_pa,
-        boundary: Boundary::Free,
-        model: Model::Hardening {
-            modulus_pa_per_m: p.k_pa_per_m,
-            initial_pa: 0.0,
-        },
-        options: SolverOptions {
-            gap_scale_m: Some(roughness.rms_height()),
-            ..solver_options()
-        },
-    };
-    let steps = sweep(&setup, &p.loads_n, &|_, _| {})?;
-    if steps.iter().any(|s| s.edge_contact) {
-        return Err(Error::InvalidArgument(
-            "demo parameters: the contact reaches the border of the map".into(),
-        ));
-    }
-    let maps = steps
-        .iter()
-        .map(|s| {
-            let contact = s
-                .solution
-                .pressure
-                .iter()
-                .map(|&v| f64::from(u8::from(v > 0.0)))
-                .collect();
-            Grid::new(contact, body.nx(), body.ny(), body.dx_m, body.dy_m)
-        })
-        .collect::<contactscope::Result<_>>()?;
-    Ok(Truth {
-        areas_m2: steps.iter().map(|s| s.area_m2).collect(),
-        maps,
-    })
-}
-
-/// 12-bit micrographs of the truth maps, off-centre by (3, −2) px; `series.tif` + `manifest.csv`.
-fn write_micrographs(p: &DemoParams, maps: &[Grid], data: &Path) -> Result<PathBuf> {
-    let dir = data.join("micrographs");
-    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-    let span = (maps[0].width as f64 * maps[0].dx_m / p.image_pixel_m).ceil() as usize;
-    let corner = ((p.image_size - span) / 2 + 3, (p.image_size - span) / 2 - 2);
-    let pages: Vec<Vec<u16>> = maps
-        .iter()
-        .enumerate()
-        .map(|(i, map)| {
-            render_micrograph(
-                map,
-                &MicrographParams {
-                    fwhm_m: p.psf_fwhm_m,
-                    pixel_m: p.image_pixel_m,
-                    width: p.image_size,
-                    height: p.image_size,
-                    corner_px: corner,
-                    background: 300.0,
-                    contact_level: 2400.0,
-                    counts_per_photon: 4.0,
-                    seed: p.seed + i as u64,
-                },
-            )
-        })
-        .collect::<contactscope::Result<_>>()?;
-    let refs: Vec<&[u16]> = pages.iter().map(Vec::as_slice).collect();
-    let tiff = encode_u16_stack(
-        &refs,
-        p.image_size,
-        p.image_size,
-        Some((p.image_pixel_m, p.image_pixel_m)),
-        "contactscope demo: synthetic confocal load series\n",
-    )?;
-    write_atomic(&dir.join("series.tif"), &tiff)?;
-    let mut manifest = String::from("file,page,force_mN\n");
-    for (i, f) in p.loads_n.iter().enumerate() {
-        manifest.push_str(&format!("series.tif,{i},{}\n", f * 1e3));
-    }
-    let path = dir.join("manifest.csv");
-    write_atomic(&path, manifest.as_bytes())?;
-    Ok(path)
 }
 
 /// Measured (force N, area m²) from `analyze`.
@@ -673,29 +548,10 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
 /// Each model's maps at the loads (fitted parameters), compared with the micrographs.
 fn compare_models(
     p: &DemoParams,
-    roughness: &Topography,
-    manifest: &Path,
+    experiment: &Experiment,
     fit: &FitResult,
 ) -> Result<Vec<(String, Comparison)>> {
-    let (_, micrographs) = load_micrographs(
-        &Micrographs::Files(SeriesSpec {
-            manifest: Some(manifest.to_path_buf()),
-            ..SeriesSpec::default()
-        }),
-        None,
-    )?;
-    let settings = CompareSettings {
-        psf_fwhm_m: p.psf_fwhm_m,
-        dihedral: false,
-        upsample: 20,
-        force_tolerance: 0.01,
-    };
-    let body = ModelBody::new(
-        roughness.clone(),
-        Some(p.radius_m),
-        p.e_star_pa,
-        solver_options(),
-    )?;
+    let body = model_body(p, experiment)?;
     let models = [
         ("Greenwood–Tripp", Family::GreenwoodTripp, None),
         ("elastic", Family::Elastic, None),
@@ -708,29 +564,10 @@ fn compare_models(
     ];
     models
         .iter()
-        .map(|&(name, family, parameter)| {
-            let (_, maps, _) = body.evaluate(family, parameter, &p.loads_n, true)?;
-            let simulated: Vec<SimulatedMap> = maps
-                .expect("maps kept")
-                .into_iter()
-                .zip(&p.loads_n)
-                .map(|(m, &f)| {
-                    Ok(SimulatedMap {
-                        force_n: f,
-                        map: Grid::new(
-                            m,
-                            body.body.nx(),
-                            body.body.ny(),
-                            body.body.dx_m,
-                            body.body.dy_m,
-                        )?,
-                        source: name.to_string(),
-                    })
-                })
-                .collect::<Result<_>>()?;
+        .map(|&model| {
             Ok((
-                name.to_string(),
-                compare_maps(&micrographs, &simulated, &settings)?,
+                model.0.to_string(),
+                compare_model(p, experiment, &body, model)?,
             ))
         })
         .collect()

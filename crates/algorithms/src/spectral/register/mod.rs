@@ -3,8 +3,14 @@
 //! and a search over the eight dihedral transforms, because the microscope looks up through the
 //! coverslip while the AFM scanned the sphere from outside (docs/methods.md §8).
 //!
+//! [`register_series`] registers a whole load series with one shift ([`series`]).
+//!
 //! Sign convention (checked by a test): [`phase_correlation`] returns the shift `(dx, dy)` such
 //! that `moving(x, y) ≈ reference(x − dx, y − dy)`, i.e. how far the content moved.
+
+pub mod series;
+
+pub use series::{register_series, LoadShift, Refinement, SeriesOptions, SeriesRegistration};
 
 use rustfft::num_complex::Complex64;
 
@@ -46,11 +52,7 @@ pub fn phase_correlation(
     upsample: usize,
     window: Window,
 ) -> Result<Shift> {
-    if !(1..=MAX_UPSAMPLE).contains(&upsample) {
-        return Err(Error::InvalidArgument(format!(
-            "registration upsampling {upsample} is outside 1 ..= {MAX_UPSAMPLE} (1/{MAX_UPSAMPLE} px is the finest resolution)"
-        )));
-    }
+    check_upsample(upsample)?;
     let n = width * height;
     if width < 2 || height < 2 || reference.len() != n || moving.len() != n {
         return Err(Error::InvalidArgument(format!(
@@ -60,16 +62,50 @@ pub fn phase_correlation(
         )));
     }
     let fft = RealFft2::new(height, width);
-    let spectrum = |img: &[f64]| {
-        let mut input = tapered(img, width, height, window);
-        let mut out = fft.make_spectrum();
-        fft.forward(&mut input, &mut out);
-        out
+    let kept = cross_power(&fft, &spectrum(&fft, reference, window), moving, window);
+    let (peak_index, peak) = highest(&correlation(&fft, &kept));
+    let coarse = signed_position(peak_index, (width, height));
+    let (dx, dy, refined_peak) = if upsample > 1 {
+        refine(&fft, &kept, coarse, upsample, None)
+    } else {
+        (coarse.0, coarse.1, peak)
     };
-    let (f_ref, f_mov) = (spectrum(reference), spectrum(moving));
-    let mut cross: Vec<Complex64> = f_mov
+    Ok(Shift {
+        dx,
+        dy,
+        peak: refined_peak / n as f64,
+    })
+}
+
+fn check_upsample(upsample: usize) -> Result<()> {
+    if (1..=MAX_UPSAMPLE).contains(&upsample) {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "registration upsampling {upsample} is outside 1 ..= {MAX_UPSAMPLE} (1/{MAX_UPSAMPLE} px is the finest resolution)"
+        )))
+    }
+}
+
+/// The half spectrum of the mean-subtracted, tapered image.
+fn spectrum(fft: &RealFft2, img: &[f64], window: Window) -> Vec<Complex64> {
+    let mut input = tapered(img, fft.nx(), fft.ny(), window);
+    let mut out = fft.make_spectrum();
+    fft.forward(&mut input, &mut out);
+    out
+}
+
+/// The normalised cross-power spectrum R = F_mov·F_ref*/|F_mov·F_ref*| (zero where either
+/// spectrum vanishes), on the half spectrum; its inverse DFT peaks at the shift of `moving`.
+fn cross_power(
+    fft: &RealFft2,
+    reference: &[Complex64],
+    moving: &[f64],
+    window: Window,
+) -> Vec<Complex64> {
+    spectrum(fft, moving, window)
         .iter()
-        .zip(&f_ref)
+        .zip(reference)
         .map(|(m, r)| {
             let c = m * r.conj();
             let norm = c.norm();
@@ -79,20 +115,34 @@ pub fn phase_correlation(
                 Complex64::new(0.0, 0.0)
             }
         })
-        .collect();
-    let kept = cross.clone();
-    let mut corr = vec![0.0; n];
-    fft.inverse(&mut cross, &mut corr);
-    let (peak_index, peak) =
-        corr.iter()
-            .enumerate()
-            .fold((0, f64::NEG_INFINITY), |best, (i, &v)| {
-                if v > best.1 {
-                    (i, v)
-                } else {
-                    best
-                }
-            });
+        .collect()
+}
+
+/// The correlation surface (inverse DFT of a cross spectrum, unnormalised: divide by
+/// `fft.len()` for a peak of 1 at a perfect match).
+fn correlation(fft: &RealFft2, cross: &[Complex64]) -> Vec<f64> {
+    let mut spectrum = cross.to_vec();
+    let mut corr = vec![0.0; fft.len()];
+    fft.inverse(&mut spectrum, &mut corr);
+    corr
+}
+
+/// Index and value of the highest element (the first of equal ones).
+fn highest(values: &[f64]) -> (usize, f64) {
+    values
+        .iter()
+        .enumerate()
+        .fold((0, f64::NEG_INFINITY), |best, (i, &v)| {
+            if v > best.1 {
+                (i, v)
+            } else {
+                best
+            }
+        })
+}
+
+/// The signed shift (x, y) of a row-major index: indices past half the side wrap to negative.
+fn signed_position(index: usize, (width, height): (usize, usize)) -> (f64, f64) {
     let signed = |k: usize, len: usize| {
         if k > len / 2 {
             k as f64 - len as f64
@@ -100,20 +150,7 @@ pub fn phase_correlation(
             k as f64
         }
     };
-    let coarse = (
-        signed(peak_index % width, width),
-        signed(peak_index / width, height),
-    );
-    let (dx, dy, refined_peak) = if upsample > 1 {
-        refine(&fft, &kept, coarse, upsample)
-    } else {
-        (coarse.0, coarse.1, peak)
-    };
-    Ok(Shift {
-        dx,
-        dy,
-        peak: refined_peak / n as f64,
-    })
+    (signed(index % width, width), signed(index / width, height))
 }
 
 fn tapered(img: &[f64], width: usize, height: usize, window: Window) -> Vec<f64> {
@@ -130,26 +167,55 @@ fn tapered(img: &[f64], width: usize, height: usize, window: Window) -> Vec<f64>
         .collect()
 }
 
+/// Inclusive limits `[(x_lo, x_hi), (y_lo, y_hi)]` on a refined shift, pixels.
+type Bounds = [(f64, f64); 2];
+
 /// Evaluate the inverse DFT of the normalised cross spectrum on a grid of 1/`upsample` px over
-/// ±0.75 px around the coarse peak and return the best point (dx, dy, value). The half spectrum
-/// suffices because the correlation of real images is real: r = Σ_half w_kx·Re(R·e^{iθ}).
+/// ±0.75 px around the coarse peak and return the best point (dx, dy, value), skipping points
+/// outside `bounds` (the coarse peak itself must lie inside them). The half spectrum suffices
+/// because the correlation of real images is real: r = Σ_half w_kx·Re(R·e^{iθ}).
 fn refine(
     fft: &RealFft2,
     cross: &[Complex64],
     coarse: (f64, f64),
     upsample: usize,
+    bounds: Option<Bounds>,
 ) -> (f64, f64, f64) {
-    let (nx, ny) = (fft.nx(), fft.ny());
     let half = (0.75 * upsample as f64).ceil() as i64;
-    let offsets: Vec<f64> = (-half..=half).map(|k| k as f64 / upsample as f64).collect();
+    let inside = |v: f64, (lo, hi): (f64, f64)| v >= lo - 1e-9 && v <= hi + 1e-9;
+    let offsets = |centre: f64, axis: usize| -> Vec<f64> {
+        (-half..=half)
+            .map(|k| centre + k as f64 / upsample as f64)
+            .filter(|&v| bounds.is_none_or(|b| inside(v, b[axis])))
+            .collect()
+    };
+    let (xs, ys) = (offsets(coarse.0, 0), offsets(coarse.1, 1));
+    let mut best = (coarse.0, coarse.1, f64::NEG_INFINITY);
+    for (y, row) in ys.iter().zip(row_sums(fft, cross, &ys)) {
+        for &x in &xs {
+            let value = evaluate_row(fft, &row, x);
+            if value > best.2 {
+                best = (x, *y, value);
+            }
+        }
+    }
+    best
+}
+
+/// The correlation of a cross spectrum at one (sub-pixel) shift, unnormalised as
+/// [`correlation`].
+fn correlation_at(fft: &RealFft2, cross: &[Complex64], (x, y): (f64, f64)) -> f64 {
+    let row = row_sums(fft, cross, &[y]).swap_remove(0);
+    evaluate_row(fft, &row, x)
+}
+
+/// T[j][kx] = Σ_ky R(kx, ky) e^{2πi ky y_j / ny}: the column sums of the inverse DFT at rows y_j.
+fn row_sums(fft: &RealFft2, cross: &[Complex64], ys: &[f64]) -> Vec<Vec<Complex64>> {
+    let ny = fft.ny();
     let tau = 2.0 * std::f64::consts::PI;
-    let kx_count = nx / 2 + 1;
-    // T[j][kx] = Σ_ky R(kx, ky) e^{2πi ky y_j / ny}
-    let t: Vec<Vec<Complex64>> = offsets
-        .iter()
-        .map(|&oy| {
-            let y = coarse.1 + oy;
-            (0..kx_count)
+    ys.iter()
+        .map(|&y| {
+            (0..fft.nx() / 2 + 1)
                 .map(|kx| {
                     (0..ny)
                         .map(|ky| {
@@ -161,7 +227,13 @@ fn refine(
                 })
                 .collect()
         })
-        .collect();
+        .collect()
+}
+
+/// Σ_kx w_kx·Re(T[kx]·e^{2πi kx x / nx}), the real inverse DFT along x at `x`.
+fn evaluate_row(fft: &RealFft2, row: &[Complex64], x: f64) -> f64 {
+    let nx = fft.nx();
+    let tau = 2.0 * std::f64::consts::PI;
     let weight = |kx: usize| {
         if kx == 0 || (nx % 2 == 0 && kx == nx / 2) {
             1.0
@@ -169,24 +241,12 @@ fn refine(
             2.0
         }
     };
-    let mut best = (coarse.0, coarse.1, f64::NEG_INFINITY);
-    for (j, row) in t.iter().enumerate() {
-        for &ox in &offsets {
-            let x = coarse.0 + ox;
-            let value: f64 = row
-                .iter()
-                .enumerate()
-                .map(|(kx, c)| {
-                    weight(kx)
-                        * (c * Complex64::from_polar(1.0, tau * kx as f64 * x / nx as f64)).re
-                })
-                .sum();
-            if value > best.2 {
-                best = (x, coarse.1 + offsets[j], value);
-            }
-        }
-    }
-    best
+    row.iter()
+        .enumerate()
+        .map(|(kx, c)| {
+            weight(kx) * (c * Complex64::from_polar(1.0, tau * kx as f64 * x / nx as f64)).re
+        })
+        .sum()
 }
 
 /// One of the eight symmetries of the square: optional transpose, then optional flips.
@@ -333,13 +393,13 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
 
-    fn random_image(n: usize, seed: u64) -> Vec<f64> {
+    pub(super) fn random_image(n: usize, seed: u64) -> Vec<f64> {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let noise: Vec<f64> = (0..n * n).map(|_| rng.random_range(0.0..1.0)).collect();
         crate::optics::blur::isotropic_blur(&noise, n, n, 1.5)
     }
 
-    fn circular_shift(img: &[f64], n: usize, dx: i64, dy: i64) -> Vec<f64> {
+    pub(super) fn circular_shift(img: &[f64], n: usize, dx: i64, dy: i64) -> Vec<f64> {
         let n_i = n as i64;
         (0..n * n)
             .map(|i| {
@@ -350,7 +410,7 @@ mod tests {
     }
 
     /// Shift by a Fourier phase ramp: an exact sub-pixel translation of a periodic image.
-    fn fourier_shift(img: &[f64], n: usize, dx: f64, dy: f64) -> Vec<f64> {
+    pub(super) fn fourier_shift(img: &[f64], n: usize, dx: f64, dy: f64) -> Vec<f64> {
         let fft = RealFft2::new(n, n);
         let mut input = img.to_vec();
         let mut spec = fft.make_spectrum();
