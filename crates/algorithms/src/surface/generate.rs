@@ -119,28 +119,42 @@ impl SelfAffineParams {
 
     fn validate_wavelengths(&self) -> Result<()> {
         let longest = self.nx.max(self.ny) as f64 * self.dx_m;
+        use contactscope_formats::param::Param;
         let named = [
-            ("roll-off", self.rolloff_wavelength_m),
-            ("short cutoff", self.short_cutoff_wavelength_m),
+            ("roll-off", Param::Rolloff, self.rolloff_wavelength_m),
+            (
+                "short cutoff",
+                Param::Cutoff,
+                self.short_cutoff_wavelength_m,
+            ),
         ];
-        for (name, value) in named {
+        for (name, param, value) in named {
             let Some(lambda) = value else { continue };
             if !(lambda.is_finite() && lambda >= 2.0 * self.dx_m) {
                 return Err(invalid(format!(
-                    "{name} wavelength must be at least 2 pixels ({} m; got {lambda} m)",
-                    2.0 * self.dx_m
+                    "{param}: the {name} wavelength must be at least 2 pixels ({} m; got \
+                     {lambda} m; {} is {} m)",
+                    2.0 * self.dx_m,
+                    Param::PixelSize,
+                    self.dx_m
                 )));
             }
             if lambda > longest * (1.0 + 1e-12) {
                 return Err(invalid(format!(
-                    "{name} wavelength {lambda} m is longer than the map ({longest} m)"
+                    "{param}: the {name} wavelength {lambda} m is longer than the map ({longest} \
+                     m: {} × {})",
+                    Param::Size,
+                    Param::PixelSize
                 )));
             }
         }
         if let (Some(r), Some(s)) = (self.rolloff_wavelength_m, self.short_cutoff_wavelength_m) {
             if s >= r {
                 return Err(invalid(format!(
-                    "short cutoff wavelength ({s} m) must be shorter than the roll-off wavelength ({r} m)"
+                    "{}: the short cutoff wavelength ({s} m) must be shorter than the roll-off \
+                     wavelength ({r} m, {})",
+                    Param::Cutoff,
+                    Param::Rolloff
                 )));
             }
         }

@@ -112,7 +112,8 @@ impl SynthParams {
                 .map(|_| ())
                 .map_err(|reason| {
                     Error::InvalidArgument(format!(
-                        "pixel size {:.4e} m is too small for the generator's blurs: {reason}",
+                        "{}: {:.4e} m is too small for the generator's blurs: {reason}",
+                        contactscope_formats::param::Param::PixelSize,
                         self.pixel_size_m
                     ))
                 })
@@ -150,11 +151,14 @@ pub fn generate(p: &SynthParams) -> Result<Vec<SynthImage>> {
         let n_contact = (p.true_area_m2(force) / pixel_area).round() as usize;
         if n_contact * 2 > order.len() {
             return Err(Error::InvalidArgument(format!(
-                "the true contact at {} mN ({:.0} µm²) would cover more than half the {}×{} px field; use a larger image or smaller loads",
+                "the true contact at {} mN ({:.0} µm²) would cover more than half the {}×{} px \
+                 field; use a larger image ({}) or smaller forces ({})",
                 force * 1e3,
                 p.true_area_m2(force) * 1e12,
                 p.width,
-                p.height
+                p.height,
+                contactscope_formats::param::Param::Size,
+                contactscope_formats::param::Param::Forces
             )));
         }
         let mut truth = vec![false; order.len()];
