@@ -55,7 +55,12 @@ pub enum Error {
         got: usize,
     },
     /// A load heavier than a penetration hardness can carry on the whole map.
-    #[error("load {load_n:.4e} N exceeds what the hardness can carry on the whole map ({capacity_n:.4e} N)")]
+    #[error(
+        "load {load_n:.4e} N exceeds what the hardness can carry on the whole map \
+         ({capacity_n:.4e} N): lower the load ({}) or raise the hardness ({})",
+        contactscope_formats::param::Param::Loads,
+        contactscope_formats::param::Param::Hardness
+    )]
     ExceedsCapacity {
         /// The load, N.
         load_n: f64,
