@@ -60,10 +60,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let single = (args.micrographs.len() == 1).then(|| &args.micrographs[0]);
-    let is_manifest = single.is_some_and(|p| {
-        p.is_dir() && p.join("manifest.csv").is_file()
-            || p.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"))
-    });
+    let is_manifest = single.is_some_and(|p| contactscope_jobs::series::is_manifest(p));
     let selection = args.select.selection();
     let load_axis = args.load_axis.map(LoadAxisArg::axis);
     let spec = match (&args.forces, is_manifest) {

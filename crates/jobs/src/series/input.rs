@@ -117,7 +117,7 @@ impl Micrographs {
 /// Whether an input path names a manifest: a `.csv` file or a folder holding `manifest.csv`.
 pub fn is_manifest(path: &std::path::Path) -> bool {
     path.join("manifest.csv").is_file()
-        || (path.is_file()
+        || (!path.is_dir()
             && path
                 .extension()
                 .is_some_and(|e| e.eq_ignore_ascii_case("csv")))

@@ -27,7 +27,9 @@ mod file;
 mod input;
 
 pub use file::SeriesFile;
-pub use input::{load, LoadedSeries, MemorySeries, Micrographs, OpenSeries, Planes, SeriesSpec};
+pub use input::{
+    is_manifest, load, LoadedSeries, MemorySeries, Micrographs, OpenSeries, Planes, SeriesSpec,
+};
 
 use crate::error::{Error, Location, Result};
 use contactscope::analysis::PlaneSource;
