@@ -118,9 +118,12 @@ impl Staging {
         }
         self.committed = true;
         unfinished.retain(|d| d != &self.staging_dir);
+        // The earlier run's folder, set aside, goes too if a signal comes while it is removed.
+        unfinished.extend(aside.clone());
         drop(unfinished);
         if let Some(aside) = &aside {
             let _ = fs::remove_dir_all(aside);
+            unregister(aside);
         }
         Ok(names.iter().map(|n| self.out_dir.join(n)).collect())
     }
