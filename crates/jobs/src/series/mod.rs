@@ -288,10 +288,23 @@ pub fn assign_forces(series: &mut Series, forces_n: &[f64]) -> Result<()> {
         let along = series.load_axis.map_or(String::new(), |a| {
             format!(" (the planes along {} {})", Param::LoadAxis, a.name())
         });
+        // Name the files, so that the person sees which images were counted.
+        let mut files: Vec<String> = series
+            .files
+            .iter()
+            .map(|f| f.path.display().to_string())
+            .collect();
+        if files.len() > 3 {
+            let more = files.len() - 2;
+            files.truncate(2);
+            files.push(format!("… ({more} more files)"));
+        }
         return Err(Error::InvalidArgument(format!(
-            "{} force(s) given for {} image(s){along}; give one force per image",
+            "{}: {} force(s) given for {} image(s) in {}{along}; give one force per image",
+            Param::Forces,
             forces_n.len(),
-            series.images.len()
+            series.images.len(),
+            files.join(", ")
         )));
     }
     if let Some(bad) = forces_n.iter().find(|f| !f.is_finite() || **f < 0.0) {
