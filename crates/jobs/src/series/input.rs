@@ -72,33 +72,25 @@ impl Micrographs {
     pub fn open(&self) -> Result<OpenSeries> {
         match self {
             Micrographs::Files(spec) => {
-                // A CSV, or a folder holding `manifest.csv`, given as the only input is that
-                // manifest.
-                let folder_manifest = match (spec.inputs.as_slice(), &spec.forces_n) {
-                    ([only], None) if spec.manifest.is_none() && is_manifest(only) => {
-                        Some(only.clone())
+                // A manifest lists the images and their forces; a CSV, or a folder holding
+                // `manifest.csv`, given as the only input (without forces) is one.
+                let manifest = match (&spec.manifest, spec.inputs.as_slice(), &spec.forces_n) {
+                    (Some(manifest), [], None) => Some(manifest),
+                    (Some(_), _, _) => {
+                        return Err(Error::InvalidArgument(format!(
+                            "a manifest lists the images and their forces: give {} alone",
+                            Param::Manifest
+                        )))
                     }
-                    _ => None,
+                    (None, [only], None) if is_manifest(only) => Some(only),
+                    (None, _, _) => None,
                 };
-                let mut series = match folder_manifest.as_ref().or(spec.manifest.as_ref()) {
-                    Some(manifest) if folder_manifest.is_some() => from_manifest_selected(
+                let mut series = match manifest {
+                    Some(manifest) => from_manifest_selected(
                         &manifest_file(manifest)?,
                         &spec.selection,
                         spec.load_axis,
                     )?,
-                    Some(manifest) => {
-                        if !spec.inputs.is_empty() || spec.forces_n.is_some() {
-                            return Err(Error::InvalidArgument(format!(
-                                "a manifest lists the images and their forces: give {} alone",
-                                Param::Manifest
-                            )));
-                        }
-                        from_manifest_selected(
-                            &manifest_file(manifest)?,
-                            &spec.selection,
-                            spec.load_axis,
-                        )?
-                    }
                     None => from_files_selected(&spec.inputs, &spec.selection, spec.load_axis)?,
                 };
                 if let Some(forces) = &spec.forces_n {
