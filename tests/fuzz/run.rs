@@ -183,31 +183,47 @@ pub struct Limits {
     pub memory_kib: u64,
 }
 
-/// What an error line may name so that a person knows what to change: the name of every file
-/// and folder of the case's inputs, and every flag of its arguments.
+/// What an error line may name so that a person knows what to change: the name of every input
+/// file of the case, every path its arguments give (a folder such as `sim`), and every flag.
 fn nameable(dir: &Path, args: &[String], out: &Path) -> Vec<String> {
     let mut names: Vec<String> = snapshot(dir, out)
         .iter()
-        .flat_map(|(p, _)| {
-            p.strip_prefix(dir)
-                .ok()
-                .into_iter()
-                .flat_map(|rel| rel.iter())
-                .map(|c| c.to_string_lossy().into_owned())
-                .collect::<Vec<_>>()
-        })
+        .filter_map(|(p, _)| p.file_name())
+        .map(|n| n.to_string_lossy().into_owned())
         .collect();
-    names.extend(args.iter().filter(|a| a.starts_with("--")).cloned());
+    names.extend(
+        args.iter()
+            .filter(|a| a.starts_with("--") || dir.join(a.as_str()).exists())
+            .cloned(),
+    );
     names.sort();
     names.dedup();
     names
+}
+
+/// Whether `line` names `name`: a file name (`series.tif`) anywhere, a flag not as the start of a
+/// longer flag, and a bare folder name (`series`, `sim`) only written as a path (`series/…`,
+/// `sim:`), so that the folder `series` is not found in "the series has no images".
+fn names(line: &str, name: &str) -> bool {
+    let word = |c: char| c.is_alphanumeric() || c == '_' || c == '-';
+    line.match_indices(name).any(|(i, _)| {
+        let before = line[..i].chars().next_back();
+        let after = line[i + name.len()..].chars().next();
+        if name.starts_with("--") {
+            !after.is_some_and(word)
+        } else if name.contains('.') {
+            true
+        } else {
+            !before.is_some_and(word) && matches!(after, Some('/' | ':')) || before == Some('/')
+        }
+    })
 }
 
 /// Run `args` in `dir` (which holds the case's inputs) and classify the result. `out` is the
 /// output path named in the arguments.
 pub fn run_case(dir: &Path, args: &[String], out: &Path, limits: &Limits) -> Outcome {
     let before = snapshot(dir, out);
-    let names = nameable(dir, args, out);
+    let nameable = nameable(dir, args, out);
     let stdout_path = dir.with_extension("stdout");
     let stderr_path = dir.with_extension("stderr");
     let script = format!("ulimit -v {} && exec \"$0\" \"$@\"", limits.memory_kib);
@@ -270,11 +286,7 @@ pub fn run_case(dir: &Path, args: &[String], out: &Path, limits: &Limits) -> Out
                 return outcome(Class::Partial, format!("{} exists: {first}", out.display()));
             }
             match clean_error(&stderr) {
-                Ok(())
-                    if !names
-                        .iter()
-                        .any(|n| error_line(&stderr).contains(n.as_str())) =>
-                {
+                Ok(()) if !nameable.iter().any(|n| names(error_line(&stderr), n)) => {
                     outcome(Class::Unnamed, first)
                 }
                 Ok(()) => outcome(Class::CleanError, first),
@@ -284,4 +296,19 @@ pub fn run_case(dir: &Path, args: &[String], out: &Path, limits: &Limits) -> Out
         Some(code) => outcome(Class::OddExit, format!("exit {code}: {first}")),
         None => outcome(Class::Abort, first),
     }
+}
+
+#[test]
+fn an_error_names_a_file_a_flag_or_a_folder_written_as_a_path() {
+    let line = "contactscope: error: the series has no images";
+    assert!(!names(line, "series"));
+    assert!(names(
+        "contactscope: error: series/a.tif: truncated",
+        "a.tif"
+    ));
+    assert!(names("contactscope: error: series: no manifest", "series"));
+    assert!(names("contactscope: error: exp/series.tif:3: bad", "exp"));
+    assert!(names("contactscope: error: --size: 0 pixels", "--size"));
+    assert!(!names("contactscope: error: --size-x: 0 pixels", "--size"));
+    assert!(!names("contactscope: error: simulated map empty", "sim"));
 }

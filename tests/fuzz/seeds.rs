@@ -194,6 +194,9 @@ pub fn build(dir: &Path) {
             "series/series.tif",
             "--forces",
             "1,2,4mN",
+            // Areas of a few µm², which the 6.4 µm maps of the fit templates can hold.
+            "--pixel-size",
+            "40nm",
             "--out",
             "an",
             "-q",

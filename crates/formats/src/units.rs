@@ -214,42 +214,33 @@ pub fn parse_forces(text: &str) -> Result<Vec<f64>> {
     force_values(text, true)
 }
 
+/// A list (each item range-checked by [`quantity_list`], 0 only if `zero_allowed`) or a
+/// log-spaced range (its two ends range-checked; the values between lie within them).
 fn force_values(text: &str, zero_allowed: bool) -> Result<Vec<f64>> {
-    let values = match text.split_once("..") {
-        Some((from, rest)) => {
-            let (to, count) = rest.split_once(':').ok_or_else(|| {
-                Error::InvalidArgument(format!(
-                    "force range '{text}' needs a count: e.g. 4mN..400mN:12"
-                ))
-            })?;
-            let (a, b) = (
-                parse_quantity(&with_unit_of(from, to), Dimension::Force)?,
-                parse_quantity(to, Dimension::Force)?,
-            );
-            let n = range_count(count, text)?;
-            if !(a > 0.0 && b > a) {
-                return Err(Error::InvalidArgument(format!(
-                    "force range '{text}' needs 0 < start < end (log-spaced values)"
-                )));
-            }
-            (0..n)
-                .map(|i| a * (b / a).powf(i as f64 / (n - 1) as f64))
-                .collect()
-        }
-        None => quantity_list(text, Dimension::Force, zero_allowed)?,
+    let Some((from, rest)) = text.split_once("..") else {
+        return quantity_list(text, Dimension::Force, zero_allowed);
     };
-    for &v in &values {
-        if v == 0.0 && zero_allowed {
-            continue;
-        }
-        if v <= 0.0 {
-            return Err(Error::InvalidArgument(format!(
-                "force {v} N in '{text}' must be positive"
-            )));
-        }
-        Quantity::Force.check_text(v, &format!("'{text}'"))?;
+    let (to, count) = rest.split_once(':').ok_or_else(|| {
+        Error::InvalidArgument(format!(
+            "force range '{text}' needs a count: e.g. 4mN..400mN:12"
+        ))
+    })?;
+    let (a, b) = (
+        parse_quantity(&with_unit_of(from, to), Dimension::Force)?,
+        parse_quantity(to, Dimension::Force)?,
+    );
+    let n = range_count(count, text)?;
+    if !(a > 0.0 && b > a) {
+        return Err(Error::InvalidArgument(format!(
+            "force range '{text}' needs 0 < start < end (log-spaced values)"
+        )));
     }
-    Ok(values)
+    for end in [a, b] {
+        Quantity::Force.check_text(end, &format!("'{text}'"))?;
+    }
+    Ok((0..n)
+        .map(|i| a * (b / a).powf(i as f64 / (n - 1) as f64))
+        .collect())
 }
 
 /// A bare number (no unit) takes the unit written after the last item, so `1..10MPa/nm:10` and

@@ -50,14 +50,17 @@ pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
         }
         let at = Location::file(format!("{}:{}", path.display(), table.line(k)));
         Quantity::Force.check_at(force, &at)?;
-        // A load without contact gives an infinite stress (friction) and no size to fit.
-        if !(area > 0.0 && area <= 1.0) {
+        // A load without contact gives an infinite stress (friction) and no size to fit; an
+        // area below one pixel of the smallest plausible size is no measurement either.
+        let smallest = Quantity::PixelSize.range().0.powi(2);
+        if !(area >= smallest && area <= 1.0) {
             return Err(Error::bad_input(
                 at,
                 format!(
-                    "area_um2 = {:e} µm²: an area must be positive and at most 1 m² (remove a \
-                     row without contact)",
-                    area * 1e12
+                    "area_um2 = {:e} µm²: an area must lie between {:e} µm² (one pixel of \
+                     0.1 nm) and 1 m² (remove a row without contact)",
+                    area * 1e12,
+                    smallest * 1e12
                 ),
             ));
         }
@@ -115,6 +118,9 @@ pub fn simulated_maps(dir: &Path) -> Result<Vec<SimulatedMap>> {
             ));
         }
         loads.push(read_map(&map, force_mn * 1e-3)?);
+    }
+    if loads.is_empty() {
+        return Err(Error::bad_input(at, "lists no loads"));
     }
     Ok(loads)
 }

@@ -265,7 +265,11 @@ pub fn compare_maps(
         .collect();
     let sim_sets: Vec<Vec<f64>> = prepared.iter().map(inside_footprint).collect();
     let refs: Vec<&[f64]> = sim_sets.iter().map(Vec::as_slice).collect();
-    let sim_threshold = otsu_of_values(&refs, "the blurred simulated maps")?;
+    let what = format!(
+        "the simulated maps blurred onto the micrographs' pixels (check {} and the PSF)",
+        contactscope_formats::param::Param::PixelSize
+    );
+    let sim_threshold = otsu_of_values(&refs, &what)?;
     let loads: Vec<LoadComparison> = prepared
         .iter()
         .map(|p| score(p, micrographs.threshold, sim_threshold, pixel))
@@ -325,9 +329,12 @@ fn match_loads<'a>(
                 .join(", ")
         };
         return Err(Error::InvalidArgument(format!(
-            "the simulation and the experiment have no common load within {:.1} %: experiment {} mN, simulation {} mN",
+            "the simulation and the experiment have no common load within {:.1} % ({}): \
+             experiment {} mN ({}), simulation {} mN",
             tolerance * 100.0,
+            contactscope_formats::param::Param::ForceTolerance,
             list(images.iter().filter_map(|i| i.force_n).collect()),
+            contactscope_formats::param::Param::Forces,
             list(simulated.iter().map(|s| s.force_n).collect()),
         )));
     }

@@ -55,7 +55,7 @@ pub fn run_to_folder(
     let outcome = run_open(request, &open, progress, sink)?;
     staging.write("areas.csv", &areas_csv(&outcome)?)?;
     #[cfg(feature = "plots")]
-    if has_log_points(&outcome) {
+    if outcome.rows.rows.iter().any(super::Row::on_log_axes) {
         let plot = area_plot(&outcome, "Contact area versus normal force");
         staging.write("area_vs_load.png", &plot.to_png()?)?;
         staging.write("area_vs_load.svg", plot.to_svg()?.as_bytes())?;
@@ -66,16 +66,6 @@ pub fn run_to_folder(
     )?;
     let written = staging.commit()?;
     Ok((outcome, written))
-}
-
-/// Whether any image has a positive force and contact area: a point on the log–log plot
-/// (without one, `analyze` writes no plot and says why in a warning).
-pub fn has_log_points(outcome: &AnalyzeOutcome) -> bool {
-    outcome
-        .rows
-        .rows
-        .iter()
-        .any(|r| r.force_mn.is_some_and(|f| f > 0.0) && r.area > 0.0)
 }
 
 /// `areas.csv`: one row per image, every column named with its unit.
@@ -156,8 +146,8 @@ pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
     let measured: Vec<(f64, f64)> = table
         .rows
         .iter()
+        .filter(|r| r.on_log_axes())
         .filter_map(|r| r.force_mn.map(|f| (f, r.area)))
-        .filter(|(f, a)| *f > 0.0 && *a > 0.0)
         .collect();
     let forces: Vec<f64> = measured.iter().map(|p| p.0).collect();
     let (lo, hi) = forces

@@ -64,6 +64,14 @@ pub struct Row {
     pub hertz_area_um2: Option<f64>,
 }
 
+impl Row {
+    /// Whether the image is a point of the area–load fits and the log–log plot: a positive
+    /// force and some contact (a 0 mN reference frame or an image without contact is not).
+    pub fn on_log_axes(&self) -> bool {
+        self.force_mn.is_some_and(|f| f > 0.0) && self.area > 0.0
+    }
+}
+
 /// Area unit of the outputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AreaUnit {
@@ -321,8 +329,8 @@ pub fn table_and_fits(
         .collect();
     let (forces, areas): (Vec<f64>, Vec<f64>) = rows
         .iter()
+        .filter(|r| r.on_log_axes())
         .filter_map(|r| r.force_mn.map(|f| (f, r.area)))
-        .filter(|(f, a)| *f > 0.0 && *a > 0.0)
         .unzip();
     let proportional_mpa = match unit {
         AreaUnit::SquareMicrometre => fit_proportional(&forces, &areas)
