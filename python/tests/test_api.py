@@ -470,7 +470,7 @@ def test_bad_input_is_valueerror(call):
 def test_areas_in_another_unit_are_refused():
     # mN and µm² given where N and m² are meant: a measured area larger than the whole map.
     h = cs.surface(32, 32, 1e-7, rms_height=1e-8, seed=1)
-    with pytest.raises(cs.InputError, match=r"larger than the whole height map \(10\.2 µm²\)"):
+    with pytest.raises(cs.InputError, match=r"larger than the whole height map \(10\.2 µm², heights"):
         cs.fit_hardening([4, 40, 100], [10, 50, 120], h, 1e-7, 3.7e9, radius=50e-6)
 
 

@@ -356,12 +356,12 @@ pub fn run(request: &FitRequest, progress: Option<ProgressHook>) -> Result<FitOu
     {
         return Err(Error::InvalidArgument(format!(
             "{}: measured area {:.4e} µm² at {:.4} mN is larger than the whole height map \
-             {} ({:.1} µm²): areas in another unit (1 µm² is 1e-12 m²), or the map's {}?",
+             ({:.1} µm², {}): areas in another unit (1 µm² is 1e-12 m²), or the map's {}?",
             request.measured.label(),
             a * 1e12,
             measured.forces_n[i] * 1e3,
-            request.body.heights.label(),
             map_area * 1e12,
+            request.body.heights.label(),
             Param::PixelSize
         )));
     }
