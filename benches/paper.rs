@@ -22,6 +22,10 @@
 //! cargo bench --bench paper -- --grid 512 --method both              # before/after, maps
 //! ```
 //!
+//! `--device cpu|cuda|both` solves on the CPU, on the first CUDA GPU (feature `cuda`), or on
+//! both side by side with the maps compared (`cargo bench --features cuda --bench paper --
+//! --device both`); with the GPU it prints the peak device memory in use during a solve.
+//!
 //! Options: `--grid 512|1024|2048`, `--models elastic,hardness,hardening`, `--forces 4,40,400`
 //! (mN), `--method standard|reference|both`, `--tolerance 1e-8`, `--restart 0.01|every`,
 //! `--applies N` (timings of one operator application, default 10). Unknown arguments (cargo's
@@ -30,6 +34,7 @@
 use std::time::Instant;
 
 use contactscope::solver::cg::{Method, Restart, SolverOptions};
+use contactscope::solver::gpu::Gpu;
 use contactscope::solver::halfspace::{Boundary, ElasticOperator};
 use contactscope::solver::simulate::{sweep, LoadStep, Model, Setup};
 use contactscope::surface::generate::{self_affine, RmsTarget, SelfAffineParams};
@@ -51,6 +56,8 @@ struct Args {
     applies: usize,
     rolloff_m: f64,
     hardness_pa: f64,
+    /// Solve on the CPU (false) and/or the GPU (true).
+    devices: Vec<bool>,
 }
 
 fn parse_args() -> Args {
@@ -64,6 +71,7 @@ fn parse_args() -> Args {
         applies: 10,
         rolloff_m: 4e-6,
         hardness_pa: HARDNESS_PA,
+        devices: vec![false],
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -85,6 +93,14 @@ fn parse_args() -> Args {
                     "reference" => vec![Method::Reference],
                     "both" => vec![Method::Reference, Method::Standard],
                     other => panic!("--method standard|reference|both, not {other}"),
+                }
+            }
+            "--device" => {
+                args.devices = match value("--device").as_str() {
+                    "cpu" => vec![false],
+                    "cuda" => vec![true],
+                    "both" => vec![false, true],
+                    other => panic!("--device cpu|cuda|both, not {other}"),
                 }
             }
             "--tolerance" => args.tolerance = value("--tolerance").parse().expect("--tolerance"),
@@ -202,6 +218,11 @@ fn apply_ms(topo: &Topography, applies: usize) -> f64 {
 
 fn main() {
     let args = parse_args();
+    let gpu = args.devices.contains(&true).then(|| {
+        let gpu = Gpu::open(0).unwrap_or_else(|e| panic!("{e}"));
+        println!("GPU: {}", gpu.name());
+        gpu
+    });
     let (topo, roughness_rms_m) = body(args.grid, args.rolloff_m);
     let apply = apply_ms(&topo, args.applies);
     println!(
@@ -224,7 +245,16 @@ fn main() {
     );
     for name in &args.models {
         let mut ramps: Vec<(Method, Vec<LoadStep>)> = Vec::new();
-        for &method in &args.methods {
+        let runs = args
+            .methods
+            .iter()
+            .flat_map(|m| args.devices.iter().map(move |d| (*m, *d)));
+        for (method, on_gpu) in runs {
+            let label = format!(
+                "{}{}",
+                format!("{method:?}").to_lowercase(),
+                if on_gpu { "-cuda" } else { "" }
+            );
             let start = (Instant::now(), cpu_seconds());
             let last = std::cell::Cell::new(start);
             let setup = Setup {
@@ -240,6 +270,7 @@ fn main() {
                     restart: args.restart,
                     // As `simulate`: gap residuals relative to the roughness.
                     gap_scale_m: Some(roughness_rms_m),
+                    gpu: if on_gpu { gpu.as_ref() } else { None },
                 },
             };
             let steps = sweep(&setup, &loads, &|_, step| {
@@ -249,7 +280,7 @@ fn main() {
                 println!(
                     "{:<10} {:<9} {:>8.1} {:>6} {:>8.2} {:>8.2} {:>8.1} {:>6.0} {:>9.3} {:>11.4}",
                     name,
-                    format!("{method:?}").to_lowercase(),
+                    label,
                     step.force_n * 1e3,
                     it,
                     wall,
@@ -267,7 +298,7 @@ fn main() {
             println!(
                 "{:<10} {:<9} {:>8} {:>6} {:>8.2} {:>8.2}  (whole ramp){}",
                 name,
-                format!("{method:?}").to_lowercase(),
+                label,
                 "ramp",
                 total,
                 t0.elapsed().as_secs_f64(),
@@ -313,4 +344,10 @@ fn main() {
         }
     }
     println!("peak RSS {:.0} MiB", peak_rss_mib());
+    if let Some(gpu) = &gpu {
+        println!(
+            "peak GPU memory in use during a solve {:.0} MiB",
+            gpu.peak_memory_used() as f64 / (1 << 20) as f64
+        );
+    }
 }

@@ -82,6 +82,33 @@ pub struct SolverArgs {
     /// Most CG iterations per load.
     #[arg(long, default_value_t = 5000)]
     pub max_iterations: usize,
+    /// Where the contact solver runs: `cpu`, `cuda` (an NVIDIA GPU; an error when none is
+    /// usable) or `auto` (a GPU when one is usable, else the CPU). The GPU needs a build with
+    /// `--features cuda`; summary.json names the device that ran.
+    #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
+    pub device: DeviceArg,
+}
+
+/// `--device`.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum DeviceArg {
+    /// The CPU.
+    Cpu,
+    /// The first NVIDIA GPU.
+    Cuda,
+    /// A GPU when one is usable, else the CPU.
+    Auto,
+}
+
+impl From<DeviceArg> for contactscope_jobs::simulate::DeviceChoice {
+    fn from(d: DeviceArg) -> Self {
+        use contactscope_jobs::simulate::DeviceChoice;
+        match d {
+            DeviceArg::Cpu => DeviceChoice::Cpu,
+            DeviceArg::Cuda => DeviceChoice::Cuda,
+            DeviceArg::Auto => DeviceChoice::Auto,
+        }
+    }
 }
 
 /// `--quiet`, `-q`.

@@ -6,7 +6,7 @@ use anyhow::Result;
 
 use contactscope_jobs::demo::{run_demo, DemoParams};
 
-use super::args::Quiet;
+use super::args::{DeviceArg, Quiet};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -16,16 +16,21 @@ pub struct Args {
     /// The reduced demo of the test suite (smaller maps, fewer loads).
     #[arg(long)]
     small: bool,
+    /// Where the contact solver runs: `cpu`, `cuda` (an NVIDIA GPU; needs a build with
+    /// `--features cuda`) or `auto` (a GPU when one is usable).
+    #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
+    device: DeviceArg,
     #[command(flatten)]
     quiet: Quiet,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let params = if args.small {
+    let mut params = if args.small {
         DemoParams::reduced()
     } else {
         DemoParams::standard()
     };
+    params.device = args.device.into();
     let start = std::time::Instant::now();
     let quiet = args.quiet.quiet;
     let progress = |stage: &str| {

@@ -183,6 +183,7 @@ pub fn run(args: Args) -> Result<()> {
                 tolerance: args.solver.tolerance,
                 max_iterations: args.solver.max_iterations,
                 imaging: imaging(&args)?,
+                device: args.solver.device.into(),
                 ..BodyRequest::new(HeightInput::File(body.topography), body.e_star_pa)
             },
         )

@@ -119,6 +119,7 @@ pub fn run(args: Args) -> Result<()> {
     request.periodic = args.periodic;
     request.tolerance = args.solver.tolerance;
     request.max_iterations = args.solver.max_iterations;
+    request.device = args.solver.device.into();
     let bar = progress_bar(request.loads_n.len(), 1, args.quiet.quiet);
     bar.set_style(
         ProgressStyle::with_template(

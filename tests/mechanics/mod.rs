@@ -3,6 +3,7 @@
 
 mod fit;
 mod friction_hertz;
+mod gpu;
 mod simulate;
 mod simulate_cli;
 mod solver;

@@ -111,6 +111,12 @@ pub enum Error {
         /// The tolerance asked for.
         tolerance: f64,
     },
+    /// The GPU asked for cannot be used, or failed (feature `cuda`; [`crate::solver::gpu`]).
+    #[error("GPU (--device cuda): {reason}")]
+    Device {
+        /// What is missing or what failed.
+        reason: String,
+    },
     /// Too few line profiles through Newton rings could be measured (`optics::newton`).
     #[error(
         "{at}: only {usable} of {total} line profiles usable, at least {needed} needed: {reason}"

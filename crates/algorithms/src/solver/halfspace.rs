@@ -15,7 +15,7 @@
 //! for a window of a quarter of the map. The load solver keeps its fields on the window that can
 //! carry load (`solver::cg::load`). Window operators are planned on first use and cached.
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use rayon::prelude::*;
 
@@ -39,8 +39,9 @@ pub struct ElasticOperator {
     ny: usize,
     boundary: Boundary,
     fft: RealFft2,
-    /// Transfer function per spectrum element, normalisation included.
-    transfer: Vec<f64>,
+    /// Transfer function per spectrum element, normalisation included: computed on the first
+    /// application (a solve on the GPU never needs it, and at 2048² it is most of the set-up).
+    transfer: OnceLock<Vec<f64>>,
     self_coefficient: f64,
     /// Pixel size and modulus, to plan window operators.
     dx: f64,
@@ -93,16 +94,12 @@ impl ElasticOperator {
             Boundary::Periodic => (ny, nx),
         };
         let fft = RealFft2::new(fy, fx);
-        let transfer = match boundary {
-            Boundary::Free => free_transfer(&fft, dx, dy, e_star),
-            Boundary::Periodic => periodic_transfer(&fft, dx, dy, e_star),
-        };
         ElasticOperator {
             nx,
             ny,
             boundary,
             fft,
-            transfer,
+            transfer: OnceLock::new(),
             self_coefficient: love_pixel(0.0, 0.0, dx, dy, e_star),
             dx,
             dy,
@@ -153,6 +150,24 @@ impl ElasticOperator {
         self.boundary
     }
 
+    /// The transfer function, computed on first use.
+    fn transfer(&self) -> &[f64] {
+        self.transfer.get_or_init(|| match self.boundary {
+            Boundary::Free => free_transfer(&self.fft, self.dx, self.dy, self.e_star),
+            Boundary::Periodic => periodic_transfer(&self.fft, self.dx, self.dy, self.e_star),
+        })
+    }
+
+    /// The pixel size (Δx, Δy).
+    pub fn pixel_size(&self) -> (f64, f64) {
+        (self.dx, self.dy)
+    }
+
+    /// The contact modulus E*.
+    pub fn modulus(&self) -> f64 {
+        self.e_star
+    }
+
     /// Displacement at a loaded pixel's centre per unit pressure on that pixel (1.12·Δ/E* for
     /// square pixels): the local compliance, used for first steps.
     pub fn self_coefficient(&self) -> f64 {
@@ -178,7 +193,7 @@ impl ElasticOperator {
         let n = self.nx * self.ny;
         assert!(p.len() == n && u.len() == n, "operator: field lengths");
         self.fft
-            .convolve(p, self.nx, &self.transfer, u, &mut work.convolve);
+            .convolve(p, self.nx, self.transfer(), u, &mut work.convolve);
     }
 
     /// u = G∗p on a window of `h` rows of `w` values (row-major; `h ≤ ny`, `w ≤ nx`) when the
@@ -196,7 +211,7 @@ impl ElasticOperator {
             "operator: field lengths"
         );
         self.fft
-            .convolve(p, w, &self.transfer, u, &mut work.convolve);
+            .convolve(p, w, self.transfer(), u, &mut work.convolve);
     }
 }
 

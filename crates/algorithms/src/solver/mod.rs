@@ -5,6 +5,7 @@
 //! ([`simulate`]) and the Greenwood–Tripp rough-sphere model with its bearing-area map ([`gt`]).
 
 pub mod cg;
+pub mod gpu;
 pub mod greens;
 pub mod gt;
 pub mod halfspace;

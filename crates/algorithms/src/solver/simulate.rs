@@ -27,6 +27,7 @@
 use crate::error::{Error, Result};
 use crate::measure::patches::count_patches;
 use crate::surface::Topography;
+use rayon::prelude::*;
 
 use super::cg::{solve_load_with, Plasticity, Problem, Solution, SolverOptions};
 use super::halfspace::{Boundary, ElasticOperator};
@@ -257,7 +258,7 @@ fn solve_step(
             initial_pa,
         } => {
             let yield_pressure: Vec<f64> = plastic
-                .iter()
+                .par_iter()
                 .map(|h| initial_pa + modulus_pa_per_m * h)
                 .collect();
             let plasticity = Plasticity::Hardening {
@@ -265,9 +266,11 @@ fn solve_step(
                 compliance: 1.0 / modulus_pa_per_m,
             };
             let sol = solve_load_with(&problem, force, plasticity, None, &setup.options)?;
-            for ((h, p), y) in plastic.iter_mut().zip(&sol.pressure).zip(&yield_pressure) {
-                *h += (p - y).max(0.0) / modulus_pa_per_m;
-            }
+            plastic
+                .par_iter_mut()
+                .zip(&sol.pressure)
+                .zip(&yield_pressure)
+                .for_each(|((h, p), y)| *h += (p - y).max(0.0) / modulus_pa_per_m);
             Ok((sol, 1))
         }
     }
@@ -275,7 +278,7 @@ fn solve_step(
 
 /// The separation of the plastically deformed body, s + h_pl.
 fn deformed(base: &[f64], plastic: &[f64]) -> Vec<f64> {
-    base.iter().zip(plastic).map(|(s, h)| s + h).collect()
+    base.par_iter().zip(plastic).map(|(s, h)| s + h).collect()
 }
 
 /// Overlap o = max(0, −g) on pixels at the cap (Eq. 4's increment), zero elsewhere.
@@ -465,10 +468,10 @@ fn describe(
     let (nx, ny) = (topo.nx(), topo.ny());
     let mask: Vec<u8> = solution
         .pressure
-        .iter()
+        .par_iter()
         .map(|p| u8::from(*p > 0.0))
         .collect();
-    let contact = mask.iter().filter(|m| **m == 1).count();
+    let contact = mask.par_iter().filter(|m| **m == 1).count();
     let area = contact as f64 * topo.dx_m * topo.dy_m;
     let on_border = |i: usize| {
         let (x, y) = (i % nx, i / nx);
@@ -481,7 +484,11 @@ fn describe(
         area_m2: area,
         contact_fraction: contact as f64 / (nx * ny) as f64,
         mean_pressure_pa: if area > 0.0 { force / area } else { f64::NAN },
-        max_pressure_pa: solution.pressure.iter().copied().fold(0.0, f64::max),
+        max_pressure_pa: solution
+            .pressure
+            .par_iter()
+            .copied()
+            .reduce(|| 0.0, f64::max),
         patches: count_patches(&mask, nx).0,
         plastic_iterations: outer,
         edge_contact,

@@ -80,13 +80,14 @@ pub fn synthetic_experiment(
 }
 
 /// The solver limits of every demo simulation.
-pub(super) fn solver_options() -> SolverOptions<'static> {
-    SolverOptions {
+pub(super) fn solver_options(p: &DemoParams) -> Result<SolverOptions<'static>> {
+    Ok(SolverOptions {
         max_iterations: 5000,
         tolerance: 1e-8,
         monitor: None,
+        gpu: p.device.open()?,
         ..SolverOptions::default()
-    }
+    })
 }
 
 /// The models' rigid body: the experiment's roughness on the sphere.
@@ -95,7 +96,7 @@ pub fn model_body(p: &DemoParams, experiment: &Experiment) -> Result<ModelBody> 
         experiment.roughness.clone(),
         Some(p.radius_m),
         p.e_star_pa,
-        solver_options(),
+        solver_options(p)?,
     )?)
 }
 
@@ -168,7 +169,7 @@ fn truth_ramp(p: &DemoParams, roughness: &Topography) -> Result<(Vec<f64>, Vec<G
         },
         options: SolverOptions {
             gap_scale_m: Some(roughness.rms_height()),
-            ..solver_options()
+            ..solver_options(p)?
         },
     };
     let steps = sweep(&setup, &p.loads_n, &|_, _| {})?;

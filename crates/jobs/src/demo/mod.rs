@@ -39,6 +39,7 @@ use crate::images::ImageInput;
 use crate::newton::{files::run_to_folder as newton_to_folder, NewtonRequest};
 use crate::psf::{files::run_to_folder as psf_to_folder, PsfRequest};
 use crate::series::{Micrographs, SeriesSpec};
+use crate::simulate::DeviceChoice;
 use crate::staging::write_atomic;
 use contactscope::compare::Comparison;
 use contactscope::mechanics::friction::{SlipOptions, XAxis};
@@ -85,6 +86,8 @@ pub struct DemoParams {
     pub fit_grid: usize,
     /// Seed of everything random.
     pub seed: u64,
+    /// Where the contact solver runs.
+    pub device: DeviceChoice,
 }
 
 impl DemoParams {
@@ -111,6 +114,7 @@ impl DemoParams {
             detection_gap_m: 9e-9,
             fit_grid: 5,
             seed: 2018,
+            device: DeviceChoice::Cpu,
         }
     }
 
@@ -492,6 +496,7 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
             fwhm_m: p.psf_fwhm_m,
             pixel_m: (p.image_pixel_m, p.image_pixel_m),
         }),
+        device: p.device,
         ..BodyRequest::new(
             HeightInput::File(TopographySource {
                 path: data.join("topography.npy"),

@@ -29,7 +29,7 @@ use crate::error::{Error, Location, Result};
 use crate::heights::{HeightInput, Roughness};
 use crate::lab::{self, OptQ, Qs, Unit, Q};
 use crate::results::read_areas_csv;
-use crate::simulate::{check_loads, check_solver, SimulateRequest};
+use crate::simulate::{check_loads, check_solver, DeviceChoice, SimulateRequest};
 
 /// The rough sphere of a fit or a ramp: heights, sphere, material, solver limits, imaging.
 #[derive(Debug, Clone)]
@@ -48,6 +48,8 @@ pub struct BodyRequest {
     pub max_iterations: usize,
     /// Count simulated areas as imaged (blur, resample, Otsu) instead of raw g = 0 pixels.
     pub imaging: Option<Imaging>,
+    /// Where the ramps are solved (CPU, CUDA GPU, or a GPU when one is usable).
+    pub device: DeviceChoice,
 }
 
 impl BodyRequest {
@@ -62,6 +64,7 @@ impl BodyRequest {
             tolerance: SimulateRequest::TOLERANCE,
             max_iterations: SimulateRequest::MAX_ITERATIONS,
             imaging: None,
+            device: DeviceChoice::Cpu,
         }
     }
 
@@ -88,6 +91,7 @@ impl BodyRequest {
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,
             monitor: None,
+            gpu: self.device.open()?,
             ..SolverOptions::default()
         };
         let mut body = ModelBody::new(topography, self.radius_m, self.e_star_pa, options)?;

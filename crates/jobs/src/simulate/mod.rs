@@ -13,6 +13,8 @@ use serde::{Serialize, Serializer};
 use contactscope::analysis::fit::fit_power_law;
 use contactscope::measure::patches::count_patches;
 use contactscope::solver::cg::{Monitor, SolverOptions};
+pub use contactscope::solver::gpu::DeviceChoice;
+use contactscope::solver::gpu::{describe, Gpu};
 use contactscope::solver::gt::{gt_bearing_area, gt_profile, GtParams};
 use contactscope::solver::halfspace::Boundary;
 use contactscope::solver::simulate::{separation, sweep_each, LoadStep, Model, Setup};
@@ -108,6 +110,8 @@ pub struct SimulateRequest {
     pub tolerance: f64,
     /// Most CG iterations per load.
     pub max_iterations: usize,
+    /// Where the half-space solver runs (CPU, CUDA GPU, or a GPU when one is usable).
+    pub device: DeviceChoice,
 }
 
 impl SimulateRequest {
@@ -132,6 +136,7 @@ impl SimulateRequest {
             loads_n,
             tolerance: Self::TOLERANCE,
             max_iterations: Self::MAX_ITERATIONS,
+            device: DeviceChoice::Cpu,
         }
     }
 
@@ -266,6 +271,8 @@ pub struct SolverFacts {
     pub tolerance: f64,
     /// Iteration limit per load.
     pub max_iterations: usize,
+    /// Where the loads were solved: "cpu", or "cuda: " and the GPU's name.
+    pub device: String,
 }
 
 /// The power law A = c·N^β through the simulated areas (N in mN, A in µm²).
@@ -371,6 +378,7 @@ pub fn run(
             e.to_string(),
         )
     })?;
+    let mut gpu = None;
     let (loads, mut warnings) = match request.model {
         ModelChoice::GreenwoodTripp => run_gt(request, &roughness, &stats, observer)?,
         ModelChoice::HalfSpace(model) => {
@@ -378,7 +386,8 @@ pub fn run(
             if let Some(r) = request.radius_m {
                 body.add_sphere(r)?;
             }
-            run_halfspace(request, model, &body, stats.h_rms_m, observer, monitor)?
+            gpu = request.device.open()?;
+            run_halfspace(request, model, &body, stats.h_rms_m, gpu, observer, monitor)?
         }
     };
     warnings.splice(0..0, notes);
@@ -420,6 +429,7 @@ pub fn run(
             method: "Polonsky–Keer constrained conjugate gradients, f64",
             tolerance: request.tolerance,
             max_iterations: request.max_iterations,
+            device: describe(gpu),
         },
         power_law: fit_power_law(&f, &a).map(|fit| PowerLaw {
             exponent: fit.exponent,
@@ -440,11 +450,13 @@ fn run_halfspace(
     model: Model,
     body: &Topography,
     h_rms_m: f64,
+    gpu: Option<&'static Gpu>,
     observer: &mut dyn LoadObserver,
     monitor: Option<Monitor>,
 ) -> Result<Rows> {
     let options = SolverOptions {
         monitor,
+        gpu,
         // Gap residuals relative to the roughness (SolverOptions::gap_scale_m).
         gap_scale_m: Some(h_rms_m),
         ..request.solver_options()

@@ -30,7 +30,9 @@ pub use displacement::solve_displacement;
 pub use load::{solve_load, solve_load_with};
 pub use reference::solve_load_bounded;
 
-use super::halfspace::{ElasticOperator, Workspace};
+use rayon::prelude::*;
+
+use super::halfspace::ElasticOperator;
 
 /// Called after every CG iteration with (iteration, relative residual), e.g. for a progress bar.
 pub type Monitor<'a> = &'a (dyn Fn(usize, f64) + Sync);
@@ -106,6 +108,9 @@ pub struct SolverOptions<'a> {
     /// relative to the smaller of this and the range of the separation, so that giving it never
     /// loosens the rule; `None`: the range of the separation.
     pub gap_scale_m: Option<f64>,
+    /// The GPU the standard load solver runs on ([`crate::solver::gpu`]); `None`: the CPU.
+    /// The reference algorithms and displacement control always run on the CPU.
+    pub gpu: Option<&'a crate::solver::gpu::Gpu>,
 }
 
 impl std::fmt::Debug for SolverOptions<'_> {
@@ -116,6 +121,7 @@ impl std::fmt::Debug for SolverOptions<'_> {
             .field("method", &self.method)
             .field("restart", &self.restart)
             .field("gap_scale_m", &self.gap_scale_m)
+            .field("gpu", &self.gpu.map(|g| g.name()))
             .finish()
     }
 }
@@ -129,6 +135,7 @@ impl Default for SolverOptions<'_> {
             method: Method::Standard,
             restart: Restart::default(),
             gap_scale_m: None,
+            gpu: None,
         }
     }
 }
@@ -296,25 +303,34 @@ fn finish(
     residuals: (f64, f64),
 ) -> Solution {
     let mut work = problem.operator.workspace();
-    finish_with(
-        problem, pressure, approach, plasticity, iterations, residuals, &mut work,
+    let mut displacement = vec![0.0; problem.len()];
+    problem
+        .operator
+        .apply(&pressure, &mut displacement, &mut work);
+    assemble(
+        problem,
+        pressure,
+        displacement,
+        approach,
+        plasticity,
+        iterations,
+        residuals,
     )
 }
 
-/// [`finish`] with the caller's workspace of the whole operator.
-fn finish_with(
+/// The solution from its pressure and displacement u = G∗p: the gap g = s − δ + u (plus the
+/// hardening spring) and the force.
+fn assemble(
     problem: &Problem,
     pressure: Vec<f64>,
+    displacement: Vec<f64>,
     approach: f64,
     plasticity: Plasticity,
     iterations: usize,
     (gap_residual, pressure_change): (f64, f64),
-    work: &mut Workspace,
 ) -> Solution {
-    let n = problem.len();
-    let mut displacement = vec![0.0; n];
-    problem.operator.apply(&pressure, &mut displacement, work);
-    let gap = (0..n)
+    let gap = (0..problem.len())
+        .into_par_iter()
         .map(|i| {
             problem.separation[i] - approach + displacement[i] + plasticity.spring(i, pressure[i])
         })

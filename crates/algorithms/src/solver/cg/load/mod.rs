@@ -51,15 +51,20 @@
 //!
 //! [`ElasticOperator::window`]: crate::solver::halfspace::ElasticOperator::window
 
+#[cfg(feature = "cuda")]
+mod device;
+mod fields;
 mod passes;
+mod restore;
 mod window;
 
-use crate::error::{Error, Result};
-use crate::solver::halfspace::{WindowOperator, Workspace};
+use rayon::prelude::*;
 
-use super::{
-    finish_with, reference, Method, Plasticity, Problem, Restart, Solution, SolverOptions,
-};
+use crate::error::{Error, Result};
+
+use super::{assemble, reference, Method, Plasticity, Problem, Restart, Solution, SolverOptions};
+use fields::{Fields, Gaps};
+use passes::HostFields;
 use window::{Reach, Window};
 
 /// Elastic contact under load control (`force` in the unit of pressure × pixel area).
@@ -86,7 +91,22 @@ pub fn solve_load_with(
             reference::solve_load_bounded(problem, force, plasticity, options)
         }
         (Method::Standard, _) => {
-            match Solver::new(problem, force, plasticity, warm).run(options)? {
+            let start = initial_pressure(problem, force, plasticity, warm);
+            let run = match options.gpu {
+                None => {
+                    let fields = HostFields::new(problem, plasticity, start);
+                    Solver::new(problem, force, plasticity, fields)?.run(options)?
+                }
+                #[cfg(feature = "cuda")]
+                Some(gpu) => {
+                    let fields = device::DeviceFields::new(gpu, problem, plasticity, &start)?;
+                    drop(start);
+                    Solver::new(problem, force, plasticity, fields)?.run(options)?
+                }
+                #[cfg(not(feature = "cuda"))]
+                Some(gpu) => gpu.unreachable(),
+            };
+            match run {
                 Run::Done(solution) => Ok(solution),
                 Run::Stalled(spent) => {
                     // The reference algorithms are slower but cannot cycle (an outer root-find on δ
@@ -122,8 +142,8 @@ enum Run {
 }
 
 /// One load-controlled solve: the problem, the window, and the fields on the window (row-major
-/// `h × w`).
-struct Solver<'a> {
+/// `h × w`) in a backend ([`Fields`]).
+struct Solver<'a, F: Fields> {
     problem: &'a Problem<'a>,
     plasticity: Plasticity<'a>,
     /// W/ΔA: the pressure sum the load requires.
@@ -132,132 +152,88 @@ struct Solver<'a> {
     /// Pixels every later window must hold: those the whole-grid check found penetrating.
     keep: Option<Window>,
     reach: Reach,
-    op: WindowOperator<'a>,
-    work: Workspace,
-    /// Separation and, for bounded models, the per-pixel cap or p_Y,prev, on the window.
-    s: Vec<f64>,
-    bound: Vec<f64>,
-    p: Vec<f64>,
-    previous: Vec<f64>,
-    u: Vec<f64>,
-    t: Vec<f64>,
-    r: Vec<f64>,
+    fields: F,
 }
 
-impl<'a> Solver<'a> {
+/// The starting pressure: `warm` projected onto the bounds, or uniform.
+fn initial_pressure(
+    problem: &Problem,
+    force: f64,
+    plasticity: Plasticity,
+    warm: Option<&[f64]>,
+) -> Vec<f64> {
+    let n = problem.len();
+    let target = force / problem.pixel_area;
+    match warm {
+        Some(w) if w.len() == n && w.iter().any(|v| *v > 0.0) => w
+            .par_iter()
+            .enumerate()
+            .map(|(i, v)| v.clamp(0.0, plasticity.cap(i)))
+            .collect(),
+        _ => (0..n)
+            .into_par_iter()
+            .map(|i| (target / n as f64).min(plasticity.cap(i)))
+            .collect(),
+    }
+}
+
+impl<'a, F: Fields> Solver<'a, F> {
+    /// The solve of `force` on `fields`, which hold the whole grid with the starting pressure
+    /// ([`initial_pressure`]).
     fn new(
         problem: &'a Problem<'a>,
         force: f64,
         plasticity: Plasticity<'a>,
-        warm: Option<&[f64]>,
-    ) -> Self {
+        fields: F,
+    ) -> Result<Self> {
         let op = problem.operator;
-        let (nx, ny) = (op.nx(), op.ny());
-        let n = problem.len();
-        let reach = Reach::new(problem.separation, nx, ny, op.boundary());
-        let window = reach.whole();
-        let target = force / problem.pixel_area;
-        let bound = match plasticity {
-            Plasticity::Elastic => Vec::new(),
-            Plasticity::Cap(c) => c.to_vec(),
-            Plasticity::Hardening { yield_pressure, .. } => yield_pressure.to_vec(),
-        };
-        let p = match warm {
-            Some(w) if w.len() == n && w.iter().any(|v| *v > 0.0) => w
-                .iter()
-                .enumerate()
-                .map(|(i, v)| v.clamp(0.0, plasticity.cap(i)))
-                .collect(),
-            _ => (0..n)
-                .map(|i| (target / n as f64).min(plasticity.cap(i)))
-                .collect(),
-        };
+        let reach = Reach::new(problem.separation, op.nx(), op.ny(), op.boundary());
         let mut solver = Solver {
             problem,
             plasticity,
-            target,
-            window,
+            target: force / problem.pixel_area,
+            window: reach.whole(),
             keep: None,
             reach,
-            op: op.window(ny, nx),
-            work: op.workspace(),
-            s: problem.separation.to_vec(),
-            bound,
-            p,
-            previous: vec![0.0; n],
-            u: vec![0.0; n],
-            t: vec![0.0; n],
-            r: vec![0.0; n],
+            fields,
         };
-        solver.start_on_the_load();
-        solver
-    }
-
-    /// The plasticity on the window's pixels.
-    fn bounds(&self) -> Plasticity<'_> {
-        match self.plasticity {
-            Plasticity::Elastic => Plasticity::Elastic,
-            Plasticity::Cap(_) => Plasticity::Cap(&self.bound),
-            Plasticity::Hardening { compliance, .. } => Plasticity::Hardening {
-                yield_pressure: &self.bound,
-                compliance,
-            },
-        }
+        solver.start_on_the_load()?;
+        Ok(solver)
     }
 
     /// Move the fields to `next`: the pressure is carried over (it is zero outside the old
     /// window, and `next` holds every loaded pixel), the CG state starts afresh.
-    fn rewindow(&mut self, next: Window) {
-        let whole = self.reach.whole();
-        self.p = next.embed(&self.window, &self.p);
-        self.s = next.embed(&whole, self.problem.separation);
-        self.bound = match self.plasticity {
-            Plasticity::Elastic => Vec::new(),
-            Plasticity::Cap(c) => next.embed(&whole, c),
-            Plasticity::Hardening { yield_pressure, .. } => next.embed(&whole, yield_pressure),
-        };
-        let n = next.len();
-        self.previous = self.p.clone();
-        (self.u, self.t, self.r) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        self.op = self.problem.operator.window(next.h, next.w);
-        self.work = self.op.window_workspace(next.h);
+    fn rewindow(&mut self, next: Window) -> Result<()> {
+        self.fields
+            .rewindow(&self.window, &next, &self.reach.whole())?;
         self.window = next;
+        Ok(())
     }
 
-    /// The solution on the whole grid ([`super::finish`]). The iteration's buffers are freed
-    /// first, and a whole-grid window lends its workspace, so that the whole-grid application
-    /// does not add a second set of buffers to the peak memory (134 MB at 2048²).
-    fn finish(
-        &mut self,
-        pressure: Vec<f64>,
-        delta: f64,
-        iteration: usize,
-        residual: (f64, f64),
-    ) -> Solution {
-        for field in [&mut self.u, &mut self.t, &mut self.r, &mut self.previous] {
-            *field = Vec::new();
-        }
-        let whole = self.window == self.reach.whole();
-        let mut own;
-        let work = if whole {
-            &mut self.work
-        } else {
-            own = self.problem.operator.workspace();
-            &mut own
-        };
-        let solution = finish_with(
+    /// The solution on the whole grid ([`super::assemble`]).
+    fn finish(&mut self, delta: f64, iteration: usize, residual: (f64, f64)) -> Result<Solution> {
+        let (pressure, displacement) = self.fields.solution(&self.window, &self.reach.whole())?;
+        Ok(assemble(
             self.problem,
             pressure,
+            displacement,
             delta,
             self.plasticity,
             iteration,
             residual,
-            work,
-        );
-        let n = self.window.len();
-        (self.u, self.t, self.r, self.previous) =
-            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        solution
+        ))
+    }
+
+    /// Σg² over F. From the shifted sums Σg'² − n·m² when n·m² ≤ ½Σg'² (then the subtraction
+    /// loses at most a bit or two; δ moved by less than the residual), else by a second, exact pass
+    /// with the new δ.
+    fn residual_norm(&mut self, gaps: &Gaps, m: f64, delta: f64) -> Result<f64> {
+        let count = gaps.count as f64;
+        let shifted = gaps.sum_sq - count * m * m;
+        if count * m * m <= 0.5 * gaps.sum_sq {
+            return Ok(shifted);
+        }
+        self.fields.residual_sq(delta)
     }
 
     fn run(mut self, options: &SolverOptions) -> Result<Run> {
@@ -269,10 +245,8 @@ impl<'a> Solver<'a> {
         let mut loaded = Some(self.window);
         let (mut best, mut best_at) = (f64::INFINITY, 0usize);
         for iteration in 1..=options.max_iterations {
-            let Window { h, w, .. } = self.window;
-            self.op
-                .apply_window(&self.p, h, w, &mut self.u, &mut self.work);
-            let gaps = self.gaps(delta);
+            self.fields.apply_pressure(&self.window)?;
+            let gaps = self.fields.gaps(delta)?;
             let count = gaps.count as f64;
             // With no free pixel (every loaded one at its cap, as with a tiny hardness early on)
             // δ is the perfectly plastic approach: the pixels that penetrate at δ, all at their
@@ -281,7 +255,7 @@ impl<'a> Solver<'a> {
             let m = if gaps.count > 0 {
                 gaps.sum / count
             } else {
-                self.plastic_approach() - delta
+                self.plastic_approach()? - delta
             };
             delta += m;
             since_move += 1;
@@ -289,13 +263,13 @@ impl<'a> Solver<'a> {
                 self.reach
                     .next_window(&self.window, union(loaded, self.keep), delta, since_move)
             {
-                self.rewindow(next);
+                self.rewindow(next)?;
                 (g_old, energy_old, conjugate, since_move) =
                     (f64::INFINITY, f64::INFINITY, false, 0);
                 continue;
             }
             let g_sq = if gaps.count > 0 {
-                self.residual_norm(&gaps, m, delta)
+                self.residual_norm(&gaps, m, delta)?
             } else {
                 0.0
             };
@@ -324,16 +298,16 @@ impl<'a> Solver<'a> {
             }
             g_old = g_sq;
             // t = g + β(t_old − mean_F t_old): mean-free on F because Σ_F g = 0.
-            self.direction(delta, beta, beta * gaps.sum_t / count.max(1.0));
-            self.op
-                .apply_window(&self.t, h, w, &mut self.r, &mut self.work);
-            let den = self.curvature();
+            self.fields
+                .direction(delta, beta, beta * gaps.sum_t / count.max(1.0))?;
+            self.fields.apply_direction(&self.window)?;
+            let den = self.fields.curvature()?;
             let tau = if den > 0.0 && num > 0.0 {
                 num / den
             } else {
                 tau0
             };
-            let step = self.step(delta, tau);
+            let step = self.fields.step(delta, tau, self.window.w)?;
             if !positive(step.total) {
                 return Err(Error::NotConverged {
                     what: "load-controlled contact (no pixel carries load)".into(),
@@ -348,21 +322,14 @@ impl<'a> Solver<'a> {
                 h: step.rows.1 - step.rows.0 + 1,
                 w: step.cols.1 - step.cols.0 + 1,
             });
-            let (change, load) = match self.load_shift(&step) {
-                Some(shift) => self.apply_shift(shift),
+            let (change, load) = match self.load_shift(&step)? {
+                Some(shift) => self.fields.apply_shift(shift)?,
                 None => {
                     // Nothing loaded is left: start again from a uniform pressure.
-                    let n = self.p.len();
-                    let uniform = self.target / n as f64;
-                    let p = std::mem::take(&mut self.p);
-                    self.p = p
-                        .iter()
-                        .enumerate()
-                        .map(|(i, _)| uniform.min(self.bounds().cap(i)))
-                        .collect();
-                    self.start_on_the_load();
+                    self.fields.fill(self.target / self.window.len() as f64)?;
+                    self.start_on_the_load()?;
                     loaded = Some(self.window);
-                    self.change()
+                    self.fields.change()?
                 }
             };
             let change = change / self.target;
@@ -388,8 +355,7 @@ impl<'a> Solver<'a> {
                 && residual.0 < options.tolerance
                 && residual.1 < options.tolerance
             {
-                let pressure = self.reach.whole().embed(&self.window, &self.p);
-                let solution = self.finish(pressure, delta, iteration, residual);
+                let solution = self.finish(delta, iteration, residual)?;
                 // Pixels outside the window were assumed not to touch: check on the whole grid.
                 let tolerance = options.tolerance * scale;
                 match self
@@ -399,7 +365,7 @@ impl<'a> Solver<'a> {
                     None => return Ok(Run::Done(solution)),
                     Some(next) => {
                         self.keep = Some(next);
-                        self.rewindow(next);
+                        self.rewindow(next)?;
                         (g_old, energy_old, conjugate, since_move) =
                             (f64::INFINITY, f64::INFINITY, false, 0);
                     }
@@ -466,7 +432,9 @@ mod tests {
             tolerance: 1e-10,
             ..SolverOptions::default()
         };
-        let mut solver = Solver::new(&problem, force, Plasticity::Elastic, None);
+        let start = initial_pressure(&problem, force, Plasticity::Elastic, None);
+        let fields = HostFields::new(&problem, Plasticity::Elastic, start);
+        let mut solver = Solver::new(&problem, force, Plasticity::Elastic, fields).unwrap();
         let confined = Window {
             y0: 24,
             x0: 24,
@@ -477,7 +445,7 @@ mod tests {
             bx as usize >= 24 + 80,
             "the asperity lies outside the window"
         );
-        solver.rewindow(confined);
+        solver.rewindow(confined).unwrap();
         let Ok(Run::Done(windowed)) = solver.run(&options) else {
             panic!("the windowed solve converges without stalling");
         };

@@ -1,10 +1,15 @@
-//! The fused passes of one load-controlled iteration over the window's fields (see the module
-//! docs of [`super`]): residual sums, direction, curvature, the projected step, and the
-//! restoration of the load. Every sum is deterministic ([`crate::solver::cg::sums`]).
+//! The fused passes of one load-controlled iteration on the host (see the module docs of
+//! [`super`]): residual sums, direction, curvature, the projected step, and the restoration of
+//! the load, over the window's fields in parallel. Every sum is deterministic
+//! ([`crate::solver::cg::sums`]).
 
+use crate::error::Result;
 use crate::solver::cg::sums::{reduce, reduce_mut, reduce_mut2};
+use crate::solver::cg::{Plasticity, Problem};
+use crate::solver::halfspace::{WindowOperator, Workspace};
 
-use super::Solver;
+use super::fields::{Fields, Gaps, Shift, ShiftSums, Step};
+use super::window::Window;
 
 /// Where a pixel's pressure sits between its bounds.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -14,141 +19,63 @@ pub(super) enum Class {
     Capped,
 }
 
-/// Sums of the residual pass, with g' = e − δ_prev (δ of the previous iteration): shifting by a
-/// δ close to the new one keeps Σg² = Σg'² − n·m² free of cancellation (m = mean g').
-#[derive(Clone, Copy)]
-pub(super) struct Gaps {
-    pub count: usize,
-    pub sum: f64,
-    pub sum_sq: f64,
-    /// Σg'·t_old and Σt_old over F.
-    pub sum_gt: f64,
-    pub sum_t: f64,
-    /// Extremes of g' on F, the smallest on p = 0, the largest on p = cap.
-    pub free_min: f64,
-    pub free_max: f64,
-    pub zero_min: f64,
-    pub capped_max: f64,
-    /// E(p) + δ·ΣpΔA (the δ term is constant under load control).
-    pub energy: f64,
+/// The fields on the host, `h × w` on the window.
+pub(super) struct HostFields<'a> {
+    problem: &'a Problem<'a>,
+    plasticity: Plasticity<'a>,
+    op: WindowOperator<'a>,
+    work: Workspace,
+    /// The window's rows and columns.
+    shape: (usize, usize),
+    /// Separation and, for bounded models, the per-pixel cap or p_Y,prev, on the window.
+    s: Vec<f64>,
+    bound: Vec<f64>,
+    p: Vec<f64>,
+    previous: Vec<f64>,
+    u: Vec<f64>,
+    t: Vec<f64>,
+    r: Vec<f64>,
 }
 
-impl Default for Gaps {
-    fn default() -> Self {
-        Gaps {
-            count: 0,
-            sum: 0.0,
-            sum_sq: 0.0,
-            sum_gt: 0.0,
-            sum_t: 0.0,
-            free_min: f64::INFINITY,
-            free_max: f64::NEG_INFINITY,
-            zero_min: f64::INFINITY,
-            capped_max: f64::NEG_INFINITY,
-            energy: 0.0,
-        }
-    }
-}
-
-impl Gaps {
-    pub fn add(self, o: Gaps) -> Gaps {
-        Gaps {
-            count: self.count + o.count,
-            sum: self.sum + o.sum,
-            sum_sq: self.sum_sq + o.sum_sq,
-            sum_gt: self.sum_gt + o.sum_gt,
-            sum_t: self.sum_t + o.sum_t,
-            free_min: self.free_min.min(o.free_min),
-            free_max: self.free_max.max(o.free_max),
-            zero_min: self.zero_min.min(o.zero_min),
-            capped_max: self.capped_max.max(o.capped_max),
-            energy: self.energy + o.energy,
-        }
-    }
-}
-
-/// Counts and sums of the step pass.
-#[derive(Clone, Copy)]
-pub(super) struct Step {
-    /// Σp after the step.
-    pub total: f64,
-    /// After the step: pixels strictly between their bounds, pixels at the cap, and the smallest
-    /// p and the smallest distance to the cap of an inside pixel. A shift μ of the inside pixels
-    /// with −min_inside < μ < headroom moves no pixel across a bound.
-    pub inside: usize,
-    pub capped: usize,
-    pub min_inside: f64,
-    pub headroom: f64,
-    /// Σp over the inside and over the capped pixels.
-    pub inside_total: f64,
-    pub capped_total: f64,
-    /// Pixels that joined from p = 0, left the cap, were pushed onto the cap, or whose hardening
-    /// spring switched on or off.
-    pub engaged: usize,
-    pub released: usize,
-    pub clamped: usize,
-    pub flipped: usize,
-    /// The first and last window rows and columns with p > 0 (inclusive), if any.
-    pub rows: (usize, usize),
-    pub cols: (usize, usize),
-}
-
-impl Default for Step {
-    fn default() -> Self {
-        Step {
-            total: 0.0,
-            inside: 0,
-            capped: 0,
-            min_inside: f64::INFINITY,
-            headroom: f64::INFINITY,
-            inside_total: 0.0,
-            capped_total: 0.0,
-            engaged: 0,
-            released: 0,
-            clamped: 0,
-            flipped: 0,
-            rows: (usize::MAX, 0),
-            cols: (usize::MAX, 0),
-        }
-    }
-}
-
-impl Step {
-    pub fn add(self, o: Step) -> Step {
-        Step {
-            total: self.total + o.total,
-            inside: self.inside + o.inside,
-            capped: self.capped + o.capped,
-            min_inside: self.min_inside.min(o.min_inside),
-            headroom: self.headroom.min(o.headroom),
-            inside_total: self.inside_total + o.inside_total,
-            capped_total: self.capped_total + o.capped_total,
-            engaged: self.engaged + o.engaged,
-            released: self.released + o.released,
-            clamped: self.clamped + o.clamped,
-            flipped: self.flipped + o.flipped,
-            rows: (self.rows.0.min(o.rows.0), self.rows.1.max(o.rows.1)),
-            cols: (self.cols.0.min(o.cols.0), self.cols.1.max(o.cols.1)),
+impl<'a> HostFields<'a> {
+    /// The fields on the whole grid with starting pressure `p`.
+    pub fn new(problem: &'a Problem<'a>, plasticity: Plasticity<'a>, p: Vec<f64>) -> Self {
+        let op = problem.operator;
+        let n = problem.len();
+        let bound = match plasticity {
+            Plasticity::Elastic => Vec::new(),
+            Plasticity::Cap(c) => c.to_vec(),
+            Plasticity::Hardening { yield_pressure, .. } => yield_pressure.to_vec(),
+        };
+        HostFields {
+            problem,
+            plasticity,
+            op: op.window(op.ny(), op.nx()),
+            work: op.workspace(),
+            shape: (op.ny(), op.nx()),
+            s: problem.separation.to_vec(),
+            bound,
+            p,
+            previous: vec![0.0; n],
+            u: vec![0.0; n],
+            t: vec![0.0; n],
+            r: vec![0.0; n],
         }
     }
 
-    /// Pixels that changed their place in the active set.
-    pub fn joined(&self) -> usize {
-        self.engaged + self.released + self.clamped
+    /// The plasticity on the window's pixels.
+    fn bounds(&self) -> Plasticity<'_> {
+        match self.plasticity {
+            Plasticity::Elastic => Plasticity::Elastic,
+            Plasticity::Cap(_) => Plasticity::Cap(&self.bound),
+            Plasticity::Hardening { compliance, .. } => Plasticity::Hardening {
+                yield_pressure: &self.bound,
+                compliance,
+            },
+        }
     }
-}
 
-/// How the load is restored after a step ([`Solver::load_shift`]): the pixels strictly inside
-/// their bounds move to clip(λ·p + μ, 0, cap), the capped ones to λ_c·p.
-#[derive(Clone, Copy)]
-pub(super) struct Shift {
-    pub inside_scale: f64,
-    pub inside_add: f64,
-    pub capped_scale: f64,
-}
-
-impl Solver<'_> {
-    pub(super) fn class(&self, i: usize, p: f64) -> Class {
+    fn class(&self, i: usize, p: f64) -> Class {
         if p <= 0.0 {
             Class::Zero
         } else if p >= self.bounds().cap(i) {
@@ -159,50 +86,29 @@ impl Solver<'_> {
     }
 
     /// e = s + u (+ the spring's compression) at pixel i for pressure p.
-    pub(super) fn effective_gap(&self, i: usize, p: f64) -> f64 {
+    fn effective_gap(&self, i: usize, p: f64) -> f64 {
         self.s[i] + self.u[i] + self.bounds().spring(i, p)
     }
+}
 
-    /// Scale the starting pressure to the load (p ≤ cap, Σ min(λp, cap) = target; the load is
-    /// below the capacity, so λ exists).
-    pub(super) fn start_on_the_load(&mut self) {
-        let n = self.p.len();
-        let cap = |i: usize| self.bounds().cap(i);
-        let mut lambda = 1.0;
-        for _ in 0..200 {
-            let p = &self.p;
-            let (value, slope) = reduce(
-                n,
-                (0.0, 0.0),
-                |range| {
-                    range.fold((0.0, 0.0), |(v, s), i| {
-                        if lambda * p[i] < cap(i) {
-                            (v + lambda * p[i], s + p[i])
-                        } else {
-                            (v + cap(i), s)
-                        }
-                    })
-                },
-                |a, b| (a.0 + b.0, a.1 + b.1),
-            );
-            if !super::positive(slope) || (value - self.target).abs() <= 1e-15 * self.target {
-                break;
-            }
-            // Σmin(λp, cap) is concave and increasing: Newton climbs to the root from below.
-            lambda = (lambda + (self.target - value) / slope).max(lambda * 0.5);
-        }
-        let mut p = std::mem::take(&mut self.p);
-        for (i, v) in p.iter_mut().enumerate() {
-            *v = (*v * lambda).min(self.bounds().cap(i));
-        }
-        self.p = p;
+impl Fields for HostFields<'_> {
+    fn apply_pressure(&mut self, window: &Window) -> Result<()> {
+        self.op
+            .apply_window(&self.p, window.h, window.w, &mut self.u, &mut self.work);
+        Ok(())
+    }
+
+    fn apply_direction(&mut self, window: &Window) -> Result<()> {
+        self.op
+            .apply_window(&self.t, window.h, window.w, &mut self.r, &mut self.work);
+        Ok(())
     }
 
     /// The residual pass (reads s, u, p, t): sums and extremes of g' = e − `delta` per class,
     /// and the energy.
-    pub(super) fn gaps(&self, delta: f64) -> Gaps {
+    fn gaps(&mut self, delta: f64) -> Result<Gaps> {
         let n = self.p.len();
-        reduce(
+        Ok(reduce(
             n,
             Gaps::default(),
             |range| {
@@ -231,36 +137,11 @@ impl Solver<'_> {
                 acc
             },
             Gaps::add,
-        )
-    }
-
-    /// Σg² over F. From the shifted sums Σg'² − n·m² when n·m² ≤ ½Σg'² (then the subtraction
-    /// loses at most a bit or two; δ moved by less than the residual), else by a second, exact pass
-    /// with the new δ.
-    pub(super) fn residual_norm(&self, gaps: &Gaps, m: f64, delta: f64) -> f64 {
-        let count = gaps.count as f64;
-        let shifted = gaps.sum_sq - count * m * m;
-        if count * m * m <= 0.5 * gaps.sum_sq {
-            return shifted;
-        }
-        reduce(
-            self.p.len(),
-            0.0,
-            |range| {
-                range
-                    .filter(|&i| self.class(i, self.p[i]) == Class::Free)
-                    .map(|i| {
-                        let g = self.effective_gap(i, self.p[i]) - delta;
-                        g * g
-                    })
-                    .sum::<f64>()
-            },
-            |a, b| a + b,
-        )
+        ))
     }
 
     /// t ← (e − δ) + β·t − `mean` on F, 0 elsewhere (reads s, u, p; writes t).
-    pub(super) fn direction(&mut self, delta: f64, beta: f64, mean: f64) {
+    fn direction(&mut self, delta: f64, beta: f64, mean: f64) -> Result<()> {
         let mut t = std::mem::take(&mut self.t);
         reduce_mut(
             &mut t,
@@ -278,11 +159,12 @@ impl Solver<'_> {
             |_, _| (),
         );
         self.t = t;
+        Ok(())
     }
 
     /// Σ(r + t/k where the spring acts)·t over F: the curvature of the energy along t.
-    pub(super) fn curvature(&self) -> f64 {
-        reduce(
+    fn curvature(&mut self) -> Result<f64> {
+        Ok(reduce(
             self.p.len(),
             0.0,
             |range| {
@@ -297,17 +179,16 @@ impl Solver<'_> {
                 acc
             },
             |a, b| a + b,
-        )
+        ))
     }
 
     /// The projected step and the joins (reads t, s, u; writes p and previous).
-    pub(super) fn step(&mut self, delta: f64, tau: f64) -> Step {
+    fn step(&mut self, delta: f64, tau: f64, width: usize) -> Result<Step> {
         let (mut p, mut previous) = (
             std::mem::take(&mut self.p),
             std::mem::take(&mut self.previous),
         );
         let this = &*self;
-        let width = self.window.w;
         let step = reduce_mut2(
             &mut p,
             &mut previous,
@@ -371,139 +252,12 @@ impl Solver<'_> {
         );
         self.p = p;
         self.previous = previous;
-        step
-    }
-
-    /// How the load is restored after a step. A deficit (clamps at the cap took load off) is
-    /// spread over the pixels strictly inside their bounds by a common shift μ,
-    /// p ← clip(p + μ, 0, cap): the Euclidean projection onto the load restricted to them, which
-    /// leaves the bounds alone whenever it can, so an active set, once found, stays found. If
-    /// even their caps cannot carry it they are filled to the cap, and the next iteration's
-    /// approach engages more pixels. An excess (clipping at 0 and joining pixels added load) is
-    /// taken off the inside pixels in proportion, p ← λp with λ < 1 (exact in one pass, nothing
-    /// crosses 0; an additive shift would push the pixels that just joined below 0 and need a
-    /// search on most iterations), and off the capped ones only when the inside ones cannot
-    /// absorb it (projecting onto every loaded pixel at once takes a sliver off each capped pixel
-    /// and cycles). Pixels at p = 0 never move. `None` when no pixel is loaded.
-    pub(super) fn load_shift(&self, step: &Step) -> Option<Shift> {
-        if step.inside + step.capped == 0 {
-            return None;
-        }
-        let miss = self.target - step.total;
-        let keep = Shift {
-            inside_scale: 1.0,
-            inside_add: 0.0,
-            capped_scale: 1.0,
-        };
-        if miss < 0.0 {
-            let excess = -miss;
-            return Some(if excess <= step.inside_total {
-                Shift {
-                    inside_scale: 1.0 - excess / step.inside_total,
-                    ..keep
-                }
-            } else {
-                Shift {
-                    inside_scale: 0.0,
-                    capped_scale: 1.0 - (excess - step.inside_total) / step.capped_total,
-                    ..keep
-                }
-            });
-        }
-        if step.inside == 0 {
-            return Some(keep);
-        }
-        // The usual case: μ = miss/|inside| reaches no cap and is exact without a pass.
-        let mu = miss / step.inside as f64;
-        if mu < step.headroom {
-            return Some(Shift {
-                inside_add: mu,
-                ..keep
-            });
-        }
-        let (mu, carried) = self.solve_shift(mu, |v, cap| (v > 0.0 && v < cap).then_some(cap));
-        Some(Shift {
-            // If the caps cannot carry it: fill them up.
-            inside_add: if carried { mu } else { f64::INFINITY },
-            ..keep
-        })
-    }
-
-    /// μ with Σ_M clip(p + μ, 0, cap) + Σ_(not M) p = target over the pixels M that `member`
-    /// selects (it returns their cap), starting from `mu`; false when no μ reaches the target
-    /// (every member at 0 or at its cap). The left side is non-decreasing and piecewise linear in
-    /// μ (slope: the members strictly inside their bounds after the shift), so Newton steps inside
-    /// a shrinking bracket find it. A pass over the fields per step; rare.
-    fn solve_shift(
-        &self,
-        mut mu: f64,
-        member: impl Fn(f64, f64) -> Option<f64> + Sync,
-    ) -> (f64, bool) {
-        let value = |mu: f64| {
-            reduce(
-                self.p.len(),
-                (0.0, 0usize, 0.0, 0.0),
-                |range| {
-                    let mut acc = (0.0, 0usize, 0.0, 0.0);
-                    for i in range {
-                        let v = self.p[i];
-                        match member(v, self.bounds().cap(i)) {
-                            Some(cap) => {
-                                let w = (v + mu).clamp(0.0, cap);
-                                acc.0 += w;
-                                acc.1 += usize::from(w > 0.0 && w < cap);
-                                acc.3 += cap;
-                            }
-                            None => {
-                                acc.0 += v;
-                                acc.2 += v;
-                            }
-                        }
-                    }
-                    acc
-                },
-                |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2, a.3 + b.3),
-            )
-        };
-        let (_, _, others, capacity) = value(0.0);
-        if !(others < self.target && others + capacity > self.target) {
-            return (
-                if others >= self.target {
-                    f64::NEG_INFINITY
-                } else {
-                    f64::INFINITY
-                },
-                false,
-            );
-        }
-        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-        for _ in 0..200 {
-            let (f, slope, _, _) = value(mu);
-            let miss = self.target - f;
-            if miss.abs() <= 1e-15 * self.target {
-                break;
-            }
-            if miss > 0.0 {
-                lo = mu;
-            } else {
-                hi = mu;
-            }
-            let newton = mu + miss / slope as f64;
-            mu = if slope > 0 && newton > lo && newton < hi {
-                newton
-            } else if lo.is_finite() && hi.is_finite() {
-                0.5 * (lo + hi)
-            } else {
-                // Widen the bracket.
-                mu + miss.signum() * (miss.abs() + mu.abs())
-            };
-        }
-        (mu, true)
+        Ok(step)
     }
 
     /// Σ|p − previous| and Σp.
-    pub(super) fn change(&self) -> (f64, f64) {
-        reduce(
+    fn change(&mut self) -> Result<(f64, f64)> {
+        Ok(reduce(
             self.p.len(),
             (0.0, 0.0),
             |range| {
@@ -512,31 +266,11 @@ impl Solver<'_> {
                 })
             },
             |a, b| (a.0 + b.0, a.1 + b.1),
-        )
-    }
-
-    /// The approach δ at which the pixels with e < δ, each at its cap, carry the load (the
-    /// perfectly plastic contact at the current displacement): the e at which the caps of the
-    /// pixels sorted by e add up to the load, halfway to the next e. A rare fallback (no free
-    /// pixel), so sorting every pixel is affordable.
-    pub(super) fn plastic_approach(&self) -> f64 {
-        let mut order: Vec<(f64, f64)> = (0..self.p.len())
-            .map(|i| (self.effective_gap(i, self.p[i]), self.bounds().cap(i)))
-            .collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut carried = 0.0;
-        for (k, &(e, cap)) in order.iter().enumerate() {
-            carried += cap;
-            if carried >= self.target {
-                let next = order.get(k + 1).map_or(e + e.abs().max(1.0), |o| o.0);
-                return 0.5 * (e + next);
-            }
-        }
-        order.last().map_or(0.0, |o| o.0)
+        ))
     }
 
     /// Apply a [`Shift`]; returns Σ|p − previous| and Σp.
-    pub(super) fn apply_shift(&mut self, shift: Shift) -> (f64, f64) {
+    fn apply_shift(&mut self, shift: Shift) -> Result<(f64, f64)> {
         let (mut p, mut previous) = (
             std::mem::take(&mut self.p),
             std::mem::take(&mut self.previous),
@@ -563,6 +297,138 @@ impl Solver<'_> {
         );
         self.p = p;
         self.previous = previous;
-        change
+        Ok(change)
+    }
+
+    fn residual_sq(&mut self, delta: f64) -> Result<f64> {
+        Ok(reduce(
+            self.p.len(),
+            0.0,
+            |range| {
+                range
+                    .filter(|&i| self.class(i, self.p[i]) == Class::Free)
+                    .map(|i| {
+                        let g = self.effective_gap(i, self.p[i]) - delta;
+                        g * g
+                    })
+                    .sum::<f64>()
+            },
+            |a, b| a + b,
+        ))
+    }
+
+    fn shift_sums(&mut self, mu: f64) -> Result<ShiftSums> {
+        let (value, inside, others, capacity) = reduce(
+            self.p.len(),
+            (0.0, 0usize, 0.0, 0.0),
+            |range| {
+                let mut acc = (0.0, 0usize, 0.0, 0.0);
+                for i in range {
+                    let (v, cap) = (self.p[i], self.bounds().cap(i));
+                    if v > 0.0 && v < cap {
+                        let w = (v + mu).clamp(0.0, cap);
+                        acc.0 += w;
+                        acc.1 += usize::from(w > 0.0 && w < cap);
+                        acc.3 += cap;
+                    } else {
+                        acc.0 += v;
+                        acc.2 += v;
+                    }
+                }
+                acc
+            },
+            |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2, a.3 + b.3),
+        );
+        Ok(ShiftSums {
+            value,
+            inside,
+            others,
+            capacity,
+        })
+    }
+
+    fn start_sums(&mut self, lambda: f64) -> Result<(f64, f64)> {
+        let p = &self.p;
+        Ok(reduce(
+            p.len(),
+            (0.0, 0.0),
+            |range| {
+                range.fold((0.0, 0.0), |(v, s), i| {
+                    let cap = self.bounds().cap(i);
+                    if lambda * p[i] < cap {
+                        (v + lambda * p[i], s + p[i])
+                    } else {
+                        (v + cap, s)
+                    }
+                })
+            },
+            |a, b| (a.0 + b.0, a.1 + b.1),
+        ))
+    }
+
+    fn scale(&mut self, lambda: f64) -> Result<()> {
+        let mut p = std::mem::take(&mut self.p);
+        for (i, v) in p.iter_mut().enumerate() {
+            *v = (*v * lambda).min(self.bounds().cap(i));
+        }
+        self.p = p;
+        Ok(())
+    }
+
+    fn fill(&mut self, value: f64) -> Result<()> {
+        let mut p = std::mem::take(&mut self.p);
+        for (i, v) in p.iter_mut().enumerate() {
+            *v = value.min(self.bounds().cap(i));
+        }
+        self.p = p;
+        Ok(())
+    }
+
+    fn gaps_and_caps(&mut self) -> Result<Vec<(f64, f64)>> {
+        Ok((0..self.p.len())
+            .map(|i| (self.effective_gap(i, self.p[i]), self.bounds().cap(i)))
+            .collect())
+    }
+
+    fn rewindow(&mut self, current: &Window, next: &Window, whole: &Window) -> Result<()> {
+        self.p = next.embed(current, &self.p);
+        self.s = next.embed(whole, self.problem.separation);
+        self.bound = match self.plasticity {
+            Plasticity::Elastic => Vec::new(),
+            Plasticity::Cap(c) => next.embed(whole, c),
+            Plasticity::Hardening { yield_pressure, .. } => next.embed(whole, yield_pressure),
+        };
+        let n = next.len();
+        self.previous = self.p.clone();
+        (self.u, self.t, self.r) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        self.op = self.problem.operator.window(next.h, next.w);
+        self.work = self.op.window_workspace(next.h);
+        self.shape = (next.h, next.w);
+        Ok(())
+    }
+
+    /// The iteration's buffers are freed first, and a whole-grid window lends its workspace,
+    /// so that the whole-grid application does not add a second set of buffers to the peak
+    /// memory (134 MB at 2048²).
+    fn solution(&mut self, window: &Window, whole: &Window) -> Result<(Vec<f64>, Vec<f64>)> {
+        let pressure = whole.embed(window, &self.p);
+        let n = self.p.len();
+        for field in [&mut self.u, &mut self.t, &mut self.r, &mut self.previous] {
+            *field = Vec::new();
+        }
+        let operator = self.problem.operator;
+        let whole = self.shape == (operator.ny(), operator.nx());
+        let mut own;
+        let work = if whole {
+            &mut self.work
+        } else {
+            own = operator.workspace();
+            &mut own
+        };
+        let mut displacement = vec![0.0; pressure.len()];
+        operator.apply(&pressure, &mut displacement, work);
+        (self.u, self.t, self.r, self.previous) =
+            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        Ok((pressure, displacement))
     }
 }

@@ -1,6 +1,8 @@
 //! The window a load-controlled solve keeps its fields on (see the module docs of
 //! [`super`]): where the separation comes within reach of an approach δ.
 
+use rayon::prelude::*;
+
 use crate::solver::halfspace::{window_length, Boundary};
 
 /// A rectangle of the grid: rows `y0..y0 + h`, columns `x0..x0 + w`.
@@ -81,12 +83,32 @@ pub(super) struct Reach {
 
 impl Reach {
     pub fn new(separation: &[f64], nx: usize, ny: usize, boundary: Boundary) -> Self {
-        let mut row_min = vec![f64::INFINITY; ny];
+        // Bands of rows in parallel, each with its own column minima, folded in band order.
+        const BAND: usize = 64;
+        let bands: Vec<(Vec<f64>, Vec<f64>)> = separation
+            .par_chunks(nx * BAND)
+            .map(|band| {
+                let mut cols = vec![f64::INFINITY; nx];
+                let rows = band
+                    .chunks(nx)
+                    .map(|row| {
+                        let mut least = f64::INFINITY;
+                        for (c, &s) in cols.iter_mut().zip(row) {
+                            least = least.min(s);
+                            *c = c.min(s);
+                        }
+                        least
+                    })
+                    .collect();
+                (rows, cols)
+            })
+            .collect();
+        let mut row_min = Vec::with_capacity(ny);
         let mut col_min = vec![f64::INFINITY; nx];
-        for (y, row) in separation.chunks(nx).enumerate() {
-            for (x, &s) in row.iter().enumerate() {
-                row_min[y] = row_min[y].min(s);
-                col_min[x] = col_min[x].min(s);
+        for (rows, cols) in bands {
+            row_min.extend(rows);
+            for (c, b) in col_min.iter_mut().zip(cols) {
+                *c = c.min(b);
             }
         }
         let s_min = row_min.iter().copied().fold(f64::INFINITY, f64::min);
