@@ -39,6 +39,16 @@ pub(crate) fn value_to_py<'py>(py: Python<'py>, value: &Value) -> PyResult<Bound
 }
 
 /// An outcome as a dict in SI units with SI keys.
+pub(crate) fn device_of(name: &str) -> PyResult<contactscope_jobs::simulate::DeviceChoice> {
+    contactscope_jobs::simulate::DeviceChoice::parse(name).ok_or_else(|| {
+        bad(format!(
+            "device '{name}': use one of {}",
+            contactscope_jobs::simulate::DeviceChoice::NAMES.join(", ")
+        ))
+    })
+}
+
+/// The outcome of a command as a dict of SI values.
 pub(crate) fn outcome_dict<'py, T: serde::Serialize>(
     py: Python<'py>,
     outcome: &T,

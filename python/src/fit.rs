@@ -53,7 +53,9 @@ fn body_request(
     detrend: &str,
     periodic: bool,
     file: (Option<f64>, Option<String>, Option<&str>),
+    device: &str,
 ) -> PyResult<BodyRequest> {
+    let device = crate::convert::device_of(device)?;
     let (height_unit, channel, fill_invalid) = file;
     let input = height_input(
         heights,
@@ -68,6 +70,7 @@ fn body_request(
     body.periodic = periodic;
     body.tolerance = tolerance.unwrap_or(body.tolerance);
     body.max_iterations = max_iterations.unwrap_or(body.max_iterations);
+    body.device = device;
     body.imaging = match (imaging_fwhm, imaging_pixel_size) {
         (Some(fwhm_m), Some(p)) => Some(Imaging {
             fwhm_m,
@@ -90,7 +93,7 @@ fn family_of(name: &str) -> PyResult<Family> {
 /// Fit contact models to a measured area–load curve (the command line's `fit-hardening`).
 /// Returns the outcome (SI keys) with each model's search `trace` [(parameter, misfit)].
 #[pyfunction]
-#[pyo3(signature = (measured, heights, pixel_size, modulus, radius=None, families=None, range=None, grid=None, ln_tolerance=None, tolerance=None, max_iterations=None, imaging_fwhm=None, imaging_pixel_size=None, detrend="plane", periodic=false, height_unit=None, channel=None, fill_invalid=None))]
+#[pyo3(signature = (measured, heights, pixel_size, modulus, radius=None, families=None, range=None, grid=None, ln_tolerance=None, tolerance=None, max_iterations=None, imaging_fwhm=None, imaging_pixel_size=None, detrend="plane", periodic=false, height_unit=None, channel=None, fill_invalid=None, device="cpu"))]
 #[allow(clippy::too_many_arguments)]
 fn fit_hardening<'py>(
     py: Python<'py>,
@@ -112,6 +115,7 @@ fn fit_hardening<'py>(
     height_unit: Option<f64>,
     channel: Option<String>,
     fill_invalid: Option<&str>,
+    device: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let body = body_request(
         heights,
@@ -125,6 +129,7 @@ fn fit_hardening<'py>(
         detrend,
         periodic,
         (height_unit, channel, fill_invalid),
+        device,
     )?;
     let mut request = FitRequest::new(measured_input(measured)?, body);
     if let Some(names) = families {
@@ -174,7 +179,7 @@ fn fit_hardening<'py>(
 /// contact areas (m²) as `fit_hardening` counts them, and whether the contact reached the
 /// border.
 #[pyfunction]
-#[pyo3(signature = (heights, pixel_size, modulus, family, parameter, loads, radius=None, tolerance=None, max_iterations=None, imaging_fwhm=None, imaging_pixel_size=None, detrend="plane", periodic=false))]
+#[pyo3(signature = (heights, pixel_size, modulus, family, parameter, loads, radius=None, tolerance=None, max_iterations=None, imaging_fwhm=None, imaging_pixel_size=None, detrend="plane", periodic=false, device="cpu"))]
 #[allow(clippy::too_many_arguments)]
 fn ramp<'py>(
     py: Python<'py>,
@@ -191,6 +196,7 @@ fn ramp<'py>(
     imaging_pixel_size: Option<PixelArg>,
     detrend: &str,
     periodic: bool,
+    device: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let family = family_of(family)?;
     let body = body_request(
@@ -205,6 +211,7 @@ fn ramp<'py>(
         detrend,
         periodic,
         (None, None, None),
+        device,
     )?;
     let outcome = compute(py, move || {
         contactscope_jobs::fit_hardening::ramp(&body, family, parameter, &loads)

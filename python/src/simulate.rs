@@ -110,7 +110,7 @@ impl LoadObserver for KeepMaps {
 /// A load ramp with one contact model (the command line's `simulate`); see the package's
 /// docstring. Returns the outcome (SI) and, with `maps`, the stacks (loads, ny, nx).
 #[pyfunction]
-#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=true, detrend="plane", height_unit=None, channel=None, fill_invalid=None))]
+#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=true, detrend="plane", height_unit=None, channel=None, fill_invalid=None, device="cpu"))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -132,7 +132,9 @@ fn simulate<'py>(
     height_unit: Option<f64>,
     channel: Option<String>,
     fill_invalid: Option<&str>,
+    device: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let device = crate::convert::device_of(device)?;
     let input = height_input(
         heights,
         pixel_size,
@@ -147,6 +149,7 @@ fn simulate<'py>(
     request.periodic = periodic;
     request.tolerance = tolerance.unwrap_or(request.tolerance);
     request.max_iterations = max_iterations.unwrap_or(request.max_iterations);
+    request.device = device;
     let (outcome, kept) = compute(py, move || {
         let mut kept = KeepMaps::default();
         let outcome = if maps {

@@ -543,3 +543,28 @@ def test_to_pandas_gives_the_rows_as_a_table():
     assert isinstance(df, pd.DataFrame) and len(df) == len(FORCES)
     assert list(df["force_n"]) == FORCES
     assert list(df.columns) == list(a.rows[0])
+
+
+def test_simulate_and_fit_say_which_device_ran(surface_npy):
+    """``device``: "auto" runs on the CPU where no GPU is usable and says so; "cuda" there is a
+    one-line InputError naming the choice; an unknown name lists the choices."""
+    h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
+    loads = [20e-6, 40e-6]
+    auto = cs.simulate(h, 100e-9, 1e9, loads, "hardening", k=4e15, radius=20e-6, maps=False,
+                       device="auto")
+    ran = auto["solver"]["device"]
+    cpu = cs.simulate(h, 100e-9, 1e9, loads, "hardening", k=4e15, radius=20e-6, maps=False)
+    assert cpu["solver"]["device"] == "cpu"
+    if ran == "cpu":
+        with pytest.raises(cs.InputError) as e:
+            cs.simulate(h, 100e-9, 1e9, loads, "hardening", k=4e15, radius=20e-6, device="cuda")
+        assert "--device cuda" in str(e.value) and "\n" not in str(e.value)
+        np.testing.assert_array_equal([r["area_m2"] for r in auto.rows],
+                                      [r["area_m2"] for r in cpu.rows])
+    else:
+        assert ran.startswith("cuda: ")
+    with pytest.raises(cs.InputError, match="cpu, cuda, auto"):
+        cs.simulate(h, 100e-9, 1e9, loads, device="tpu")
+    fit = cs.fit_hardening(loads, [r["area_m2"] for r in cpu.rows], h, 100e-9, 1e9,
+                           radius=20e-6, grid=3, device="auto")
+    assert fit["device"] == ran

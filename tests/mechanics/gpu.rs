@@ -308,3 +308,68 @@ fn gpu_gives_the_volume_conserving_and_periodic_maps_of_the_host() {
         }
     }
 }
+
+/// `--device`: `cuda` where no GPU is usable is one line naming the flag, with nothing
+/// written; `auto` falls back to the CPU and says so in summary.json. With a usable GPU, `cuda`
+/// runs there and says which.
+#[test]
+fn simulate_says_which_device_ran() {
+    use crate::common::{rough_surface, run, stderr};
+    let dir = tempfile::tempdir().unwrap();
+    let surface = dir.path().join("rough.npy");
+    rough_surface(
+        &surface,
+        64,
+        "32nm",
+        3,
+        &["--rolloff", "1um", "--cutoff", "128nm"],
+    );
+    let simulate = |device: &str, out: &std::path::Path| {
+        run(&[
+            "simulate",
+            "--topography",
+            surface.to_str().unwrap(),
+            "--pixel-size",
+            "32nm",
+            "--radius",
+            "20um",
+            "--modulus",
+            "3.7GPa",
+            "--model",
+            "hardness",
+            "--hardness",
+            "370MPa",
+            "--forces",
+            "0.05,0.1mN",
+            "--device",
+            device,
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ])
+    };
+    let device_of = |out: &std::path::Path| {
+        let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["solver"]["device"].as_str().unwrap().to_string()
+    };
+    let usable = gpu().is_some();
+    let auto = dir.path().join("auto");
+    let o = simulate("auto", &auto);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let ran = device_of(&auto);
+    assert_eq!(ran.starts_with("cuda: "), usable, "{ran}");
+    assert!(usable || ran == "cpu", "{ran}");
+    let cuda = dir.path().join("cuda");
+    let o = simulate("cuda", &cuda);
+    if usable {
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(device_of(&cuda).starts_with("cuda: "));
+    } else {
+        let message = stderr(&o);
+        assert!(!o.status.success());
+        assert_eq!(message.trim().lines().count(), 1, "{message}");
+        assert!(message.contains("--device cuda"), "{message}");
+        assert!(!cuda.exists(), "nothing is written");
+    }
+}

@@ -497,7 +497,7 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
              periodic: bool = False, tolerance: Optional[float] = None,
              max_iterations: Optional[int] = None, maps: bool = True, detrend: str = "plane",
              height_unit: Optional[float] = None, channel: Optional[str] = None,
-             fill_invalid: Optional[str] = None) -> Results:
+             fill_invalid: Optional[str] = None, device: str = "cpu") -> Results:
     """A load ramp on a rough body pressed on a flat of contact modulus E* ``modulus`` (Pa) at
     normal forces ``loads`` (N, in order; the plastic state carries from load to load): the
     command line's ``simulate``, with the same defaults, checks and warnings.
@@ -511,7 +511,9 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
     Models: "elastic"; "hardness" (p ≤ ``hardness`` Pa; ``alpha`` for the volume-conserving
     update); "hardening" (p_Y = ``initial_hardness`` + ``k``·h_pl, k in Pa/m); "gt"
     (Greenwood–Tripp bearing area, needs ``radius``). Solver limits: ``tolerance`` (default
-    1e-8) and ``max_iterations`` per load (default 5000).
+    1e-8) and ``max_iterations`` per load (default 5000). ``device``: "cpu", "cuda" (an NVIDIA
+    GPU, in a package built with the ``cuda`` feature; an error when none is usable) or "auto"
+    (a GPU when one is usable); ``solver["device"]`` says which ran.
 
     Returns the outcome the command line writes as ``summary.json``, in SI units: ``loads``
     (per load: ``force_n``, ``area_m2``, ``mean_pressure_pa``, ``approach_m``, ``patches``,
@@ -525,7 +527,7 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
     result = Results(_cs.simulate(heights, pixel_size, float(modulus), [float(f) for f in loads],
                                   model, hardness, k, initial_hardness, alpha, radius, periodic,
                                   tolerance, max_iterations, maps, detrend, height_unit,
-                                  channel, fill_invalid), table="loads")
+                                  channel, fill_invalid, device), table="loads")
     _warn(result)
     return result
 
@@ -542,14 +544,14 @@ def ramp(heights: Any, pixel_size: Optional[PixelSize], modulus: float, family: 
          tolerance: Optional[float] = None, max_iterations: Optional[int] = None,
          imaging_fwhm: Optional[float] = None,
          imaging_pixel_size: Optional[PixelSize] = None, *, detrend: str = "plane",
-         periodic: bool = False) -> Results:
+         periodic: bool = False, device: str = "cpu") -> Results:
     """One model evaluation of a fit (the unit of a Dask task): contact areas ``areas_m2`` (m²)
     of one load ramp (``loads`` in N, increasing) for ``family`` ("elastic", "gt", "hardness"
     with p_Y in Pa, "hardening" with k in Pa/m), on the body :func:`fit_hardening` builds from
-    the same arguments and counted as it counts them."""
+    the same arguments and counted as it counts them; ``device`` as :func:`simulate`."""
     return Results(_cs.ramp(_heights(heights), pixel_size, float(modulus), family, parameter,
                             [float(f) for f in loads], radius, tolerance, max_iterations,
-                            imaging_fwhm, imaging_pixel_size, detrend, periodic))
+                            imaging_fwhm, imaging_pixel_size, detrend, periodic, device))
 
 
 def misfit(forces: Sequence[float], areas: Sequence[float], simulated: Sequence[float]) -> float:
@@ -612,7 +614,7 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
                   imaging_pixel_size: Optional[PixelSize] = None, client: Any = None, *,
                   detrend: str = "plane", periodic: bool = False,
                   height_unit: Optional[float] = None, channel: Optional[str] = None,
-                  fill_invalid: Optional[str] = None) -> FitResults:
+                  fill_invalid: Optional[str] = None, device: str = "cpu") -> FitResults:
     """Fit contact models to a measured area–load curve: the command line's ``fit-hardening``,
     with its defaults, checks and warnings. The curve: ``forces`` (N) and ``areas`` (m²), or
     ``forces`` an ``areas.csv`` written by ``analyze`` (``areas`` None). The rough sphere:
@@ -623,7 +625,7 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
     method to ``ln_tolerance`` (default 0.01); "elastic" and "gt" are evaluated once.
     ``imaging_fwhm`` and ``imaging_pixel_size`` count simulated areas as imaged. A height-map
     file is read as the command line reads ``--topography`` (``height_unit``, ``channel``,
-    ``fill_invalid``).
+    ``fill_invalid``). ``device`` as :func:`simulate` (``device`` in ``fit.json`` says which ran).
 
     Returns a :class:`FitResults` (``parameter``, ``parameter_se``, ``misfit``, ``areas_m2``,
     ``trace`` of the best model; the whole ``fit.json`` in SI units). With a
@@ -654,7 +656,7 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
                                           float(modulus), radius, families, range, grid,
                                           ln_tolerance, tolerance, max_iterations,
                                           imaging_fwhm, imaging_pixel_size, detrend, periodic,
-                                          height_unit, channel, fill_invalid))
+                                          height_unit, channel, fill_invalid, device))
     _warn(result)
     return result
 

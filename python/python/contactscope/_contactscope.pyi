@@ -461,6 +461,7 @@ def simulate(
     height_unit: Optional[float] = None,
     channel: Optional[str] = None,
     fill_invalid: Optional[str] = None,
+    device: str = "cpu",
 ) -> SimulateResult: ...
 class RampResult(TypedDict):
     areas_m2: npt.NDArray[np.float64]
@@ -480,6 +481,7 @@ def ramp(
     imaging_pixel_size: Optional[PixelSize] = None,
     detrend: str = "plane",
     periodic: bool = False,
+    device: str = "cpu",
 ) -> RampResult: ...
 def misfit(forces: Sequence[float], areas: Sequence[float], simulated: Sequence[float]) -> float: ...
 
@@ -494,6 +496,7 @@ class FitResult(TypedDict):
     measured: Dict[str, List[float]]
     simulated_areas: Dict[str, Any]
     method: str
+    device: str
     models: List[Dict[str, Any]]
     best_model: Optional[str]
     sweep_rows: int
@@ -518,6 +521,7 @@ def fit_hardening(
     height_unit: Optional[float] = None,
     channel: Optional[str] = None,
     fill_invalid: Optional[str] = None,
+    device: str = "cpu",
 ) -> FitResult: ...
 
 # Mechanics tests (CSV files)

@@ -321,6 +321,8 @@ pub struct FitOutcome {
     pub simulated_areas: Counting,
     /// The fitting method, in words.
     pub method: &'static str,
+    /// Where the ramps were solved: "cpu", or "cuda: " and the GPU's name.
+    pub device: String,
     /// One fit per family, in request order.
     pub models: Vec<FittedModel>,
     /// The family with the lowest misfit.
@@ -415,6 +417,7 @@ pub fn run(request: &FitRequest, progress: Option<ProgressHook>) -> Result<FitOu
         },
         simulated_areas: Counting(request.body.imaging),
         method: METHOD,
+        device: contactscope::solver::gpu::describe(body.options.gpu),
         models: fits,
         best_model,
         sweep_rows: sweep.len(),

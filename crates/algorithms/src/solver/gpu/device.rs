@@ -68,8 +68,7 @@ kernels!(
     apply_shift,
     change,
     start_sums,
-    scale,
-    fill,
+    affine,
 );
 
 /// An NVIDIA GPU opened for the solver.
@@ -613,6 +612,10 @@ mod tests {
         // Needs NVRTC only (no GPU): run with its lib folder on LD_LIBRARY_PATH.
         // SAFETY: only tries to load the library.
         if !unsafe { cudarc::nvrtc::sys::is_culib_present() } {
+            assert!(
+                std::env::var_os("CONTACTSCOPE_REQUIRE_NVRTC").is_none(),
+                "NVRTC (libnvrtc) not found on LD_LIBRARY_PATH"
+            );
             eprintln!("skipped: NVRTC (libnvrtc) not found on the library path");
             return;
         }

@@ -392,16 +392,9 @@ extern "C" __global__ void start_sums(double* out, const double* p, long long n,
     block_reduce<2>(v, ops, out);
 }
 
-// p ← min(λp, cap).
-extern "C" __global__ void scale(double* p, long long n, int mode, double compliance,
-                                 const double* bound, double lambda) {
+// p ← min(a·p + b, cap): scaling (b = 0) and filling (a = 0).
+extern "C" __global__ void affine(double* p, long long n, int mode, double compliance,
+                                  const double* bound, double a, double b) {
     Plastic pl = {mode, compliance, bound};
-    FOR_EACH(i, n) { p[i] = fmin(p[i] * lambda, cap_of(pl, i)); }
-}
-
-// p ← min(value, cap).
-extern "C" __global__ void fill(double* p, long long n, int mode, double compliance,
-                                const double* bound, double value) {
-    Plastic pl = {mode, compliance, bound};
-    FOR_EACH(i, n) { p[i] = fmin(value, cap_of(pl, i)); }
+    FOR_EACH(i, n) { p[i] = fmin(a == 0.0 ? b : a * p[i] + b, cap_of(pl, i)); }
 }

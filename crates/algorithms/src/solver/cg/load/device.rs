@@ -13,6 +13,20 @@ use crate::solver::gpu::{device_error, DeviceOperator, Fold, Gpu, Plastic, Reduc
 use super::fields::{Fields, Gaps, Shift, ShiftSums, Step};
 use super::window::Window;
 
+/// Launch kernel `$kernel` of kernels.cu with `$config` and the arguments in order; a launch
+/// error names `$pass`.
+macro_rules! launch {
+    ($gpu:expr, $kernel:ident, $config:expr, $pass:literal, [$($arg:expr),* $(,)?]) => {{
+        let gpu: &Gpu = $gpu;
+        // SAFETY: every call below passes the arguments of the kernel's signature in
+        // kernels.cu, in order and of its types (i64 for `long long`, i32 for `int`), and
+        // buffers holding at least the `n` values (or window sizes) passed with them.
+        unsafe { gpu.launch(&gpu.kernels.$kernel)$(.arg($arg))*.launch($config) }
+            .map(|_| ())
+            .map_err(launch_error($pass))
+    }};
+}
+
 /// The fields on the device. Each buffer holds the whole grid; the window's `h × w` values sit
 /// at its start.
 pub(super) struct DeviceFields<'a> {
@@ -108,6 +122,19 @@ impl<'a> DeviceFields<'a> {
         Ok(fields)
     }
 
+    /// p ← min(a·p + b, cap).
+    fn affine(&mut self, a: f64, b: f64) -> Result<()> {
+        let n = self.len();
+        let Plastic { mode, compliance } = self.plastic;
+        launch!(
+            self.gpu,
+            affine,
+            Gpu::elementwise(n as usize),
+            "setting the pressure",
+            [&mut self.p, &n, &mode, &compliance, &self.bound, &a, &b]
+        )
+    }
+
     fn len(&self) -> i64 {
         (self.shape.0 * self.shape.1) as i64
     }
@@ -126,23 +153,24 @@ fn embed(
     src: &Window,
 ) -> Result<()> {
     let a = |v: usize| v as i32;
-    // SAFETY: the arguments match the kernel's signature; `to` holds dst.h·dst.w values and
-    // `from` src.h·src.w.
-    unsafe {
-        gpu.launch(&gpu.kernels.embed)
-            .arg(to)
-            .arg(&a(dst.y0))
-            .arg(&a(dst.x0))
-            .arg(&a(dst.h))
-            .arg(&a(dst.w))
-            .arg(from)
-            .arg(&a(src.y0))
-            .arg(&a(src.x0))
-            .arg(&a(src.h))
-            .arg(&a(src.w))
-            .launch(Gpu::elementwise(dst.len()))
-    }
-    .map_err(launch_error("moving the window"))?;
+    launch!(
+        gpu,
+        embed,
+        Gpu::elementwise(dst.len()),
+        "moving the window",
+        [
+            to,
+            &a(dst.y0),
+            &a(dst.x0),
+            &a(dst.h),
+            &a(dst.w),
+            from,
+            &a(src.y0),
+            &a(src.x0),
+            &a(src.h),
+            &a(src.w)
+        ]
+    )?;
     Ok(())
 }
 
@@ -162,23 +190,24 @@ impl Fields for DeviceFields<'_> {
     fn gaps(&mut self, delta: f64) -> Result<Gaps> {
         let n = self.len();
         let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: the arguments match the kernel's signature; every buffer holds n values.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.gaps)
-                .arg(&mut self.sums.partials)
-                .arg(&self.s)
-                .arg(&self.u)
-                .arg(&self.p)
-                .arg(&self.t)
-                .arg(&n)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .arg(&delta)
-                .launch(Gpu::reducing())
-        }
-        .map_err(launch_error("the residual pass"))?;
+        launch!(
+            self.gpu,
+            gaps,
+            Gpu::reducing(),
+            "the residual pass",
+            [
+                &mut self.sums.partials,
+                &self.s,
+                &self.u,
+                &self.p,
+                &self.t,
+                &n,
+                &mode,
+                &compliance,
+                &self.bound,
+                &delta
+            ]
+        )?;
         use Fold::{Max, Min, Sum};
         let v = self.sums.fold(
             self.gpu,
@@ -201,67 +230,70 @@ impl Fields for DeviceFields<'_> {
     fn residual_sq(&mut self, delta: f64) -> Result<f64> {
         let n = self.len();
         let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.residual_sq)
-                .arg(&mut self.sums.partials)
-                .arg(&self.s)
-                .arg(&self.u)
-                .arg(&self.p)
-                .arg(&n)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .arg(&delta)
-                .launch(Gpu::reducing())
-        }
-        .map_err(launch_error("the residual norm"))?;
+        launch!(
+            self.gpu,
+            residual_sq,
+            Gpu::reducing(),
+            "the residual norm",
+            [
+                &mut self.sums.partials,
+                &self.s,
+                &self.u,
+                &self.p,
+                &n,
+                &mode,
+                &compliance,
+                &self.bound,
+                &delta
+            ]
+        )?;
         Ok(self.sums.fold(self.gpu, &[Fold::Sum])?[0])
     }
 
     fn direction(&mut self, delta: f64, beta: f64, mean: f64) -> Result<()> {
         let n = self.len();
         let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.direction)
-                .arg(&mut self.t)
-                .arg(&self.s)
-                .arg(&self.u)
-                .arg(&self.p)
-                .arg(&n)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .arg(&delta)
-                .arg(&beta)
-                .arg(&mean)
-                .launch(Gpu::elementwise(n as usize))
-        }
-        .map_err(launch_error("the direction"))?;
+        launch!(
+            self.gpu,
+            direction,
+            Gpu::elementwise(n as usize),
+            "the direction",
+            [
+                &mut self.t,
+                &self.s,
+                &self.u,
+                &self.p,
+                &n,
+                &mode,
+                &compliance,
+                &self.bound,
+                &delta,
+                &beta,
+                &mean
+            ]
+        )?;
         Ok(())
     }
 
     fn curvature(&mut self) -> Result<f64> {
         let n = self.len();
         let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.curvature)
-                .arg(&mut self.sums.partials)
-                .arg(&self.r)
-                .arg(&self.t)
-                .arg(&self.p)
-                .arg(&n)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .launch(Gpu::reducing())
-        }
-        .map_err(launch_error("the curvature"))?;
+        launch!(
+            self.gpu,
+            curvature,
+            Gpu::reducing(),
+            "the curvature",
+            [
+                &mut self.sums.partials,
+                &self.r,
+                &self.t,
+                &self.p,
+                &n,
+                &mode,
+                &compliance,
+                &self.bound
+            ]
+        )?;
         Ok(self.sums.fold(self.gpu, &[Fold::Sum])?[0])
     }
 
@@ -269,26 +301,27 @@ impl Fields for DeviceFields<'_> {
         let n = self.len();
         let width = width as i32;
         let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.step)
-                .arg(&mut self.sums.partials)
-                .arg(&mut self.p)
-                .arg(&mut self.previous)
-                .arg(&self.s)
-                .arg(&self.u)
-                .arg(&self.t)
-                .arg(&n)
-                .arg(&width)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .arg(&delta)
-                .arg(&tau)
-                .launch(Gpu::reducing())
-        }
-        .map_err(launch_error("the step"))?;
+        launch!(
+            self.gpu,
+            step,
+            Gpu::reducing(),
+            "the step",
+            [
+                &mut self.sums.partials,
+                &mut self.p,
+                &mut self.previous,
+                &self.s,
+                &self.u,
+                &self.t,
+                &n,
+                &width,
+                &mode,
+                &compliance,
+                &self.bound,
+                &delta,
+                &tau
+            ]
+        )?;
         use Fold::{Max, Min, Sum};
         let v = self.sums.fold(
             self.gpu,
@@ -317,20 +350,21 @@ impl Fields for DeviceFields<'_> {
     fn shift_sums(&mut self, mu: f64) -> Result<ShiftSums> {
         let n = self.len();
         let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.shift_sums)
-                .arg(&mut self.sums.partials)
-                .arg(&self.p)
-                .arg(&n)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .arg(&mu)
-                .launch(Gpu::reducing())
-        }
-        .map_err(launch_error("the load's shift"))?;
+        launch!(
+            self.gpu,
+            shift_sums,
+            Gpu::reducing(),
+            "the load's shift",
+            [
+                &mut self.sums.partials,
+                &self.p,
+                &n,
+                &mode,
+                &compliance,
+                &self.bound,
+                &mu
+            ]
+        )?;
         let v = self.sums.fold(self.gpu, &[Fold::Sum; 4])?;
         Ok(ShiftSums {
             value: v[0],
@@ -343,40 +377,37 @@ impl Fields for DeviceFields<'_> {
     fn apply_shift(&mut self, shift: Shift) -> Result<(f64, f64)> {
         let n = self.len();
         let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.apply_shift)
-                .arg(&mut self.sums.partials)
-                .arg(&mut self.p)
-                .arg(&self.previous)
-                .arg(&n)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .arg(&shift.inside_scale)
-                .arg(&shift.inside_add)
-                .arg(&shift.capped_scale)
-                .launch(Gpu::reducing())
-        }
-        .map_err(launch_error("restoring the load"))?;
+        launch!(
+            self.gpu,
+            apply_shift,
+            Gpu::reducing(),
+            "restoring the load",
+            [
+                &mut self.sums.partials,
+                &mut self.p,
+                &self.previous,
+                &n,
+                &mode,
+                &compliance,
+                &self.bound,
+                &shift.inside_scale,
+                &shift.inside_add,
+                &shift.capped_scale
+            ]
+        )?;
         let v = self.sums.fold(self.gpu, &[Fold::Sum; 2])?;
         Ok((v[0], v[1]))
     }
 
     fn change(&mut self) -> Result<(f64, f64)> {
         let n = self.len();
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.change)
-                .arg(&mut self.sums.partials)
-                .arg(&self.p)
-                .arg(&self.previous)
-                .arg(&n)
-                .launch(Gpu::reducing())
-        }
-        .map_err(launch_error("the pressure change"))?;
+        launch!(
+            self.gpu,
+            change,
+            Gpu::reducing(),
+            "the pressure change",
+            [&mut self.sums.partials, &self.p, &self.previous, &n]
+        )?;
         let v = self.sums.fold(self.gpu, &[Fold::Sum; 2])?;
         Ok((v[0], v[1]))
     }
@@ -384,60 +415,31 @@ impl Fields for DeviceFields<'_> {
     fn start_sums(&mut self, lambda: f64) -> Result<(f64, f64)> {
         let n = self.len();
         let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.start_sums)
-                .arg(&mut self.sums.partials)
-                .arg(&self.p)
-                .arg(&n)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .arg(&lambda)
-                .launch(Gpu::reducing())
-        }
-        .map_err(launch_error("the starting load"))?;
+        launch!(
+            self.gpu,
+            start_sums,
+            Gpu::reducing(),
+            "the starting load",
+            [
+                &mut self.sums.partials,
+                &self.p,
+                &n,
+                &mode,
+                &compliance,
+                &self.bound,
+                &lambda
+            ]
+        )?;
         let v = self.sums.fold(self.gpu, &[Fold::Sum; 2])?;
         Ok((v[0], v[1]))
     }
 
     fn scale(&mut self, lambda: f64) -> Result<()> {
-        let n = self.len();
-        let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.scale)
-                .arg(&mut self.p)
-                .arg(&n)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .arg(&lambda)
-                .launch(Gpu::elementwise(n as usize))
-        }
-        .map_err(launch_error("scaling the pressure"))?;
-        Ok(())
+        self.affine(lambda, 0.0)
     }
 
     fn fill(&mut self, value: f64) -> Result<()> {
-        let n = self.len();
-        let Plastic { mode, compliance } = self.plastic;
-        // SAFETY: as in `gaps`.
-        unsafe {
-            self.gpu
-                .launch(&self.gpu.kernels.fill)
-                .arg(&mut self.p)
-                .arg(&n)
-                .arg(&mode)
-                .arg(&compliance)
-                .arg(&self.bound)
-                .arg(&value)
-                .launch(Gpu::elementwise(n as usize))
-        }
-        .map_err(launch_error("filling the pressure"))?;
-        Ok(())
+        self.affine(0.0, value)
     }
 
     fn gaps_and_caps(&mut self) -> Result<Vec<(f64, f64)>> {
