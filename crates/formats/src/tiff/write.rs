@@ -48,8 +48,8 @@ pub enum Compression {
     /// reader that opens one opens the other), written about six times faster. On the float32
     /// maps of a 2048² `simulate` ramp (measured) a map takes 57–88 ms against 350–550 ms at the
     /// default level 6; the maps of real-valued fields come out as large as at level 6 (within
-    /// 1–4 %, 21 % for the mostly-zero pressure of the lightest load), the 0/1 contact maps 2.7–3.6×
-    /// larger (0.1–0.2 MB), the whole folder 0.5 % larger.
+    /// 4 %; 21 % larger for the mostly-zero pressure of the lightest load), the 0/1 contact maps
+    /// 2.7–3.6× larger (0.09–0.16 MB), the whole folder 0.5 % larger.
     DeflateFast,
 }
 
