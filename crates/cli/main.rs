@@ -70,7 +70,7 @@ enum Command {
     Demo(demo::Args),
     /// Simulate contact of a rough topography under a load sweep (elastic, hardness, hardening, gt).
     #[command(
-        after_help = "Examples:\n  contactscope simulate --topography sphere.npy --pixel-size 32nm --height-unit 1nm --modulus 3.7GPa --model hardening --hardening 4MPa/nm --forces 4mN..400mN:12 --out sim\n  contactscope simulate --topography scan.gwy --radius 290um --modulus 3.7GPa --model elastic --forces 4,40,400mN"
+        after_help = "Examples:\n  contactscope simulate --topography sphere.npy --pixel-size 32nm --height-unit 1nm --modulus 3.7GPa --model hardening --hardening 4MPa/nm --forces 4mN..400mN:12 --out sim\n  contactscope simulate --topography scan.gwy --radius 290um --modulus 3.7GPa --model elastic --forces 4,40,400mN\n  contactscope simulate --topography rough2048.npy --pixel-size 32nm --radius 290um --modulus 3.7GPa --model hardening --hardening 4MPa/nm --forces 4,40,400mN --maps contact --out ramp"
     )]
     Simulate(simulate::Args),
     /// Generate a self-affine random surface (Fourier filtering, seeded).

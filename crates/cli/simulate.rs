@@ -8,7 +8,7 @@ use contactscope::solver::simulate::Model;
 use contactscope_formats::units::{self, Dimension};
 use contactscope_jobs::heights::HeightInput;
 use contactscope_jobs::simulate::files::run_to_folder;
-use contactscope_jobs::simulate::{ModelChoice, SimulateRequest};
+use contactscope_jobs::simulate::{MapChoice, ModelChoice, SimulateRequest};
 
 use super::args::{default_out, load_forces, BodyArgs, Forces, OutputFolder, Quiet, SolverArgs};
 use super::common::{command_line, print_warnings, print_written, progress_bar};
@@ -25,6 +25,17 @@ enum ModelArg {
     Hardening,
     /// Greenwood–Tripp bearing area.
     Gt,
+}
+
+/// `--maps`: which per-load TIFF maps to write.
+#[derive(Clone, Copy, ValueEnum)]
+enum MapsArg {
+    /// No maps: areas.csv, summary.json and the plot only.
+    None,
+    /// The contact map of each load only.
+    Contact,
+    /// Contact, pressure, gap, plastic displacement and deformed surface of each load.
+    All,
 }
 
 #[derive(clap::Args)]
@@ -54,6 +65,9 @@ pub struct Args {
     forces: Forces,
     #[command(flatten)]
     solver: SolverArgs,
+    /// Per-load float32 TIFF maps to write: all, contact (the contact map only) or none.
+    #[arg(long, value_enum, default_value = "all")]
+    maps: MapsArg,
     #[command(flatten)]
     out: OutputFolder<Out>,
     #[command(flatten)]
@@ -120,6 +134,11 @@ pub fn run(args: Args) -> Result<()> {
     request.tolerance = args.solver.tolerance;
     request.max_iterations = args.solver.max_iterations;
     request.device = args.solver.device.into();
+    request.maps = match args.maps {
+        MapsArg::None => MapChoice::None,
+        MapsArg::Contact => MapChoice::Contact,
+        MapsArg::All => MapChoice::All,
+    };
     let bar = progress_bar(request.loads_n.len(), 1, args.quiet.quiet);
     bar.set_style(
         ProgressStyle::with_template(

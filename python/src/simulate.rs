@@ -9,7 +9,9 @@ use pyo3::types::PyDict;
 
 use contactscope::solver::simulate::Model;
 use contactscope_formats::param::Param;
-use contactscope_jobs::simulate::{run, LoadMaps, LoadObserver, ModelChoice, SimulateRequest};
+use contactscope_jobs::simulate::{
+    run, LoadMaps, LoadObserver, MapChoice, ModelChoice, SimulateRequest,
+};
 
 use crate::convert::outcome_dict;
 use crate::heights::{height_input, HeightsArg};
@@ -65,9 +67,31 @@ pub(crate) fn model_of(
     })
 }
 
-/// Keeps each load's maps: pressure (Pa), gap (m), plastic displacement (m), contact.
+/// `maps=`: `"none"`, `"contact"` or `"all"`; `True` and `False` (the older spelling) mean
+/// `"all"` and `"none"`.
+#[derive(FromPyObject)]
+enum MapsArg {
+    Flag(bool),
+    Name(String),
+}
+
+fn maps_of(arg: MapsArg) -> PyResult<MapChoice> {
+    match arg {
+        MapsArg::Flag(true) => Ok(MapChoice::All),
+        MapsArg::Flag(false) => Ok(MapChoice::None),
+        MapsArg::Name(name) => name.parse().map_err(|_| {
+            bad(format!(
+                "maps={name:?} is not one of \"none\", \"contact\", \"all\""
+            ))
+        }),
+    }
+}
+
+/// Keeps each load's maps: pressure (Pa), gap (m), plastic displacement (m), contact; or the
+/// contact alone (`maps="contact"`).
 #[derive(Default)]
 struct KeepMaps {
+    contact_only: bool,
     pressure: Vec<f64>,
     gap: Vec<f64>,
     plastic: Vec<f64>,
@@ -87,6 +111,9 @@ impl LoadObserver for KeepMaps {
                 self.shape = (body.ny(), body.nx());
                 self.contact
                     .extend(step.solution.pressure.iter().map(|p| *p > 0.0));
+                if self.contact_only {
+                    return Ok(());
+                }
                 // The step is ours: its fields move into the stacks.
                 self.pressure.extend(step.solution.pressure);
                 self.gap.extend(step.solution.gap);
@@ -98,6 +125,9 @@ impl LoadObserver for KeepMaps {
                 let n = mask.len();
                 self.shape = (roughness.ny(), roughness.nx());
                 self.contact.extend(mask.iter().map(|m| *m > 0));
+                if self.contact_only {
+                    return Ok(());
+                }
                 self.pressure.extend(std::iter::repeat_n(f64::NAN, n));
                 self.gap.extend(std::iter::repeat_n(f64::NAN, n));
                 self.plastic.extend(std::iter::repeat_n(0.0, n));
@@ -108,9 +138,9 @@ impl LoadObserver for KeepMaps {
 }
 
 /// A load ramp with one contact model (the command line's `simulate`); see the package's
-/// docstring. Returns the outcome (SI) and, with `maps`, the stacks (loads, ny, nx).
+/// docstring. Returns the outcome (SI) and the stacks (loads, ny, nx) `maps` asks for.
 #[pyfunction]
-#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=true, detrend="plane", height_unit=None, channel=None, fill_invalid=None, device="cpu"))]
+#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=MapsArg::Name("all".into()), detrend="plane", height_unit=None, channel=None, fill_invalid=None, device="cpu"))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -127,7 +157,7 @@ fn simulate<'py>(
     periodic: bool,
     tolerance: Option<f64>,
     max_iterations: Option<usize>,
-    maps: bool,
+    maps: MapsArg,
     detrend: &str,
     height_unit: Option<f64>,
     channel: Option<String>,
@@ -144,25 +174,30 @@ fn simulate<'py>(
         fill_invalid,
     )?;
     let model = model_of(model, hardness, k, initial_hardness, alpha)?;
+    let maps = maps_of(maps)?;
     let mut request = SimulateRequest::new(input, modulus, model, loads);
     request.radius_m = radius;
     request.periodic = periodic;
     request.tolerance = tolerance.unwrap_or(request.tolerance);
     request.max_iterations = max_iterations.unwrap_or(request.max_iterations);
     request.device = device;
+    request.maps = maps;
     let (outcome, kept) = compute(py, move || {
-        let mut kept = KeepMaps::default();
-        let outcome = if maps {
-            run(&request, &mut kept, None)?
-        } else {
+        let mut kept = KeepMaps {
+            contact_only: maps == MapChoice::Contact,
+            ..KeepMaps::default()
+        };
+        let outcome = if maps == MapChoice::None {
             run(&request, &mut contactscope_jobs::simulate::NoMaps, None)?
+        } else {
+            run(&request, &mut kept, None)?
         };
         Ok::<_, contactscope_jobs::Error>((outcome, kept))
     })?;
     let d = outcome_dict(py, &outcome)?;
-    if maps {
-        let shape = (outcome.loads.len(), kept.shape.0, kept.shape.1);
-        let err = |e: ndarray::ShapeError| bad(format!("maps: {e}"));
+    let shape = (outcome.loads.len(), kept.shape.0, kept.shape.1);
+    let err = |e: ndarray::ShapeError| bad(format!("maps: {e}"));
+    if maps.all() {
         for (name, values) in [
             ("pressure", kept.pressure),
             ("gap", kept.gap),
@@ -171,6 +206,8 @@ fn simulate<'py>(
             let a = Array3::from_shape_vec(shape, values).map_err(err)?;
             d.set_item(name, a.into_pyarray(py))?;
         }
+    }
+    if maps != MapChoice::None {
         let a = Array3::from_shape_vec(shape, kept.contact).map_err(err)?;
         d.set_item("contact", a.into_pyarray(py))?;
     }

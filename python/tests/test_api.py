@@ -336,6 +336,28 @@ def test_simulate_gt_and_elastic_models(surface_npy):
     assert np.isnan(gt.pressure).all()
 
 
+def test_simulate_maps_choice(surface_npy):
+    # maps= chooses the stacks returned, as --maps chooses the files; the solution is the same.
+    h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
+    run = lambda **kw: cs.simulate(h, 100e-9, 1e9, [20e-6, 40e-6], "hardening", k=4e15,
+                                   radius=20e-6, **kw)
+    stacks = {"pressure", "gap", "plastic", "contact"}
+    a, c, n = run(), run(maps="contact"), run(maps="none")
+    assert (a["maps"], c["maps"], n["maps"]) == ("all", "contact", "none")
+    assert stacks <= set(a)
+    assert stacks & set(c) == {"contact"}
+    assert not stacks & set(n)
+    np.testing.assert_array_equal(c.contact, a.contact)
+    assert c.contact.shape == (2, 128, 128) and c.contact.any()
+    assert [r["area_m2"] for r in n.rows] == [r["area_m2"] for r in a.rows]
+    # The older spelling: True and False.
+    assert run(maps=False)["maps"] == "none" and run(maps=True)["maps"] == "all"
+    with pytest.raises(cs.InputError, match='maps="pressure"'):
+        run(maps="pressure")
+    gt = cs.simulate(h, 100e-9, 1e9, [20e-6], "gt", radius=20e-6, maps="contact")
+    assert stacks & set(gt) == {"contact"} and gt.contact.any()
+
+
 def test_compare_matches_cli(cli, series_tif, tmp_path):
     path, s = series_tif
     sim = tmp_path / "sim"

@@ -192,6 +192,8 @@ pub const TEMPLATES: &[Template] = &[
             "4MPa/nm",
             "--forces",
             "0.05,0.1mN",
+            "--maps",
+            "contact",
             "--out",
             "OUT",
             "-q"

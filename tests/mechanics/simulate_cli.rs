@@ -304,3 +304,154 @@ fn bad_simulation_inputs_fail_cleanly() {
         "map.xyz",
     );
 }
+
+/// The files of a run's folder, sorted (the run record included).
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+fn float_page(path: &Path) -> Vec<u32> {
+    let mut reader = TiffReader::open(path).unwrap();
+    match reader.read_page(0, 0).unwrap().samples {
+        contactscope_formats::image::Samples::Float(v) => v.iter().map(|x| x.to_bits()).collect(),
+        _ => panic!("{}: float32 expected", path.display()),
+    }
+}
+
+#[test]
+fn maps_choice_writes_exactly_the_maps_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let surface = make_surface(dir.path());
+    let sim = |model: &[&str], maps: Option<&str>, name: &str| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "simulate",
+            "--topography",
+            s(&surface),
+            "--pixel-size",
+            "32nm",
+            "--radius",
+            "290um",
+            "--modulus",
+            "3.7GPa",
+            "--forces",
+            "0.002mN,0.005mN",
+            "--out",
+            s(&out),
+            "-q",
+        ];
+        args.extend_from_slice(model);
+        if let Some(m) = maps {
+            args.extend(["--maps", m]);
+        }
+        let o = run(&args);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let summary: serde_json::Value =
+            serde_json::from_str(&fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+        (out, summary)
+    };
+    let hardening = ["--model", "hardening", "--hardening", "4MPa/nm"];
+    let tables = [
+        ".contactscope-run.json",
+        "area_vs_load.png",
+        "areas.csv",
+        "summary.json",
+    ];
+    let with_tables = |maps: &[&str]| {
+        let mut v: Vec<String> = tables.iter().chain(maps).map(|n| n.to_string()).collect();
+        v.sort();
+        v
+    };
+
+    let (all, summary) = sim(&hardening, None, "all");
+    assert_eq!(summary["maps"], "all", "the default");
+    let every: Vec<String> = (1..=2)
+        .flat_map(|i| {
+            [
+                "contact",
+                "deformed_um",
+                "gap_um",
+                "plastic_um",
+                "pressure_MPa",
+            ]
+            .map(|m| format!("load_{i:03}_{m}.tif"))
+        })
+        .collect();
+    let every: Vec<&str> = every.iter().map(String::as_str).collect();
+    assert_eq!(listing(&all), with_tables(&every));
+
+    let (contact, summary) = sim(&hardening, Some("contact"), "contact");
+    assert_eq!(summary["maps"], "contact");
+    assert_eq!(
+        listing(&contact),
+        with_tables(&["load_001_contact.tif", "load_002_contact.tif"])
+    );
+    // The same solution: the same table and, bit for bit, the same contact maps.
+    assert_eq!(
+        fs::read_to_string(contact.join("areas.csv")).unwrap(),
+        fs::read_to_string(all.join("areas.csv")).unwrap()
+    );
+    for i in 1..=2 {
+        let name = format!("load_{i:03}_contact.tif");
+        let page = float_page(&contact.join(&name));
+        assert_eq!(page, float_page(&all.join(&name)), "{name}");
+        assert!(
+            page.iter().any(|b| f32::from_bits(*b) == 1.0),
+            "{name}: contact"
+        );
+    }
+    // The run record lists exactly the files written.
+    let record: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(contact.join(".contactscope-run.json")).unwrap())
+            .unwrap();
+    assert_eq!(record["files"].as_array().unwrap().len(), 5);
+
+    let (none, summary) = sim(&hardening, Some("none"), "none");
+    assert_eq!(summary["maps"], "none");
+    assert_eq!(listing(&none), with_tables(&[]));
+    assert_eq!(summary["loads"].as_array().unwrap().len(), 2);
+
+    // A rerun with fewer maps replaces the folder as a whole: no map of the earlier run stays.
+    let (again, _) = sim(&hardening, Some("none"), "all");
+    assert_eq!(listing(&again), with_tables(&[]));
+
+    // Greenwood–Tripp has a contact map only, written under `contact` and `all`, not `none`.
+    let (gt, summary) = sim(&["--model", "gt"], Some("contact"), "gt");
+    assert_eq!(summary["maps"], "contact");
+    assert_eq!(
+        listing(&gt),
+        with_tables(&["load_001_contact.tif", "load_002_contact.tif"])
+    );
+    let (gt_none, _) = sim(&["--model", "gt"], Some("none"), "gt-none");
+    assert_eq!(listing(&gt_none), with_tables(&[]));
+
+    // A choice that does not exist: one line naming the flag, nothing written.
+    let out = dir.path().join("never");
+    let o = run(&[
+        "simulate",
+        "--topography",
+        s(&surface),
+        "--pixel-size",
+        "32nm",
+        "--modulus",
+        "3.7GPa",
+        "--model",
+        "elastic",
+        "--forces",
+        "1mN",
+        "--maps",
+        "pressure",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(err.contains("--maps") && err.contains("contact"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(!out.exists());
+}

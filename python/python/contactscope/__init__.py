@@ -495,7 +495,8 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
              k: Optional[float] = None, initial_hardness: Optional[float] = None,
              alpha: Optional[float] = None, radius: Optional[float] = None,
              periodic: bool = False, tolerance: Optional[float] = None,
-             max_iterations: Optional[int] = None, maps: bool = True, detrend: str = "plane",
+             max_iterations: Optional[int] = None, maps: Union[str, bool] = "all",
+             detrend: str = "plane",
              height_unit: Optional[float] = None, channel: Optional[str] = None,
              fill_invalid: Optional[str] = None, device: str = "cpu") -> Results:
     """A load ramp on a rough body pressed on a flat of contact modulus E* ``modulus`` (Pa) at
@@ -518,9 +519,11 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
     Returns the outcome the command line writes as ``summary.json``, in SI units: ``loads``
     (per load: ``force_n``, ``area_m2``, ``mean_pressure_pa``, ``approach_m``, ``patches``,
     ``plastic_volume_m3``, ``edge_contact``, …; also :attr:`Results.rows`), ``topography``,
-    ``model``, ``power_law`` and ``warnings`` (also issued as :class:`ContactscopeWarning`), and
-    with ``maps`` the per-load stacks ``pressure`` (Pa), ``gap`` (m), ``contact`` (bool) and
-    ``plastic`` (m), each (loads, ny, nx).
+    ``model``, ``power_law``, ``maps`` and ``warnings`` (also issued as
+    :class:`ContactscopeWarning`), and the per-load stacks ``maps`` asks for, each (loads, ny,
+    nx): with ``"all"`` (the default) ``pressure`` (Pa), ``gap`` (m), ``contact`` (bool) and
+    ``plastic`` (m); with ``"contact"`` ``contact`` only; with ``"none"`` none (``True`` and
+    ``False`` mean ``"all"`` and ``"none"``). The command line's ``--maps`` takes the same choice.
     """
     if not isinstance(heights, (str, os.PathLike)):
         heights = _f64(heights, 2, "heights")

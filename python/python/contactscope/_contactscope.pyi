@@ -435,8 +435,9 @@ class SimulateResult(TypedDict, total=False):
     solver: Dict[str, Any]
     loads: List[SimulatedLoad]
     power_law: Optional[Dict[str, Any]]
+    maps: str
     warnings: List[str]
-    # With maps=True: (loads, ny, nx) stacks.
+    # (loads, ny, nx) stacks: all four with maps="all", contact only with maps="contact".
     pressure: npt.NDArray[np.float64]
     gap: npt.NDArray[np.float64]
     plastic: npt.NDArray[np.float64]
@@ -456,7 +457,7 @@ def simulate(
     periodic: bool = False,
     tolerance: Optional[float] = None,
     max_iterations: Optional[int] = None,
-    maps: bool = True,
+    maps: Union[str, bool] = "all",
     detrend: str = "plane",
     height_unit: Optional[float] = None,
     channel: Optional[str] = None,

@@ -13,7 +13,10 @@
 //! window caused by pressure inside the same window only needs a zero-padded transform of
 //! 2h' × 2w' with h' ≥ h, w' ≥ w ([`ElasticOperator::window`]): exact, and 16 times cheaper
 //! for a window of a quarter of the map. The load solver keeps its fields on the window that can
-//! carry load (`solver::cg::load`). Window operators are planned on first use and cached.
+//! carry load (`solver::cg::load`). Window operators are planned on first use and cached, and
+//! take their kernel values from the whole operator's (the Love pixel responses at the offsets
+//! the window spans are a corner of the whole grid's, the same numbers), so that planning one
+//! costs its transform only.
 
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -47,6 +50,9 @@ pub struct ElasticOperator {
     dx: f64,
     dy: f64,
     e_star: f64,
+    /// Free boundaries: the Love pixel responses of the transfer function, computed on first
+    /// use and shared with the window operators.
+    quadrant: OnceLock<Quadrant>,
     /// Window operators planned so far.
     windows: Mutex<Vec<Arc<ElasticOperator>>>,
 }
@@ -89,21 +95,43 @@ pub fn window_length(n: usize) -> usize {
 impl ElasticOperator {
     /// Plan the operator for `ny × nx` pixels of `dx × dy` and contact modulus `e_star`.
     pub fn new(ny: usize, nx: usize, dx: f64, dy: f64, e_star: f64, boundary: Boundary) -> Self {
-        let (fy, fx) = match boundary {
-            Boundary::Free => (2 * ny, 2 * nx),
-            Boundary::Periodic => (ny, nx),
+        let fft = match boundary {
+            Boundary::Free => RealFft2::new(2 * ny, 2 * nx),
+            Boundary::Periodic => RealFft2::new(ny, nx),
         };
-        let fft = RealFft2::new(fy, fx);
+        Self::planned(ny, nx, dx, dy, e_star, boundary, fft, OnceLock::new())
+    }
+
+    /// The free operator of `ny × nx` pixels whose kernel values come from `quadrant` (at least
+    /// (ny + 1) × (nx + 1) offsets); it keeps no quadrant of its own.
+    fn free(ny: usize, nx: usize, dx: f64, dy: f64, e_star: f64, quadrant: &Quadrant) -> Self {
+        let fft = RealFft2::new(2 * ny, 2 * nx);
+        let transfer = free_transfer(&fft, quadrant);
+        Self::planned(ny, nx, dx, dy, e_star, Boundary::Free, fft, transfer.into())
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn planned(
+        ny: usize,
+        nx: usize,
+        dx: f64,
+        dy: f64,
+        e_star: f64,
+        boundary: Boundary,
+        fft: RealFft2,
+        transfer: OnceLock<Vec<f64>>,
+    ) -> Self {
         ElasticOperator {
             nx,
             ny,
             boundary,
             fft,
-            transfer: OnceLock::new(),
+            transfer,
             self_coefficient: love_pixel(0.0, 0.0, dx, dy, e_star),
             dx,
             dy,
             e_star,
+            quadrant: OnceLock::new(),
             windows: Mutex::new(Vec::new()),
         }
     }
@@ -123,16 +151,40 @@ impl ElasticOperator {
         if let Some(op) = cache.iter().find(|op| op.ny == wy && op.nx == wx) {
             return WindowOperator::Part(Arc::clone(op));
         }
-        let op = Arc::new(ElasticOperator::new(
+        let op = Arc::new(ElasticOperator::free(
             wy,
             wx,
             self.dx,
             self.dy,
             self.e_star,
-            Boundary::Free,
+            self.quadrant(),
         ));
         cache.push(Arc::clone(&op));
         WindowOperator::Part(op)
+    }
+
+    /// The Love pixel responses at offsets up to the grid's size, computed on first use.
+    fn quadrant(&self) -> &Quadrant {
+        self.quadrant
+            .get_or_init(|| Quadrant::new(self.ny + 1, self.nx + 1, self.dx, self.dy, self.e_star))
+    }
+
+    /// The transfer function, computed on first use.
+    fn transfer(&self) -> &[f64] {
+        self.transfer.get_or_init(|| match self.boundary {
+            Boundary::Free => free_transfer(&self.fft, self.quadrant()),
+            Boundary::Periodic => periodic_transfer(&self.fft, self.dx, self.dy, self.e_star),
+        })
+    }
+
+    /// The pixel size (Δx, Δy).
+    pub fn pixel_size(&self) -> (f64, f64) {
+        (self.dx, self.dy)
+    }
+
+    /// The contact modulus E*.
+    pub fn modulus(&self) -> f64 {
+        self.e_star
     }
 
     /// Grid rows.
@@ -148,24 +200,6 @@ impl ElasticOperator {
     /// The boundary conditions.
     pub fn boundary(&self) -> Boundary {
         self.boundary
-    }
-
-    /// The transfer function, computed on first use.
-    fn transfer(&self) -> &[f64] {
-        self.transfer.get_or_init(|| match self.boundary {
-            Boundary::Free => free_transfer(&self.fft, self.dx, self.dy, self.e_star),
-            Boundary::Periodic => periodic_transfer(&self.fft, self.dx, self.dy, self.e_star),
-        })
-    }
-
-    /// The pixel size (Δx, Δy).
-    pub fn pixel_size(&self) -> (f64, f64) {
-        (self.dx, self.dy)
-    }
-
-    /// The contact modulus E*.
-    pub fn modulus(&self) -> f64 {
-        self.e_star
     }
 
     /// Displacement at a loaded pixel's centre per unit pressure on that pixel (1.12·Δ/E* for
@@ -221,21 +255,39 @@ pub struct Workspace {
     convolve: ConvolveWork,
 }
 
-fn free_transfer(fft: &RealFft2, dx: f64, dy: f64, e_star: f64) -> Vec<f64> {
+/// The Love pixel responses G(i·dx, j·dy) for 0 ≤ i < qx, 0 ≤ j < qy (row-major, qx a row).
+/// G is even in x and y, so these fill any kernel whose offsets stay within them.
+#[derive(Debug)]
+struct Quadrant {
+    qx: usize,
+    values: Vec<f64>,
+}
+
+impl Quadrant {
+    fn new(qy: usize, qx: usize, dx: f64, dy: f64, e_star: f64) -> Self {
+        let values = (0..qy * qx)
+            .into_par_iter()
+            .map(|k| love_pixel((k % qx) as f64 * dx, (k / qx) as f64 * dy, dx, dy, e_star))
+            .collect();
+        Quadrant { qx, values }
+    }
+
+    /// G at offsets (|x|, |y|) in pixels.
+    fn at(&self, y: usize, x: usize) -> f64 {
+        self.values[y * self.qx + x]
+    }
+}
+
+fn free_transfer(fft: &RealFft2, quadrant: &Quadrant) -> Vec<f64> {
     let (fy, fx) = (fft.ny(), fft.nx());
     // Offsets wrap at half the padded length; G is even in x and y, so one quadrant of values
     // (|offset| ≤ half the length) fills the whole kernel.
-    let (qy, qx) = (fy / 2 + 1, fx / 2 + 1);
-    let quadrant: Vec<f64> = (0..qy * qx)
-        .into_par_iter()
-        .map(|k| love_pixel((k % qx) as f64 * dx, (k / qx) as f64 * dy, dx, dy, e_star))
-        .collect();
     let fold = |i: usize, n: usize| if i <= n / 2 { i } else { n - i };
     let mut kernel = vec![0.0; fy * fx];
     kernel.par_chunks_mut(fx).enumerate().for_each(|(y, row)| {
-        let base = fold(y, fy) * qx;
+        let oy = fold(y, fy);
         for (x, value) in row.iter_mut().enumerate() {
-            *value = quadrant[base + fold(x, fx)];
+            *value = quadrant.at(oy, fold(x, fx));
         }
     });
     let mut spectrum = fft.make_spectrum();
@@ -323,6 +375,15 @@ mod tests {
         }
         // A window as large as the grid is the operator itself.
         assert!(matches!(op.window(ny, nx), WindowOperator::Whole(_)));
+        // Its kernel values come from the whole operator's: the same transfer function, bit for
+        // bit, as an operator planned on its own.
+        let own = ElasticOperator::new(12, 16, dx, dy, e, Boundary::Free);
+        assert_eq!(part.transfer().len(), own.transfer().len());
+        assert!(part
+            .transfer()
+            .iter()
+            .zip(own.transfer())
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
     }
 
     #[test]

@@ -89,7 +89,7 @@ pub fn read_image(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::image::PixelSizeSource;
+    use crate::image::{PixelSizeSource, Samples};
 
     #[test]
     fn pages_and_single_image() {
@@ -113,5 +113,68 @@ mod tests {
             PixelSizeSource::CommandLine
         );
         assert!(read_pages(&path, Some(1), None).is_err());
+    }
+
+    #[test]
+    fn float_maps_round_trip_bit_for_bit() {
+        // `simulate`'s maps (Deflate level 1, several strips): every bit of every value comes
+        // back through our reader, NaN payloads, −0, ±∞ and subnormals included.
+        let (width, height) = (301, 1000);
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut values: Vec<f32> = (0..width * height)
+            .map(|i| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                match i % 5 {
+                    // Smooth, like a gap or height map, and arbitrary bit patterns.
+                    0 | 1 => (i as f32 * 1e-3).sin() * 3.7,
+                    2 => f32::from_bits(state as u32),
+                    3 => 0.0,
+                    _ => (state >> 40) as f32 * 1e-6,
+                }
+            })
+            .collect();
+        values[..6].copy_from_slice(&[
+            f32::from_bits(0x7fc0_1234),
+            -0.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::from_bits(1),
+            f32::MAX,
+        ]);
+        let second: Vec<f32> = values.iter().rev().copied().collect();
+        let bytes = encode_f32_stack(
+            &[&values, &second],
+            width,
+            height,
+            Some((32e-9, 32e-9)),
+            "contactscope simulate gap_um\n",
+        )
+        .unwrap();
+        assert!(bytes.len() < 8 * width * height, "compressed");
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("map.tif");
+        std::fs::write(&path, bytes).unwrap();
+        let mut reader = TiffReader::open(&path).unwrap();
+        let info = reader.info().clone();
+        assert_eq!(info.compression, "Deflate");
+        assert_eq!(
+            (info.width, info.height, info.pages.len()),
+            (width, height, 2)
+        );
+        assert!((info.pixel_size.unwrap().x_m - 32e-9).abs() < 1e-15);
+        for (page, expected) in [values, second].iter().enumerate() {
+            let Samples::Float(read) = reader.read_page(page, 0).unwrap().samples else {
+                panic!("float32 pages");
+            };
+            assert_eq!(read.len(), expected.len());
+            let differing = read
+                .iter()
+                .zip(expected)
+                .filter(|(a, b)| a.to_bits() != b.to_bits())
+                .count();
+            assert_eq!(differing, 0, "page {page}");
+        }
     }
 }

@@ -6,6 +6,7 @@
 
 use std::io::Cursor;
 
+use tiff::encoder::compression::DeflateLevel;
 use tiff::encoder::{colortype, Compression as TiffCompression, Rational, TiffEncoder, TiffValue};
 use tiff::tags::{ResolutionUnit, Tag};
 
@@ -43,6 +44,13 @@ pub enum Compression {
     Lzw,
     /// Adobe Deflate, no predictor.
     Deflate,
+    /// Adobe Deflate at level 1, no predictor: the same format as [`Compression::Deflate`] (every
+    /// reader that opens one opens the other), written about six times faster. On the float32
+    /// maps of a 2048² `simulate` ramp (measured) a map takes 57–88 ms against 350–550 ms at the
+    /// default level 6; the maps of real-valued fields come out as large as at level 6 (within
+    /// 4 %; 21 % larger for the mostly-zero pressure of the lightest load), the 0/1 contact maps
+    /// 2.7–3.6× larger (0.09–0.16 MB), the whole folder 0.5 % larger.
+    DeflateFast,
 }
 
 impl Compression {
@@ -51,6 +59,7 @@ impl Compression {
             Compression::None => TiffCompression::Uncompressed,
             Compression::Lzw => TiffCompression::Lzw,
             Compression::Deflate => TiffCompression::Deflate(Default::default()),
+            Compression::DeflateFast => TiffCompression::Deflate(DeflateLevel::Fast),
         }
     }
 }
@@ -66,7 +75,10 @@ fn encode_stack<C: colortype::ColorType>(
 where
     [C::Inner]: TiffValue,
 {
-    let mut bytes = Cursor::new(Vec::new());
+    // Room for the uncompressed pages, so that the buffer does not grow (and copy itself) while
+    // a large page is written; what is not written is never touched.
+    let raw = pages.len() * width * height * std::mem::size_of::<C::Inner>();
+    let mut bytes = Cursor::new(Vec::with_capacity(raw + 4096));
     let mut encoder = TiffEncoder::new(&mut bytes)
         .map_err(encode_error)?
         .with_compression(compression.to_tiff());
@@ -145,7 +157,9 @@ pub fn encode_u8_stack(
     encode_stack::<colortype::Gray8>(pages, width, height, pixel_size, "", Compression::Deflate)
 }
 
-/// Encode 32-bit float grey pages (maps of the solver) as one TIFF with ImageJ calibration.
+/// Encode 32-bit float grey pages (maps of the solver) as one TIFF with ImageJ calibration,
+/// Deflate-compressed at level 1 ([`Compression::DeflateFast`]; no predictor, so that ImageJ's
+/// own TIFF reader, which ignores the floating-point predictor, opens them as well).
 pub fn encode_f32_stack(
     pages: &[&[f32]],
     width: usize,
@@ -159,6 +173,6 @@ pub fn encode_f32_stack(
         height,
         pixel_size,
         extra_description,
-        Compression::Deflate,
+        Compression::DeflateFast,
     )
 }

@@ -1,13 +1,16 @@
 //! The outputs of `simulate` as the command line writes them, through a staging folder (nothing
 //! appears on failure): `areas.csv` and `summary.json` from the [`SimulateOutcome`], per-load
-//! float32 TIFF maps as the loads are solved, and `area_vs_load.png` (feature `plots`).
+//! float32 TIFF maps as the loads are solved (those [`MapChoice`] asks for), and
+//! `area_vs_load.png` (feature `plots`).
 
 use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
 
 use contactscope::solver::cg::Monitor;
 use contactscope_formats::tiff::write::encode_f32_stack;
 
-use super::{run, LoadMaps, LoadObserver, SimulateOutcome, SimulateRequest};
+use super::{run, LoadMaps, LoadObserver, MapChoice, SimulateOutcome, SimulateRequest};
 use crate::error::Result;
 use crate::heights::HeightInput;
 use crate::staging::Staging;
@@ -32,6 +35,8 @@ pub fn run_to_folder(
     let mut writer = MapWriter {
         staging: &staging,
         progress,
+        maps: request.maps,
+        top_m: None,
     };
     let outcome = run(request, &mut writer, monitor)?;
     staging.write("areas.csv", &areas_csv(&outcome)?)?;
@@ -53,97 +58,119 @@ pub fn areas_csv(outcome: &SimulateOutcome) -> Result<Vec<u8>> {
 struct MapWriter<'a> {
     staging: &'a Staging,
     progress: &'a dyn Fn(usize, usize),
+    maps: MapChoice,
+    /// The top of the undeformed body, the same at every load (found at the first).
+    top_m: Option<f64>,
 }
 
 impl LoadObserver for MapWriter<'_> {
     fn load(&mut self, index: usize, total: usize, maps: LoadMaps<'_>) -> Result<()> {
-        write_maps(self.staging, index, &maps)?;
+        if self.maps != MapChoice::None {
+            self.write_maps(index, &maps)?;
+        }
         (self.progress)(index + 1, total);
         Ok(())
     }
 }
 
-/// Per-load float32 maps: contact, pressure (MPa), gap (µm), plastic displacement (µm) and the
-/// deformed topography (µm, heights positive towards the flat); Greenwood–Tripp: the contact.
-fn write_maps(staging: &Staging, i: usize, maps: &LoadMaps<'_>) -> Result<()> {
-    let map = |grid: (usize, usize, f64, f64), name: &str, values: Vec<f32>| -> Result<()> {
-        let (nx, ny, dx, dy) = grid;
-        let tiff = encode_f32_stack(
-            &[&values],
-            nx,
-            ny,
-            Some((dx, dy)),
-            &format!("contactscope simulate {name}\n"),
-        )?;
-        staging.write(&format!("load_{:03}_{name}.tif", i + 1), &tiff)?;
-        Ok(())
-    };
-    match maps {
-        LoadMaps::BearingArea { roughness, mask } => {
-            let grid = (
-                roughness.nx(),
-                roughness.ny(),
-                roughness.dx_m,
-                roughness.dy_m,
-            );
-            let contact: Vec<f32> = mask.iter().map(|m| f32::from(*m)).collect();
-            // The GT map's description names the model.
-            let (nx, ny, dx, dy) = grid;
-            let tiff = encode_f32_stack(
-                &[&contact],
-                nx,
-                ny,
-                Some((dx, dy)),
-                "contactscope simulate gt contact\n",
-            )?;
-            staging.write(&format!("load_{:03}_contact.tif", i + 1), &tiff)?;
-            Ok(())
+/// The per-load maps, in the order they are staged.
+#[derive(Debug, Clone, Copy)]
+enum Map {
+    Contact,
+    Pressure,
+    Gap,
+    Plastic,
+    Deformed,
+}
+
+impl Map {
+    /// The name in `load_NNN_{name}.tif`, with the unit.
+    fn name(self) -> &'static str {
+        match self {
+            Map::Contact => "contact",
+            Map::Pressure => "pressure_MPa",
+            Map::Gap => "gap_um",
+            Map::Plastic => "plastic_um",
+            Map::Deformed => "deformed_um",
         }
-        LoadMaps::HalfSpace { body, base, step } => {
-            let grid = (body.nx(), body.ny(), body.dx_m, body.dy_m);
-            let s = step;
-            map(
-                grid,
-                "contact",
-                s.solution
-                    .pressure
-                    .iter()
-                    .map(|p| f32::from(u8::from(*p > 0.0)))
-                    .collect(),
-            )?;
-            map(
-                grid,
-                "pressure_MPa",
-                s.solution
-                    .pressure
-                    .iter()
-                    .map(|p| (p * 1e-6) as f32)
-                    .collect(),
-            )?;
-            map(
-                grid,
-                "gap_um",
-                s.solution.gap.iter().map(|g| (g * 1e6) as f32).collect(),
-            )?;
-            map(
-                grid,
-                "plastic_um",
-                s.plastic_m.iter().map(|h| (h * 1e6) as f32).collect(),
-            )?;
-            let top = base
+    }
+
+    /// The map's float32 values; `top_m` is the top of the undeformed body.
+    fn values(self, maps: &LoadMaps<'_>, top_m: f64) -> Vec<f32> {
+        let (base, step) = match maps {
+            LoadMaps::BearingArea { mask, .. } => {
+                return mask.iter().map(|m| f32::from(*m)).collect();
+            }
+            LoadMaps::HalfSpace { base, step, .. } => (base, step),
+        };
+        let (p, gap, plastic) = (&step.solution.pressure, &step.solution.gap, &step.plastic_m);
+        match self {
+            Map::Contact => p.iter().map(|p| f32::from(u8::from(*p > 0.0))).collect(),
+            Map::Pressure => p.iter().map(|p| (p * 1e-6) as f32).collect(),
+            Map::Gap => gap.iter().map(|g| (g * 1e6) as f32).collect(),
+            Map::Plastic => plastic.iter().map(|h| (h * 1e6) as f32).collect(),
+            Map::Deformed => base
                 .iter()
-                .zip(body.heights.iter())
-                .map(|(s, h)| s + h)
-                .fold(f64::NAN, f64::max);
-            map(
-                grid,
-                "deformed_um",
-                base.iter()
-                    .zip(&s.plastic_m)
-                    .map(|(sep, h)| ((top - sep - h) * 1e6) as f32)
-                    .collect(),
-            )
+                .zip(plastic)
+                .map(|(sep, h)| ((top_m - sep - h) * 1e6) as f32)
+                .collect(),
         }
+    }
+}
+
+impl MapWriter<'_> {
+    /// Per-load float32 maps: contact, pressure (MPa), gap (µm), plastic displacement (µm) and
+    /// the deformed topography (µm, heights positive towards the flat), or the contact alone
+    /// ([`MapChoice::Contact`]); Greenwood–Tripp: the contact. The maps of one load are converted
+    /// and compressed in parallel, then staged in this order.
+    fn write_maps(&mut self, i: usize, maps: &LoadMaps<'_>) -> Result<()> {
+        let (grid, description, wanted) = match maps {
+            // The GT map's description names the model.
+            LoadMaps::BearingArea { roughness, .. } => (&**roughness, "gt ", &[Map::Contact][..]),
+            LoadMaps::HalfSpace { body, .. } => (
+                *body,
+                "",
+                if self.maps.all() {
+                    &[
+                        Map::Contact,
+                        Map::Pressure,
+                        Map::Gap,
+                        Map::Plastic,
+                        Map::Deformed,
+                    ][..]
+                } else {
+                    &[Map::Contact][..]
+                },
+            ),
+        };
+        let top_m = match maps {
+            LoadMaps::HalfSpace { body, base, .. } if self.maps.all() => {
+                *self.top_m.get_or_insert_with(|| {
+                    base.iter()
+                        .zip(body.heights.iter())
+                        .map(|(s, h)| s + h)
+                        .fold(f64::NAN, f64::max)
+                })
+            }
+            _ => f64::NAN,
+        };
+        let encoded: Vec<Result<Vec<u8>>> = wanted
+            .par_iter()
+            .map(|map| {
+                Ok(encode_f32_stack(
+                    &[&map.values(maps, top_m)],
+                    grid.nx(),
+                    grid.ny(),
+                    Some((grid.dx_m, grid.dy_m)),
+                    &format!("contactscope simulate {description}{}\n", map.name()),
+                )?)
+            })
+            .collect();
+        for (map, tiff) in wanted.iter().zip(encoded) {
+            self.staging
+                .write(&format!("load_{:03}_{}.tif", i + 1, map.name()), &tiff?)?;
+        }
+        Ok(())
     }
 }
 

@@ -91,6 +91,57 @@ impl Serialize for ModelChoice {
     }
 }
 
+/// Which per-load maps a run writes (the command line's TIFFs) or keeps (Python's arrays).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MapChoice {
+    /// No maps: the tables, `summary.json` and the plot only.
+    None,
+    /// The contact map of each load only.
+    Contact,
+    /// Every map of each load: contact, pressure, gap, plastic displacement, deformed surface
+    /// (Greenwood–Tripp: the contact).
+    #[default]
+    All,
+}
+
+impl MapChoice {
+    /// Every choice, in the order help texts list them.
+    pub const ALL: [MapChoice; 3] = [MapChoice::None, MapChoice::Contact, MapChoice::All];
+
+    /// The choice's name, as `summary.json` records it and the front-ends take it.
+    pub fn name(self) -> &'static str {
+        match self {
+            MapChoice::None => "none",
+            MapChoice::Contact => "contact",
+            MapChoice::All => "all",
+        }
+    }
+
+    /// Whether the maps other than the contact are wanted.
+    pub fn all(self) -> bool {
+        self == MapChoice::All
+    }
+}
+
+impl std::str::FromStr for MapChoice {
+    type Err = String;
+
+    /// `none`, `contact` or `all`; the refusal lists them (the front-end adds its own name).
+    fn from_str(text: &str) -> std::result::Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == text.trim())
+            .ok_or_else(|| format!("{text:?} is not one of none, contact, all"))
+    }
+}
+
+/// `summary.json` records the choice by its name (`"maps": "contact"`).
+impl Serialize for MapChoice {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
 /// Everything `simulate` needs. SI units.
 #[derive(Debug, Clone)]
 pub struct SimulateRequest {
@@ -112,6 +163,8 @@ pub struct SimulateRequest {
     pub max_iterations: usize,
     /// Where the half-space solver runs (CPU, CUDA GPU, or a GPU when one is usable).
     pub device: DeviceChoice,
+    /// Which per-load maps reach the caller (the observer hears of every load either way).
+    pub maps: MapChoice,
 }
 
 impl SimulateRequest {
@@ -137,6 +190,7 @@ impl SimulateRequest {
             tolerance: Self::TOLERANCE,
             max_iterations: Self::MAX_ITERATIONS,
             device: DeviceChoice::Cpu,
+            maps: MapChoice::All,
         }
     }
 
@@ -323,6 +377,8 @@ pub struct SimulateOutcome {
     pub loads: Vec<SimulatedLoad>,
     /// A = c·N^β through the loads with contact.
     pub power_law: Option<PowerLaw>,
+    /// Which per-load maps were written (kept, in Python): `none`, `contact` or `all`.
+    pub maps: MapChoice,
     /// Warnings (notes on the input, edge contact, empty contacts).
     pub warnings: Vec<String>,
     /// Statistics of the roughness (after detrending, before adding a sphere).
@@ -438,6 +494,7 @@ pub fn run(
             r_squared: fit.r_squared,
         }),
         loads,
+        maps: request.maps,
         warnings,
         stats,
     })
