@@ -290,7 +290,7 @@ impl Gpu {
             .map_err(|e| device_error("running the solver's kernels", e))
     }
 
-    /// A launch of `kernel` over `n` elements (grid-stride).
+    /// A launch of `kernel` on the GPU's stream; add its arguments in order.
     pub(crate) fn launch<'a>(&'a self, kernel: &'a CudaFunction) -> LaunchArgs<'a> {
         self.stream.launch_builder(kernel)
     }
@@ -451,8 +451,6 @@ struct OperatorWork {
     spectrum: CudaSlice<double2>,
 }
 
-// SAFETY: the plans and buffers are only used under the mutex, on the GPU's one stream.
-unsafe impl Send for OperatorWork {}
 
 impl DeviceOperator {
     fn new(gpu: &Gpu, key: OperatorKey, dx: f64, dy: f64, e_star: f64) -> Result<Self> {
