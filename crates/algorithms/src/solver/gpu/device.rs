@@ -451,7 +451,6 @@ struct OperatorWork {
     spectrum: CudaSlice<double2>,
 }
 
-
 impl DeviceOperator {
     fn new(gpu: &Gpu, key: OperatorKey, dx: f64, dy: f64, e_star: f64) -> Result<Self> {
         let (ny, nx) = key.grid;
