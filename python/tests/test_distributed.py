@@ -103,3 +103,43 @@ def test_brent_finds_minimum():
     x = dd.brent_minimum(f, -1.0, 2.0, 1e-6)
     assert x == pytest.approx(0.3, abs=1e-5)
     assert len(calls) < 30
+
+
+def test_tasks_undo_the_worker_environment_s_malloc_thresholds(tmp_path):
+    """In a process started like a Dask worker (``MALLOC_TRIM_THRESHOLD_`` set), the solver's
+    buffers fault in afresh at every load until a task sets glibc's thresholds back; counted in
+    a subprocess, minor page faults of one 256² ramp before and after."""
+    import os
+    import subprocess
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        pytest.skip("glibc's mallopt: Linux only")
+    script = tmp_path / "faults.py"
+    script.write_text(
+        "import resource, contactscope as cs\n"
+        "from contactscope import distributed as dd\n"
+        "cs.set_num_threads(1)\n"
+        "h = cs.surface(256, 256, 128e-9, rms_slope=0.1, rolloff=4e-6, cutoff=512e-9, seed=7)\n"
+        "def faults():\n"
+        "    f = resource.getrusage(resource.RUSAGE_SELF).ru_minflt\n"
+        "    cs.ramp(h, 128e-9, 3.7e9, 'hardening', 4e15, [4e-3, 40e-3, 400e-3], radius=290e-6)\n"
+        "    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f\n"
+        "faults()\n"
+        "before = faults()\n"
+        "tuned = dd._tune_malloc()\n"
+        "faults()\n"
+        "print(before, faults(), tuned)\n")
+    env = dict(os.environ, MALLOC_TRIM_THRESHOLD_="65536")
+    out = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True,
+                         check=True).stdout.split()
+    before, after, tuned = int(out[0]), int(out[1]), out[2] == "True"
+    if not tuned:
+        pytest.skip("not glibc: mallopt unavailable")
+    assert after * 3 < before, f"minor faults per ramp: {before} before, {after} after"
+    # Without the variable nothing is changed.
+    env.pop("MALLOC_TRIM_THRESHOLD_")
+    out = subprocess.run([sys.executable, "-c",
+                          "from contactscope import distributed as dd; print(dd._tune_malloc())"],
+                         env=env, capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["False"]
