@@ -143,3 +143,43 @@ def test_tasks_undo_the_worker_environment_s_malloc_thresholds(tmp_path):
                           "from contactscope import distributed as dd; print(dd._tune_malloc())"],
                          env=env, capture_output=True, text=True, check=True).stdout.split()
     assert out == ["False"]
+
+
+def test_a_worker_killed_mid_sweep_loses_nothing():
+    """SIGKILL one of two worker processes while its ramps run: Dask reruns the lost tasks (they
+    are pure), its nanny starts a new worker, and the sweep returns every row, equal to the
+    serial path's."""
+    import os
+    import signal
+    import threading
+    import time
+
+    spec = dict(nx=128, ny=128, pixel_size=1e-7, rms_height=5e-8, hurst=0.8)
+    h = cs.surface(seed=5, **spec)
+    kwargs = dict(family="hardening", values=list(np.geomspace(1e15, 1e16, 12)), heights=h,
+                  radius=RADIUS)
+    serial = dd.sweep(LOADS, 1e-7, 1e9, client="serial", **kwargs)
+    with dd.local_client(n_workers=2, threads_per_worker=1) as c:
+        pids = c.run(os.getpid)
+        victim_address, victim = sorted(pids.items())[0]
+        killed = threading.Event()
+
+        def kill_when_busy():
+            deadline = time.monotonic() + 60
+            while time.monotonic() < deadline and not killed.is_set():
+                if c.processing().get(victim_address):
+                    os.kill(victim, signal.SIGKILL)
+                    killed.set()
+                    return
+                time.sleep(0.01)
+
+        killer = threading.Thread(target=kill_when_busy, daemon=True)
+        killer.start()
+        on_dask = dd.sweep(LOADS, 1e-7, 1e9, client=c, **kwargs)
+        killer.join(timeout=5)
+        assert killed.is_set(), "the worker was killed while it held tasks"
+        assert victim not in c.run(os.getpid).values(), "a new worker process took its place"
+    assert len(on_dask.rows) == len(serial.rows) == 12
+    for a, b in zip(on_dask.rows, serial.rows):
+        assert a["error"] is None and a["parameter"] == b["parameter"]
+        np.testing.assert_array_equal(a["areas_m2"], b["areas_m2"])
