@@ -118,30 +118,36 @@ fn surface_topography_and_elastic_simulation() {
     assert!(out.join("area_vs_load.png").exists());
 }
 
+/// `simulate` of the 128² test surface on a 290 µm sphere at 2 and 5 µN, into `out`, with
+/// `extra` arguments (the model, `--maps`).
+fn simulate_sphere(surface: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "simulate",
+        "--topography",
+        s(surface),
+        "--pixel-size",
+        "32nm",
+        "--radius",
+        "290um",
+        "--modulus",
+        "3.7GPa",
+        "--forces",
+        "0.002mN,0.005mN",
+        "--out",
+        s(out),
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
 #[test]
 fn plastic_models_from_the_command_line() {
     let dir = tempfile::tempdir().unwrap();
     let surface = make_surface(dir.path());
     let sim = |extra: &[&str], name: &str| {
         let out = dir.path().join(name);
-        let mut args = vec![
-            "simulate",
-            "--topography",
-            s(&surface),
-            "--pixel-size",
-            "32nm",
-            "--radius",
-            "290um",
-            "--modulus",
-            "3.7GPa",
-            "--forces",
-            "0.002mN,0.005mN",
-            "--out",
-            s(&out),
-            "-q",
-        ];
-        args.extend_from_slice(extra);
-        let o = run(&args);
+        let o = simulate_sphere(&surface, &out, extra);
         assert!(o.status.success(), "{name}: {}", stderr(&o));
         let (h, r) = read_csv(&out.join("areas.csv"));
         (
@@ -329,27 +335,11 @@ fn maps_choice_writes_exactly_the_maps_asked_for() {
     let surface = make_surface(dir.path());
     let sim = |model: &[&str], maps: Option<&str>, name: &str| {
         let out = dir.path().join(name);
-        let mut args = vec![
-            "simulate",
-            "--topography",
-            s(&surface),
-            "--pixel-size",
-            "32nm",
-            "--radius",
-            "290um",
-            "--modulus",
-            "3.7GPa",
-            "--forces",
-            "0.002mN,0.005mN",
-            "--out",
-            s(&out),
-            "-q",
-        ];
-        args.extend_from_slice(model);
+        let mut extra = model.to_vec();
         if let Some(m) = maps {
-            args.extend(["--maps", m]);
+            extra.extend(["--maps", m]);
         }
-        let o = run(&args);
+        let o = simulate_sphere(&surface, &out, &extra);
         assert!(o.status.success(), "{name}: {}", stderr(&o));
         let summary: serde_json::Value =
             serde_json::from_str(&fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();

@@ -22,6 +22,9 @@ pub(crate) const BLOCKS: u32 = 512;
 const THREADS: u32 = 256;
 /// Most blocks of an element-wise kernel (they loop over the grid).
 const MAX_BLOCKS: usize = 8192;
+/// Most operators kept planned (a ramp at 2048² uses the whole grid's and 2–4 windows'; one at
+/// 4096² holds about 1.6 GB of transfer function, buffers and cuFFT work area).
+const MAX_OPERATORS: usize = 8;
 
 const SOURCE: &str = include_str!("kernels.cu");
 
@@ -343,6 +346,13 @@ impl Gpu {
         let mut cache = self.operators.lock().expect("operator cache lock");
         if let Some(found) = cache.iter().find(|o| o.key == key) {
             return Ok(Arc::clone(found));
+        }
+        // The cache lives as long as the process (`shared`): with many grids (a Python session
+        // looping over maps) drop the oldest operator no solve holds before adding one.
+        if cache.len() >= MAX_OPERATORS {
+            if let Some(idle) = cache.iter().position(|o| Arc::strong_count(o) == 1) {
+                cache.remove(idle);
+            }
         }
         let made = Arc::new(DeviceOperator::new(self, key, dx, dy, op.modulus())?);
         cache.push(Arc::clone(&made));

@@ -44,6 +44,12 @@ __device__ __forceinline__ double spring_compliance_of(const Plastic& pl, long l
     return (pl.mode == 2 && p > pl.bound[i]) ? pl.compliance : 0.0;
 }
 
+// The effective gap e − delta = s + u + spring − delta at pixel i for pressure p.
+__device__ __forceinline__ double gap_of(const Plastic& pl, const double* s, const double* u,
+                                         long long i, double p, double delta) {
+    return s[i] + u[i] + spring_of(pl, i, p) - delta;
+}
+
 // Rust's f64::clamp(lo, hi) for lo <= hi.
 __device__ __forceinline__ double clamp_to(double x, double lo, double hi) {
     return x < lo ? lo : (x > hi ? hi : x);
@@ -185,7 +191,7 @@ extern "C" __global__ void gaps(double* out, const double* s, const double* u, c
                          OP_MIN, OP_MAX, OP_MIN, OP_MAX, OP_SUM};
     FOR_EACH(i, n) {
         double pi = p[i], si = s[i], ui = u[i];
-        double g = si + ui + spring_of(pl, i, pi) - delta;
+        double g = gap_of(pl, s, u, i, pi, delta);
         v[9] += pi * (si + 0.5 * ui) + spring_energy_of(pl, i, pi);
         if (pi <= 0.0) {
             v[7] = fmin(v[7], g);
@@ -215,7 +221,7 @@ extern "C" __global__ void residual_sq(double* out, const double* s, const doubl
     FOR_EACH(i, n) {
         double pi = p[i];
         if (pi > 0.0 && pi < cap_of(pl, i)) {
-            double g = s[i] + u[i] + spring_of(pl, i, pi) - delta;
+            double g = gap_of(pl, s, u, i, pi, delta);
             v[0] += g * g;
         }
     }
@@ -231,7 +237,7 @@ extern "C" __global__ void direction(double* t, const double* s, const double* u
     FOR_EACH(i, n) {
         double pi = p[i];
         if (pi > 0.0 && pi < cap_of(pl, i)) {
-            t[i] = s[i] + u[i] + spring_of(pl, i, pi) - delta + beta * t[i] - mean;
+            t[i] = gap_of(pl, s, u, i, pi, delta) + beta * t[i] - mean;
         } else {
             t[i] = 0.0;
         }
@@ -272,7 +278,7 @@ extern "C" __global__ void step(double* out, double* p, double* previous, const 
         previous[i] = old;
         double next;
         if (old <= 0.0) {
-            double g = s[i] + u[i] + spring_of(pl, i, old) - delta;
+            double g = gap_of(pl, s, u, i, old, delta);
             if (g < 0.0) {
                 v[7] += 1.0;
                 next = fmin(-tau * g, cap);
@@ -280,7 +286,7 @@ extern "C" __global__ void step(double* out, double* p, double* previous, const 
                 next = old;
             }
         } else if (old >= cap) {
-            double g = s[i] + u[i] + spring_of(pl, i, old) - delta;
+            double g = gap_of(pl, s, u, i, old, delta);
             if (g > 0.0) {
                 v[8] += 1.0;
                 next = fmax(cap - tau * g, 0.0);

@@ -40,7 +40,7 @@ impl DeviceChoice {
     pub fn parse(name: &str) -> Option<DeviceChoice> {
         match name.trim().to_ascii_lowercase().as_str() {
             "cpu" => Some(DeviceChoice::Cpu),
-            "cuda" | "gpu" => Some(DeviceChoice::Cuda),
+            "cuda" => Some(DeviceChoice::Cuda),
             "auto" => Some(DeviceChoice::Auto),
             _ => None,
         }
