@@ -26,6 +26,7 @@ mod info;
 mod mechanics;
 mod mechanics_csv;
 mod optics;
+mod outputs;
 mod series;
 mod simulate;
 mod synth;
@@ -220,6 +221,7 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     mechanics::register(m)?;
     mechanics_csv::register(m)?;
     optics::register(m)?;
+    outputs::register(m)?;
     series::register(m)?;
     simulate::register(m)?;
     synth::register(m)?;

@@ -183,3 +183,175 @@ def test_a_worker_killed_mid_sweep_loses_nothing():
     for a, b in zip(on_dask.rows, serial.rows):
         assert a["error"] is None and a["parameter"] == b["parameter"]
         np.testing.assert_array_equal(a["areas_m2"], b["areas_m2"])
+
+
+def test_thread_plan_shares_each_machine_s_cores():
+    one = {"host": "a", "job": None, "cpus": 2, "nthreads": 1}
+    two_singles = {"w1": one, "w2": dict(one)}
+    # A sweep: one thread per single-thread worker; a lone task (a Brent step): both cores.
+    assert dd.thread_plan(two_singles, 8) == {"w1": 1, "w2": 1}
+    assert dd.thread_plan(two_singles, 1) == {"w1": 2, "w2": 2}
+    # One 4-thread worker in a 4-core Slurm job: its pool of 4 shared by its 4 tasks.
+    job = {"w": {"host": "n1", "job": "17", "cpus": 4, "nthreads": 4}}
+    assert dd.thread_plan(job, 8) == {"w": 4}
+    # Two Slurm jobs of 1 core each on one node do not share: each is its own allocation.
+    jobs = {"a": {"host": "n1", "job": "1", "cpus": 1, "nthreads": 1},
+            "b": {"host": "n1", "job": "2", "cpus": 1, "nthreads": 1}}
+    assert dd.thread_plan(jobs, 1) == {"a": 1, "b": 1}
+    # More Dask threads than cores: the pools never outgrow the cores.
+    over = {"w": {"host": "a", "job": None, "cpus": 2, "nthreads": 4}}
+    assert dd.thread_plan(over, 8) == {"w": 2}
+    # 16 single-thread workers on 16 cores running a 7-point grid: 2 threads each (14 in use).
+    many = {f"w{i}": {"host": "a", "job": None, "cpus": 16, "nthreads": 1} for i in range(16)}
+    assert set(dd.thread_plan(many, 7).values()) == {2}
+    assert set(dd.thread_plan(many, 100).values()) == {1}
+
+
+def test_workers_get_their_share_of_the_cores(client):
+    """On the module's cluster (2 single-thread workers on this machine), a sweep leaves each
+    worker's pool at its share of the cores and a fit's lone Brent step at all of them."""
+    cpus = dd._cpus()
+    h = cs.surface(seed=1, **SPEC)
+    dd.sweep(LOADS, 2e-7, 1e9, values=[1e15, 2e15, 4e15, 8e15], heights=h, radius=RADIUS,
+             client=client)
+    assert set(client.run(cs.get_num_threads).values()) == {max(1, cpus // 2)}
+    dd.fit_hardening(LOADS, [1e-12, 2e-12, 4e-12], h, 2e-7, 1e9, radius=RADIUS, grid=3,
+                     ln_tolerance=1.0, client=client)
+    # The last tasks were the standard error's three ramps, at most 2 running at once.
+    assert set(client.run(cs.get_num_threads).values()) == {max(1, cpus // 2)}
+    fixed = dd.sweep(LOADS, 2e-7, 1e9, values=[1e15, 2e15], heights=h, radius=RADIUS,
+                     client=client, threads_per_task=3)
+    assert set(client.run(cs.get_num_threads).values()) == {3}
+    assert all(r["error"] is None for r in fixed.rows)
+    # A lone task (elastic: one ramp) gets every core of its machine.
+    dd.fit_hardening(LOADS, [1e-12, 2e-12, 4e-12], h, 2e-7, 1e9, radius=RADIUS,
+                     family="elastic", client=client)
+    assert cpus in client.run(cs.get_num_threads).values()
+
+
+def test_a_ramp_that_does_not_converge_fills_its_row_with_the_error(client):
+    h = cs.surface(seed=1, **SPEC)
+    # Within 20 iterations the soft material's ramp converges, the hard one's does not.
+    kwargs = dict(family="hardening", values=[1e15, 16e15], heights=h, radius=RADIUS,
+                  max_iterations=20)
+    with pytest.raises(cs.ConvergenceError):
+        cs.ramp(h, 2e-7, 1e9, "hardening", 16e15, LOADS, radius=RADIUS, max_iterations=20)
+    r = dd.sweep(LOADS, 2e-7, 1e9, client=client, **kwargs)
+    assert r.rows[1]["areas_m2"] is None and "20 iterations" in r.rows[1]["error"]
+    assert r.rows[0]["error"] is None
+    serial = dd.sweep(LOADS, 2e-7, 1e9, client="serial", **kwargs)
+    np.testing.assert_array_equal(r.rows[0]["areas_m2"], serial.rows[0]["areas_m2"])
+    assert r.rows[1]["error"] == serial.rows[1]["error"]
+
+
+def test_a_sweep_writes_its_folder_whole(client, tmp_path):
+    import csv
+    import json
+
+    h = cs.surface(seed=1, **SPEC)
+    out = tmp_path / "sweep"
+    r = dd.sweep(LOADS, 2e-7, 1e9, family="hardness", values=[1e5, 1e9], heights=h,
+                 radius=RADIUS, client=client, out=out)
+    assert sorted(p.name for p in out.iterdir()) == [".contactscope-run.json", "sweep.csv",
+                                                     "sweep.json"]
+    rows = list(csv.DictReader((out / "sweep.csv").open()))
+    assert [k for k in rows[0]] == ["surface", "seed", "model", "hardness_MPa", "force_mN",
+                                    "area_um2", "edge_contact", "error"]
+    assert len(rows) == 2 * len(LOADS)
+    assert float(rows[0]["hardness_MPa"]) == pytest.approx(0.1)
+    assert rows[0]["area_um2"] == "" and "exceeds" in rows[0]["error"]
+    assert [float(x["area_um2"]) for x in rows[3:]] == pytest.approx(
+        [a * 1e12 for a in r.rows[1]["areas_m2"]], rel=1e-15)
+    summary = json.loads((out / "sweep.json").read_text())
+    assert summary["loads_mN"] == pytest.approx([f * 1e3 for f in LOADS])
+    assert summary["failed"] == 1 and summary["ramps"] == 2
+    # A second run replaces the folder as a whole; a folder of someone else's is refused
+    # before any ramp runs, and nothing in it changes.
+    dd.sweep(LOADS, 2e-7, 1e9, values=[4e15], heights=h, radius=RADIUS, client="serial",
+             out=out)
+    assert len(list(csv.DictReader((out / "sweep.csv").open()))) == len(LOADS)
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep")
+
+    class NoTasks:  # a client that fails any use: the refusal must come first
+        def __getattr__(self, name):
+            raise AssertionError(f"client.{name} used before the folder was checked")
+
+    with pytest.raises(cs.FileError, match="not written by contactscope"):
+        dd.sweep(LOADS, 2e-7, 1e9, values=[4e15], heights=h, radius=RADIUS, client=NoTasks(),
+                 out=mine)
+    assert [p.name for p in mine.iterdir()] == ["notes.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine", "sweep"]
+
+
+def _descendants(pid):
+    """Process IDs below ``pid`` (Linux /proc)."""
+    import os
+
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as f:
+                    parent = int(f.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+            children.setdefault(parent, []).append(int(entry))
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.append(child)
+            todo.append(child)
+    return found
+
+
+def test_an_interrupted_sweep_leaves_no_folder_and_no_workers(tmp_path):
+    """Ctrl-C (SIGINT) to a script while its sweep's ramps run on the cluster the sweep
+    started: the script stops with KeyboardInterrupt, writes no output folder (nor a staging
+    folder beside it), and the cluster's worker processes are gone."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    if not sys.platform.startswith("linux"):
+        pytest.skip("reads /proc to find the worker processes")
+    script = tmp_path / "interrupted.py"
+    script.write_text(
+        "import sys\n"
+        "import numpy as np\n"
+        "import contactscope as cs\n"
+        "from contactscope import distributed as dd\n"
+        "if __name__ == '__main__':\n"
+        "    h = cs.surface(256, 256, 1e-7, rms_height=5e-8, hurst=0.8, seed=5)\n"
+        "    dd.sweep([2e-5, 4e-5, 8e-5], 1e-7, 1e9, values=list(np.geomspace(1e15, 1e16, 60)),\n"
+        "             heights=h, radius=20e-6, progress=True, out=sys.argv[1])\n")
+    out = tmp_path / "results"
+    p = subprocess.Popen([sys.executable, str(script), str(out)], stderr=subprocess.PIPE,
+                         text=True, cwd=tmp_path)
+    try:
+        lines = []
+        for line in p.stderr:  # the sweep prints the dashboard's address once it has a client
+            lines.append(line)
+            if "Dask dashboard at" in line:
+                break
+        assert any("Dask dashboard at http://127.0.0.1:" in x for x in lines), "".join(lines)
+        time.sleep(1.5)  # the ramps are running on the workers
+        workers = _descendants(p.pid)
+        assert workers, "the sweep's cluster has worker processes"
+        p.send_signal(signal.SIGINT)
+        rest = p.communicate(timeout=60)[1]
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert p.returncode != 0
+    assert "KeyboardInterrupt" in rest
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["interrupted.py"]
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline and any(os.path.exists(f"/proc/{w}") for w in workers):
+        time.sleep(0.2)
+    left = [w for w in workers if os.path.exists(f"/proc/{w}")
+            and open(f"/proc/{w}/stat").read().rsplit(")", 1)[1].split()[0] != "Z"]
+    assert not left, f"worker processes still running: {left}"

@@ -6,16 +6,17 @@ the ramp. Height maps are scattered to the workers once (``client.scatter(..., b
 and every task refers to them. Surfaces given by seed are generated once each, on a worker, as
 tasks of their own.
 
-Every task first sets contactscope's thread count on its worker (``threads_per_task``, default
-the worker's share: 1 for ``LocalCluster(n_workers=2, threads_per_worker=1)``), so that the
-workers' parallel loops do not oversubscribe the cores, and, once per worker process, glibc's
-malloc thresholds that Dask's worker environment lowers (:func:`_tune_malloc`: a 512² ramp
-took 1.60–1.77 s in a one-thread worker without them, 1.41–1.42 s with them).
+Threads: by default (``threads_per_task=None``) every worker's contactscope thread pool gets its
+share of the cores it may use, so that all tasks together never use more threads than there are
+cores (:func:`thread_plan`); with fewer tasks than Dask threads (one Brent step of a fit), each
+task gets more. Once per worker process, the first task also resets glibc's malloc thresholds
+that Dask's worker environment lowers (:func:`_tune_malloc`).
 
-``client=None`` starts a loopback-only ``LocalCluster(n_workers=2, threads_per_worker=1,
-host="127.0.0.1", dashboard_address="127.0.0.1:0")`` for the call and closes it afterwards;
-``client="serial"`` runs the same tasks in this process, one after the other (the reference the
-Dask results equal exactly).
+``client=None`` starts a loopback-only ``LocalCluster`` for the call (one single-thread worker
+per core, at most one per task; every listener on 127.0.0.1) and closes it afterwards, or runs
+the tasks in this process when there is only one task or one core; ``client="serial"`` runs the
+same tasks in this process, one after the other (the reference the Dask results equal exactly).
+``out=`` writes a sweep's table as the command line writes its folders: all files or none.
 
 SI units: heights and lengths in m, forces in N, E* in Pa, hardness in Pa, k in Pa/m.
 """
@@ -24,27 +25,120 @@ from __future__ import annotations
 
 import builtins
 import contextlib
+import csv
 import ctypes
+import io
 import itertools
+import json
 import math
 import os
+import socket
 import sys
-from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence
+from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
 from . import FitResults, Results, _cs, _f64
 
-__all__ = ["local_client", "sweep", "fit_hardening", "brent_minimum"]
+__all__ = ["local_client", "sweep", "fit_hardening", "brent_minimum", "thread_plan"]
 
 #: A misfit standing for an infeasible parameter in the Brent search (misfits are RMS log
 #: ratios, of order 1), as in the library's own fit.
 INFEASIBLE_MISFIT = 1e6
 
+#: What a task is told about threads: ``None`` (leave this process's setting), a pool size, or
+#: a pool size per worker address with a default for workers that joined later.
+Plan = Optional[Tuple[Mapping[str, int], int]]
 
-def _threads(n: int) -> None:
+
+def _cpus() -> int:
+    """The cores this process may run on (its CPU affinity, where the system has one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+def _worker_facts() -> Dict[str, Any]:
+    """Where a worker runs and how many cores it may use: its CPU affinity, within a Slurm job
+    also no more than the job's CPUs on this node (``SLURM_CPUS_ON_NODE``). Runs on each worker
+    (``client.run``)."""
+    cpus = _cpus()
+    allocated = os.environ.get("SLURM_CPUS_ON_NODE", "")
+    if allocated.isdigit() and int(allocated) > 0:
+        cpus = min(cpus, int(allocated))
+    return {"host": socket.gethostname(), "job": os.environ.get("SLURM_JOB_ID"), "cpus": cpus}
+
+
+def thread_plan(workers: Mapping[str, Mapping[str, Any]], tasks: int) -> Dict[str, int]:
+    """The size of each worker's contactscope thread pool for ``tasks`` concurrent-able tasks.
+
+    ``workers`` maps a worker's address to ``host``, ``job`` (a Slurm job ID or ``None``),
+    ``cpus`` (cores it may use) and ``nthreads`` (Dask threads, i.e. tasks it runs at once).
+    Workers on one host in one job (or outside any job) share that host's cores: with
+    ``running = min(their Dask threads, tasks)`` tasks at once, each task is worth
+    ``cpus / running`` threads, and a worker's pool, shared by the tasks it runs, gets
+    ``cpus × min(nthreads, tasks) // running`` (at least 1). So two single-thread workers on 2
+    cores get 1 thread each for a sweep and 2 each for a lone task (a Brent step); a 4-thread
+    worker in a 4-core Slurm job gets a pool of 4 shared by its 4 tasks. While as many tasks
+    run as the group has Dask threads, the threads in use never exceed its cores.
+    """
+    tasks = max(1, int(tasks))
+    groups: Dict[Tuple[str, Any], Dict[str, Any]] = {}
+    for address, w in workers.items():
+        g = groups.setdefault((w["host"], w.get("job")), {"cpus": int(w["cpus"]), "threads": 0})
+        g["cpus"] = min(g["cpus"], int(w["cpus"]))
+        g["threads"] += int(w["nthreads"])
+    plan = {}
+    for address, w in workers.items():
+        g = groups[(w["host"], w.get("job"))]
+        running = max(1, min(g["threads"], tasks))
+        plan[address] = max(1, g["cpus"] * min(int(w["nthreads"]), tasks) // running)
+    return plan
+
+
+class _Threads:
+    """Thread plans for one client: the workers' facts asked once, a plan per phase."""
+
+    def __init__(self, ex: Any, threads_per_task: Optional[int]) -> None:
+        self.fixed = threads_per_task
+        self.workers: Optional[Dict[str, Dict[str, Any]]] = None
+        if isinstance(ex, _Serial):
+            return
+        nthreads = ex.nthreads()
+        if threads_per_task is None:
+            facts = ex.run(_worker_facts)
+            self.workers = {a: {**f, "nthreads": nthreads.get(a, 1)} for a, f in facts.items()}
+        else:
+            self.workers = {a: {"nthreads": n} for a, n in nthreads.items()}
+
+    def plan(self, tasks: int) -> Plan:
+        if self.workers is None:  # in this process
+            return None if self.fixed is None else ({}, int(self.fixed))
+        if self.fixed is not None:
+            n = max(1, int(self.fixed))
+            return ({a: n * int(w["nthreads"]) for a, w in self.workers.items()}, n)
+        return (thread_plan(self.workers, tasks), 1)
+
+
+def _pool_size(plan: Plan) -> Optional[int]:
+    if plan is None:
+        return None
+    sizes, default = plan
+    if not sizes:
+        return default
+    try:
+        from distributed import get_worker
+
+        return sizes.get(get_worker().address, default)
+    except (ImportError, ValueError):  # not in a Dask worker
+        return default
+
+
+def _threads(plan: Plan) -> None:
     _tune_malloc()
-    if _cs.get_num_threads() != n:
+    n = _pool_size(plan)
+    if n is not None and _cs.get_num_threads() != n:
         _cs.set_num_threads(n)
 
 
@@ -86,20 +180,22 @@ def _tune_malloc() -> bool:
 def _ramp_task(heights: np.ndarray, pixel_size: Any, modulus: float, family: str,
                parameter: Optional[float], loads: List[float], radius: Optional[float],
                tolerance: float, max_iterations: int, imaging_fwhm: Optional[float],
-               imaging_pixel_size: Any, threads: int) -> Dict[str, Any]:
+               imaging_pixel_size: Any, threads: Plan) -> Dict[str, Any]:
     """One load ramp on a worker: areas (m²) and whether contact reached the map's border.
-    An infeasible parameter (e.g. a hardness too low for the load) gives ``error``."""
+    A parameter the ramp cannot be solved with gives ``error`` (its message) in place of
+    areas: an infeasible one (e.g. a hardness too low for the load) or one the solver does not
+    converge for within ``max_iterations`` (:class:`contactscope.ConvergenceError`)."""
     _threads(threads)
     try:
         r = _cs.ramp(heights, pixel_size, modulus, family, parameter, loads, radius, tolerance,
                      max_iterations, imaging_fwhm, imaging_pixel_size)
-    except ValueError as e:
+    except ValueError as e:  # InputError and ConvergenceError
         return {"areas_m2": None, "edge_contact": False, "error": str(e)}
     return {"areas_m2": np.asarray(r["areas_m2"]), "edge_contact": r["edge_contact"],
             "error": None}
 
 
-def _surface_task(spec: Dict[str, Any], seed: int, threads: int) -> np.ndarray:
+def _surface_task(spec: Dict[str, Any], seed: int, threads: Plan) -> np.ndarray:
     _threads(threads)
     return _cs.surface(spec["nx"], spec["ny"], spec["pixel_size"], spec.get("hurst"),
                        spec.get("rms_height"), spec.get("rms_slope"), spec.get("rolloff"),
@@ -107,14 +203,22 @@ def _surface_task(spec: Dict[str, Any], seed: int, threads: int) -> np.ndarray:
 
 
 @contextlib.contextmanager
-def local_client(n_workers: int = 2, threads_per_worker: int = 1) -> Iterator[Any]:
+def local_client(n_workers: Optional[int] = None,
+                 threads_per_worker: int = 1) -> Iterator[Any]:
     """A ``dask.distributed`` client on a new loopback-only ``LocalCluster`` (every listener,
-    the dashboard included, on 127.0.0.1), closed on exit."""
+    the dashboard included, on 127.0.0.1), closed on exit. ``n_workers`` defaults to one
+    single-thread worker per core this process may use."""
+    import dask
     from dask.distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=n_workers, threads_per_worker=threads_per_worker,
-                           host="127.0.0.1", dashboard_address="127.0.0.1:0",
-                           processes=True)
+    if n_workers is None:
+        n_workers = max(1, _cpus() // max(1, threads_per_worker))
+    # One queued task per Dask thread (the default, 1.1, holds two per single-thread worker):
+    # ramps of unequal length then end together on a sweep's last round.
+    with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
+        cluster = LocalCluster(n_workers=n_workers, threads_per_worker=threads_per_worker,
+                               host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                               processes=True)
     client = Client(cluster)
     try:
         yield client
@@ -157,12 +261,19 @@ class _Done:
 
 
 @contextlib.contextmanager
-def _executor(client: Any) -> Iterator[Any]:
-    if client is None:
-        with local_client() as c:
+def _executor(client: Any, tasks: int, threads_per_task: Optional[int]) -> Iterator[Any]:
+    """The executor of ``client`` (module docs); ``tasks``: how many can run at once."""
+    if (isinstance(client, str) and client == "serial") or (client is None
+                                                             and min(_cpus(), tasks) <= 1):
+        before = _cs.get_num_threads()
+        try:
+            yield _Serial()
+        finally:
+            if threads_per_task is not None:
+                _cs.set_num_threads(before)
+    elif client is None:
+        with local_client(n_workers=min(_cpus(), tasks)) as c:
             yield c
-    elif isinstance(client, str) and client == "serial":
-        yield _Serial()
     else:
         yield client
 
@@ -173,6 +284,29 @@ def _pure(client: Any) -> Dict[str, Any]:
     return {} if isinstance(client, _Serial) else {"pure": True}
 
 
+class _Progress:
+    """Progress of a computation on Dask, when asked for: the dashboard's address once, then
+    Dask's own progress bar per batch of tasks (text in a terminal, a widget in a notebook)."""
+
+    def __init__(self, ex: Any, on: bool) -> None:
+        self.ex = ex
+        self.on = on and not isinstance(ex, _Serial)
+        if self.on:
+            link = getattr(ex, "dashboard_link", None)
+            if link:
+                print(f"contactscope: Dask dashboard at {link}", file=sys.stderr, flush=True)
+
+    def __call__(self, futures: Sequence[Any]) -> None:
+        if self.on and futures:
+            from dask.distributed import progress
+
+            progress(list(futures))
+
+    def note(self, message: str) -> None:
+        if self.on:
+            print(f"contactscope: {message}", file=sys.stderr, flush=True)
+
+
 def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
           family: str = "hardening", values: Sequence[Optional[float]] = (None,),
           heights: Any = None, surfaces: Optional[Sequence[Any]] = None,
@@ -180,7 +314,8 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
           radius: Optional[float] = None, tolerance: float = 1e-8,
           max_iterations: int = 5000, imaging_fwhm: Optional[float] = None,
           imaging_pixel_size: Any = None, client: Any = None,
-          threads_per_task: int = 1) -> Results:
+          threads_per_task: Optional[int] = None, progress: bool = False,
+          out: Any = None) -> Results:
     """Load ramps over a parameter grid, one Dask task per ramp.
 
     The grid is every combination of a model parameter in ``values`` (k in Pa/m for
@@ -190,8 +325,17 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
     ``nx``, ``ny``, ``pixel_size`` in m, ``hurst``, ``rms_height`` in m, …). Every surface is
     pressed at ``loads`` (N) with a sphere of ``radius`` m on a flat of E* ``modulus`` Pa.
 
+    ``threads_per_task``: contactscope threads per running task (a worker's pool gets this
+    times its Dask threads); ``None`` shares each machine's cores among its workers
+    (:func:`thread_plan`). ``progress``: print the Dask dashboard's address and show Dask's
+    progress bar. ``out``: a folder to write ``sweep.csv`` (one row per ramp and load, units in
+    the column names) and ``sweep.json`` into, as the command line writes its folders — only
+    once every ramp is back, all files or none.
+
     Returns ``rows`` (per ramp: ``surface``, ``seed``, ``family``, ``parameter``, ``areas_m2``,
     ``edge_contact``, ``error``) in grid order; ``to_pandas()`` gives one row per ramp and load.
+    A ramp that cannot be solved (infeasible, or not converged) has ``areas_m2`` ``None`` and
+    its message in ``error``; the other rows are complete.
     """
     loads = [float(f) for f in loads]
     maps: List[Any] = []
@@ -206,26 +350,96 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
         raise _cs.InputError("seeds need surface_spec (nx, ny, pixel_size, rms_height, …)")
     if not maps and not seeds:
         raise _cs.InputError("give heights, surfaces or seeds with surface_spec")
-    with _executor(client) as ex:
+    values = list(values)
+    if out is not None:
+        _check_out(out)
+    n_ramps = (len(maps) + len(seeds)) * len(values)
+    with _executor(client, n_ramps, threads_per_task) as ex:
+        threads = _Threads(ex, threads_per_task)
+        show = _Progress(ex, progress)
         futures = [ex.scatter(m, broadcast=True, hash=False) for m in maps]
         for seed in seeds:
             labels.append({"surface": len(futures), "seed": int(seed)})
             futures.append(ex.submit(_surface_task, dict(surface_spec), int(seed),
-                                     threads_per_task, **_pure(ex)))
+                                     threads.plan(len(seeds)), **_pure(ex)))
         tasks = []
         grid = list(itertools.product(range(len(futures)), values))
+        plan = threads.plan(len(grid))
         for surface, value in grid:
             tasks.append(ex.submit(_ramp_task, futures[surface], pixel_size, float(modulus),
                                    family, None if value is None else float(value), loads,
                                    radius, tolerance, max_iterations, imaging_fwhm,
-                                   imaging_pixel_size, threads_per_task, **_pure(ex)))
+                                   imaging_pixel_size, plan, **_pure(ex)))
+        show(tasks)
         outcomes = ex.gather(tasks)
     rows = []
-    for (surface, value), out in zip(grid, outcomes):
+    for (surface, value), result in zip(grid, outcomes):
         rows.append({**labels[surface], "family": family,
                      "parameter": None if value is None else float(value),
-                     "loads_n": loads, **out})
-    return _SweepResults(rows=rows)
+                     "loads_n": loads, **result})
+    results = _SweepResults(rows=rows)
+    if out is not None:
+        _write_sweep(out, results, modulus=float(modulus), radius=radius)
+    return results
+
+
+def _parameter_column(family: str) -> Tuple[Optional[str], float]:
+    """The CSV column of a family's parameter and the factor from SI to its unit."""
+    if family == "hardening":
+        return "k_MPa_per_nm", 1e-15
+    if family == "hardness":
+        return "hardness_MPa", 1e-6
+    return None, 1.0
+
+
+def _check_out(out: Any) -> None:
+    """Refuse, before any ramp runs, an output folder the final write would refuse: one in the
+    way (a file) or holding files no contactscope run wrote (the command line's ``--out``
+    rules; the write itself checks again)."""
+    path = os.fspath(out)
+    if not os.path.lexists(path):
+        return
+    if not os.path.isdir(path):
+        raise _cs.FileError(f"cannot write {path}: is in the way (not a folder); nothing was "
+                            "written (choose another out= or remove it)")
+    if os.listdir(path) and not os.path.isfile(os.path.join(path, ".contactscope-run.json")):
+        raise _cs.FileError(f"cannot write {path}: is not empty and was not written by "
+                            "contactscope (no .contactscope-run.json); nothing was written "
+                            "(choose another out= or remove it)")
+
+
+def _write_sweep(out: Any, results: "_SweepResults", modulus: float,
+                 radius: Optional[float]) -> None:
+    """``sweep.csv`` and ``sweep.json`` in lab units (mN, µm², MPa/nm), written as one folder."""
+    rows = results["rows"]
+    name, factor = _parameter_column(rows[0]["family"] if rows else "elastic")
+    text = io.StringIO()
+    table = csv.writer(text, lineterminator="\n")
+    table.writerow(["surface", "seed", "model"] + ([name] if name else [])
+                   + ["force_mN", "area_um2", "edge_contact", "error"])
+    records = []
+    for r in rows:
+        parameter = [] if name is None else [repr(r["parameter"] * factor)]
+        areas = r["areas_m2"]
+        for i, f in enumerate(r["loads_n"]):
+            area = "" if areas is None else repr(float(areas[i]) * 1e12)
+            table.writerow([r["surface"], "" if r["seed"] is None else r["seed"], r["family"]]
+                           + parameter + [repr(f * 1e3), area,
+                                          str(bool(r["edge_contact"])).lower(), r["error"] or ""])
+        record = {"surface": r["surface"], "seed": r["seed"], "model": r["family"]}
+        if name is not None:
+            record[name] = r["parameter"] * factor
+        record.update({"areas_um2": None if areas is None else [float(a) * 1e12 for a in areas],
+                       "edge_contact": bool(r["edge_contact"]), "error": r["error"]})
+        records.append(record)
+    summary = {"loads_mN": [f * 1e3 for f in rows[0]["loads_n"]] if rows else [],
+               "contact_modulus_GPa": modulus * 1e-9,
+               "radius_um": None if radius is None else radius * 1e6,
+               "ramps": len(rows), "failed": sum(r["error"] is not None for r in rows),
+               "rows": records}
+    _cs.write_folder(os.fspath(out), [("sweep.csv", text.getvalue().encode()),
+                                      ("sweep.json", (json.dumps(summary, indent=1) + "\n")
+                                       .encode())])
 
 
 class _SweepResults(Results):
@@ -303,7 +517,8 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
                   grid: Optional[int] = None, ln_tolerance: Optional[float] = None,
                   tolerance: Optional[float] = None, max_iterations: Optional[int] = None,
                   imaging_fwhm: Optional[float] = None, imaging_pixel_size: Any = None,
-                  client: Any = None, threads_per_task: int = 1) -> FitResults:
+                  client: Any = None, threads_per_task: Optional[int] = None,
+                  progress: bool = False) -> FitResults:
     """:func:`contactscope.fit_hardening` with every model evaluation (one load ramp) a Dask task.
 
     The same search as the library's: a log-spaced grid of ``grid`` values over ``range``
@@ -313,8 +528,10 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
     Misfit: RMS of ln(A_sim/A_exp) (forces in N, areas in m²). "elastic" and "gt" are one ramp.
     The result equals the serial path (``client="serial"``) exactly; it agrees with the
     library's own fit to the search tolerance (their Brent implementations differ in detail).
-    Returns a :class:`contactscope.FitResults` with one model (no ``measured`` or
-    ``roughness``: the tasks see only the ramps).
+    ``threads_per_task`` and ``progress`` as for :func:`sweep` (the grid's ramps share the
+    cores, each Brent step, a lone task, gets all of its worker's share). Returns a
+    :class:`contactscope.FitResults` with one model (no ``measured`` or ``roughness``: the
+    tasks see only the ramps).
     """
     grid = 7 if grid is None else grid
     ln_tolerance = 0.01 if ln_tolerance is None else ln_tolerance
@@ -337,13 +554,15 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
         raise _cs.InputError(f"search range {lo:e}..{hi:e} is not usable")
     h = _f64(heights, 2, "heights")
 
-    with _executor(client) as ex:
+    with _executor(client, grid if has_parameter else 1, threads_per_task) as ex:
+        threads = _Threads(ex, threads_per_task)
+        show = _Progress(ex, progress)
         body = ex.scatter(h, broadcast=True, hash=False)
 
-        def submit(parameter: Optional[float]) -> Any:
+        def submit(parameter: Optional[float], plan: Plan) -> Any:
             return ex.submit(_ramp_task, body, pixel_size, float(modulus), family, parameter,
                              fs, radius, tolerance, max_iterations, imaging_fwhm,
-                             imaging_pixel_size, threads_per_task, **_pure(ex))
+                             imaging_pixel_size, plan, **_pure(ex))
 
         def score(out: Dict[str, Any]) -> float:
             if out["error"] is not None:
@@ -351,14 +570,18 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
             return _cs.misfit(fs, ms, list(out["areas_m2"]))
 
         if not has_parameter:
-            out = submit(None).result()
+            out = submit(None, threads.plan(1)).result()
             if out["error"] is not None:
                 raise _cs.InputError(out["error"])
             return _fit_results(family, None, None, score(out), out["areas_m2"], [], False)
 
         a, b = math.log(lo), math.log(hi)
         xs = [a + (b - a) * i / (grid - 1) for i in builtins.range(grid)]
-        grid_out = ex.gather([submit(math.exp(x)) for x in xs])
+        show.note(f"{family} fit: {grid} ramps over the search grid")
+        plan = threads.plan(grid)
+        pending = [submit(math.exp(x), plan) for x in xs]
+        show(pending)
+        grid_out = ex.gather(pending)
         values = [score(o) for o in grid_out]
         if all(math.isinf(v) for v in values):
             first = next((o["error"] for o in grid_out if o["error"]), "no feasible value")
@@ -367,9 +590,12 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
         best = min(builtins.range(len(values)), key=lambda i: values[i])
         at_edge = best in (0, len(values) - 1)
         x0, x1 = xs[max(best - 1, 0)], xs[min(best + 1, len(xs) - 1)]
+        alone = threads.plan(1)
+        unit, factor = _parameter_column(family)
 
         def cost(x: float) -> float:
-            m = score(submit(math.exp(x)).result())
+            m = score(submit(math.exp(x), alone).result())
+            show.note(f"Brent step: {unit} = {math.exp(x) * factor:.6g}, misfit {m:.6g}")
             if math.isfinite(m):
                 trace.append((math.exp(x), m))
                 return m
@@ -377,9 +603,12 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
 
         ln_best = brent_minimum(cost, x0, x1, ln_tolerance / 4.0)
         step = 0.05
-        final, minus, plus = ex.gather([submit(math.exp(ln_best)),
-                                        submit(math.exp(ln_best - step)),
-                                        submit(math.exp(ln_best + step))])
+        plan = threads.plan(3)
+        pending = [submit(math.exp(ln_best), plan), submit(math.exp(ln_best - step), plan),
+                   submit(math.exp(ln_best + step), plan)]
+        show.note("the best value and the two ramps of its standard error")
+        show(pending)
+        final, minus, plus = ex.gather(pending)
     if final["error"] is not None:
         raise _cs.InputError(final["error"])
     best_areas = list(final["areas_m2"])
