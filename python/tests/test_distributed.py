@@ -1,7 +1,14 @@
 """Dask: a loopback-only LocalCluster(n_workers=2, threads_per_worker=1); sweeps and fits on it
 equal the serial path exactly, and the fit agrees with the library's own."""
 
+import csv
+import json
 import math
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pytest
@@ -10,6 +17,8 @@ import contactscope as cs
 
 distributed = pytest.importorskip("dask.distributed")
 from contactscope import distributed as dd  # noqa: E402
+
+from dask_faults import when_busy  # noqa: E402
 
 SPEC = dict(nx=64, ny=64, pixel_size=2e-7, rms_height=1e-7, hurst=0.8)
 LOADS = [2e-5, 4e-5, 8e-5]
@@ -109,10 +118,6 @@ def test_tasks_undo_the_worker_environment_s_malloc_thresholds(tmp_path):
     """In a process started like a Dask worker (``MALLOC_TRIM_THRESHOLD_`` set), the solver's
     buffers fault in afresh at every load until a task sets glibc's thresholds back; counted in
     a subprocess, minor page faults of one 256² ramp before and after."""
-    import os
-    import subprocess
-    import sys
-
     if not sys.platform.startswith("linux"):
         pytest.skip("glibc's mallopt: Linux only")
     script = tmp_path / "faults.py"
@@ -149,11 +154,6 @@ def test_a_worker_killed_mid_sweep_loses_nothing():
     """SIGKILL one of two worker processes while its ramps run: Dask reruns the lost tasks (they
     are pure), its nanny starts a new worker, and the sweep returns every row, equal to the
     serial path's."""
-    import os
-    import signal
-    import threading
-    import time
-
     spec = dict(nx=128, ny=128, pixel_size=1e-7, rms_height=5e-8, hurst=0.8)
     h = cs.surface(seed=5, **spec)
     kwargs = dict(family="hardening", values=list(np.geomspace(1e15, 1e16, 12)), heights=h,
@@ -162,19 +162,7 @@ def test_a_worker_killed_mid_sweep_loses_nothing():
     with dd.local_client(n_workers=2, threads_per_worker=1) as c:
         pids = c.run(os.getpid)
         victim_address, victim = sorted(pids.items())[0]
-        killed = threading.Event()
-
-        def kill_when_busy():
-            deadline = time.monotonic() + 60
-            while time.monotonic() < deadline and not killed.is_set():
-                if c.processing().get(victim_address):
-                    os.kill(victim, signal.SIGKILL)
-                    killed.set()
-                    return
-                time.sleep(0.01)
-
-        killer = threading.Thread(target=kill_when_busy, daemon=True)
-        killer.start()
+        killer, killed = when_busy(c, victim_address, lambda: os.kill(victim, signal.SIGKILL))
         on_dask = dd.sweep(LOADS, 1e-7, 1e9, client=c, **kwargs)
         killer.join(timeout=5)
         assert killed.is_set(), "the worker was killed while it held tasks"
@@ -245,8 +233,6 @@ def test_a_ramp_that_does_not_converge_fills_its_row_with_the_error(client):
 
 
 def test_a_sweep_writes_its_folder_whole(client, tmp_path):
-    import csv
-    import json
 
     h = cs.surface(seed=1, **SPEC)
     out = tmp_path / "sweep"
@@ -287,8 +273,6 @@ def test_a_sweep_writes_its_folder_whole(client, tmp_path):
 
 def _descendants(pid):
     """Process IDs below ``pid`` (Linux /proc)."""
-    import os
-
     children = {}
     for entry in os.listdir("/proc"):
         if entry.isdigit():
@@ -310,12 +294,6 @@ def test_an_interrupted_sweep_leaves_no_folder_and_no_workers(tmp_path):
     """Ctrl-C (SIGINT) to a script while its sweep's ramps run on the cluster the sweep
     started: the script stops with KeyboardInterrupt, writes no output folder (nor a staging
     folder beside it), and the cluster's worker processes are gone."""
-    import os
-    import signal
-    import subprocess
-    import sys
-    import time
-
     if not sys.platform.startswith("linux"):
         pytest.skip("reads /proc to find the worker processes")
     script = tmp_path / "interrupted.py"

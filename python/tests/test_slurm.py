@@ -6,7 +6,6 @@ import os
 import pathlib
 import re
 import subprocess
-import threading
 import time
 
 import numpy as np
@@ -20,6 +19,8 @@ if not PARTITION:
                 allow_module_level=True)
 pytest.importorskip("dask_jobqueue", reason="Dask on Slurm needs dask-jobqueue")
 from contactscope import distributed as dd  # noqa: E402
+
+from dask_faults import when_busy  # noqa: E402
 
 README = pathlib.Path(__file__).resolve().parents[1] / "README.md"
 SPEC = dict(nx=128, ny=128, pixel_size=1e-7, rms_height=5e-8, hurst=0.8)
@@ -127,19 +128,8 @@ def test_a_job_cancelled_mid_sweep_loses_nothing(slurm):
     serial = dd.sweep(LOADS, 1e-7, 1e9, client="serial", **kwargs)
     ids = client.run(lambda: os.environ["SLURM_JOB_ID"])
     victim_address, victim = sorted(ids.items())[0]
-    cancelled = threading.Event()
-
-    def cancel_when_busy():
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            if client.processing().get(victim_address):
-                subprocess.run(["scancel", "--signal=KILL", "--full", victim], check=True)
-                cancelled.set()
-                return
-            time.sleep(0.01)
-
-    canceller = threading.Thread(target=cancel_when_busy, daemon=True)
-    canceller.start()
+    canceller, cancelled = when_busy(client, victim_address, lambda: subprocess.run(
+        ["scancel", "--signal=KILL", "--full", victim], check=True))
     on_slurm = dd.sweep(LOADS, 1e-7, 1e9, client=client, **kwargs)
     canceller.join(timeout=5)
     assert cancelled.is_set(), "the job was cancelled while its worker held ramps"
