@@ -217,6 +217,24 @@ def test_workers_get_their_share_of_the_cores(client):
     assert cpus in client.run(cs.get_num_threads).values()
 
 
+def test_a_worker_with_several_dask_threads_gets_a_pool_for_all_of_them():
+    """One worker running 2 tasks at once: the sweep's plan gives its pool the machine's cores
+    (2 tasks sharing them), and a worker missing from a plan (one that joined later) gets one
+    thread per Dask thread, never one thread for all of its tasks."""
+    cpus = dd._cpus()
+    with dd.local_client(n_workers=1, threads_per_worker=2) as c:
+        assert c.submit(dd._pool_size, ({}, 1), pure=False).result() == 2
+        assert c.submit(dd._pool_size, ({"tcp://elsewhere:1": 5}, 3), pure=False).result() == 6
+        h = cs.surface(seed=1, **SPEC)
+        r = dd.sweep(LOADS, 2e-7, 1e9, values=[1e15, 4e15, 16e15], heights=h, radius=RADIUS,
+                     client=c)
+        assert list(c.run(cs.get_num_threads).values()) == [max(1, cpus)]
+    serial = dd.sweep(LOADS, 2e-7, 1e9, values=[1e15, 4e15, 16e15], heights=h, radius=RADIUS,
+                      client="serial")
+    for a, b in zip(r.rows, serial.rows):
+        np.testing.assert_array_equal(a["areas_m2"], b["areas_m2"])
+
+
 def test_a_ramp_that_does_not_converge_fills_its_row_with_the_error(client):
     h = cs.surface(seed=1, **SPEC)
     # Within 20 iterations the soft material's ramp converges, the hard one's does not.

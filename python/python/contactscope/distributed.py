@@ -46,8 +46,9 @@ __all__ = ["local_client", "sweep", "fit_hardening", "brent_minimum", "thread_pl
 #: ratios, of order 1), as in the library's own fit.
 INFEASIBLE_MISFIT = 1e6
 
-#: What a task is told about threads: ``None`` (leave this process's setting), a pool size, or
-#: a pool size per worker address with a default for workers that joined later.
+#: What a task is told about threads: ``None`` (leave this process's setting), or a pool size
+#: per worker address with a default: threads per Dask thread for workers that joined later,
+#: the pool size itself outside a worker.
 Plan = Optional[Tuple[Mapping[str, int], int]]
 
 
@@ -122,17 +123,22 @@ class _Threads:
 
 
 def _pool_size(plan: Plan) -> Optional[int]:
+    """The pool size a task sets: its worker's entry in the plan; for a worker that joined after
+    the plan was made, the plan's default per Dask thread of that worker (so that a worker
+    running several tasks at once never squeezes them onto one thread); outside a worker, the
+    default itself."""
     if plan is None:
         return None
     sizes, default = plan
-    if not sizes:
-        return default
     try:
         from distributed import get_worker
 
-        return sizes.get(get_worker().address, default)
+        worker = get_worker()
     except (ImportError, ValueError):  # not in a Dask worker
         return default
+    if worker.address in sizes:
+        return sizes[worker.address]
+    return default * max(1, int(worker.state.nthreads))
 
 
 def _threads(plan: Plan) -> None:
