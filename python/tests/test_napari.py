@@ -209,19 +209,20 @@ def _docs_image(image, name):
     """Write a screenshot for docs/napari.md when CONTACTSCOPE_DOCS_IMAGES names a folder."""
     folder = os.environ.get("CONTACTSCOPE_DOCS_IMAGES")
     if folder:
-        from imageio.v3 import imwrite
+        from PIL import Image
 
-        imwrite(pathlib.Path(folder) / name, image[..., :3])
+        # 256 colours keep a screenshot of the viewer small (< 300 kB) and legible.
+        Image.fromarray(image[..., :3]).quantize(256).save(pathlib.Path(folder) / name,
+                                                           optimize=True)
 
 
-def _wait(worker):
-    """Let the viewer's event loop run until the worker has finished."""
+def _wait(widget):
+    """Let the viewer's event loop run until the widget's worker has finished (the widget
+    enables its button again when the worker's `finished` signal arrives)."""
     from qtpy.QtWidgets import QApplication
 
-    done = []
-    worker.finished.connect(lambda: done.append(True))
-    for _ in range(200000):
-        if done:
+    for _ in range(1_000_000):
+        if widget.run_button.isEnabled():
             return
         QApplication.processEvents()
     pytest.fail("the worker did not finish")
@@ -231,7 +232,9 @@ def _wait(worker):
 @needs_display
 def test_open_czi_in_viewer_with_scale(viewer):
     czi = real("real-formats/czi/CellDivision_T3_Z5_CH2_X240_Y170.czi")
-    layers = viewer.open(str(czi), plugin="contactscope")
+    # No plugin named, as `napari file.czi` opens it (plugin=None: napari picks the one
+    # compatible reader; viewer.open's own default would be napari's built-in reader).
+    layers = viewer.open(str(czi), plugin=None)
     assert len(layers) == 2
     px = cs.info(czi)["series"][0]["pixel_size_m"]
     assert layers[0].scale[-1] == pytest.approx(px["x"] * 1e6)
@@ -254,8 +257,8 @@ def test_series_widget_exports_the_cli_folder(viewer, series_tif, tmp_path, cli)
     viewer.window.add_dock_widget(w)
     w.paths.setText(str(path))
     w.forces.setText("2,4,8mN")
-    worker = w.start()  # the viewer's way: a worker thread
-    _wait(worker)
+    assert w.start() is not None  # the viewer's way: a worker thread
+    _wait(w)
     assert w.outcome is not None, w.status.text()
     result = w.outcome["result"]
     # Layers: the masks and their edges over the micrographs, as the Rust analysis gave them.
@@ -285,7 +288,7 @@ def test_series_widget_exports_the_cli_folder(viewer, series_tif, tmp_path, cli)
 
 @needs_napari
 @needs_display
-def test_series_widget_manifest_and_czi_match_cli(viewer, series_tif, tmp_path, cli):
+def test_series_widget_manifest_matches_cli(viewer, series_tif, tmp_path, cli):
     from contactscope.napari.series_widget import LoadSeriesWidget
 
     path, _ = series_tif
@@ -299,19 +302,39 @@ def test_series_widget_manifest_and_czi_match_cli(viewer, series_tif, tmp_path, 
     cli("analyze", "--manifest", str(manifest), "--out", str(tmp_path / "cli"))
     assert (tmp_path / "widget" / "areas.csv").read_bytes() == \
         (tmp_path / "cli" / "areas.csv").read_bytes()
+
+
+@needs_napari
+@needs_display
+def test_three_clicks_from_a_czi(viewer, tmp_path, cli):
+    # Open the file, pick its layer in the dock widget (channel, load axis t and the Z plane on
+    # screen come from the layer and the viewer), type the forces, Analyze.
+    from contactscope.napari.series_widget import LoadSeriesWidget
+
     czi = real("real-formats/czi/CellDivision_T3_Z5_CH2_X240_Y170.czi")
-    w.paths.setText(str(czi))
+    viewer.open(str(czi), plugin="contactscope")
+    viewer.dims.set_point(1, 2 * 0.32)  # the Z slider on plane 2 (z step 0.32 µm)
+    w = LoadSeriesWidget(viewer)
+    viewer.window.add_dock_widget(w, name="Load series (contact area)")
+    w.source.setCurrentText("CellDivision_T3_Z5_CH2_X240_Y170 C1")
+    assert w.load_axis.currentText() == "t"
+    assert (w.selection["channel"].value(), w.selection["z"].value()) == (1, 2)
     w.forces.setText("4,40,400mN")
-    w.load_axis.setCurrentText("t")
-    w.selection["channel"].setValue(1)
-    w.selection["z"].setValue(2)
     w.run_now()
-    assert viewer.layers["contact mask"].data.shape == (3, 170, 240)
+    # The masks in the file's axes (T, Z, y, x), on the Z plane analysed.
+    mask = viewer.layers["contact mask"]
+    assert mask.data.shape == (3, 1, 170, 240)
+    assert mask.translate[1] == pytest.approx(2 * 0.32)
+    assert "contact micrographs" not in viewer.layers
+    assert w.table.rowCount() == 3
     w.export_now(str(tmp_path / "w2"))
     cli("analyze", str(czi), "--forces", "4,40,400mN", "--channel", "1", "--z", "2",
         "--load-axis", "t", "--out", str(tmp_path / "c2"))
     assert (tmp_path / "w2" / "areas.csv").read_bytes() == \
         (tmp_path / "c2" / "areas.csv").read_bytes()
+    viewer.dims.set_point(0, 2)
+    viewer.reset_view()
+    _docs_image(viewer.screenshot(canvas_only=False), "napari-czi-series.png")
 
 
 @needs_napari
@@ -356,8 +379,8 @@ def test_compare_widget_layers_and_dice(viewer, series_tif, tmp_path, cli):
     w.simulation.setText(str(sim))
     w.paths.setText(str(path))
     w.forces.setText("2,4,8mN")
-    worker = w.start()
-    _wait(worker)
+    assert w.start() is not None
+    _wait(w)
     assert w.outcome is not None, w.status.text()
     result = w.outcome["result"]
     # The scores are the command line's; the layers are what they were computed on.
@@ -378,6 +401,33 @@ def test_compare_widget_layers_and_dice(viewer, series_tif, tmp_path, cli):
 
 @needs_napari
 @needs_display
+def test_compare_widget_on_the_demo_experiment(viewer, tmp_path, cli, monkeypatch):
+    # The demo's experiment (micrographs imaged from a hardening simulation) against the same
+    # model simulated again: the imaged maps match the micrographs (the demo reports Dice 0.97).
+    from contactscope.napari.compare_widget import CompareWidget
+
+    monkeypatch.chdir(tmp_path)  # relative paths, as a person types them
+    cli("demo", "--small", "--out", "demo", "-q")
+    cli("simulate", "--topography", "demo/data/topography.npy", "--pixel-size", "80nm",
+        "--radius", "50um", "--modulus", "3.7GPa", "--model", "hardening", "--hardening",
+        "4MPa/nm", "--forces", "0.05,0.1,0.2,0.35mN", "--out", "simulation", "-q")
+    w = CompareWidget(viewer)
+    viewer.window.add_dock_widget(w, name="Compare with simulation")
+    w.simulation.setText("simulation")
+    w.paths.setText("demo/data/micrographs/manifest.csv")
+    result = w.run_now()["result"]
+    assert result["loads_matched"] == 4 and result["dice_mean"] > 0.9
+    cli("compare", "--micrographs", "demo/data/micrographs/manifest.csv", "--simulation",
+        "simulation", "--psf-fwhm", "450nm", "--out", "cmp")
+    theirs = json.loads((tmp_path / "cmp" / "compare.json").read_text())
+    assert result["dice_mean"] == pytest.approx(theirs["dice_mean"], abs=1e-12)
+    viewer.dims.set_point(0, 3)
+    viewer.reset_view()
+    _docs_image(viewer.screenshot(canvas_only=False), "napari-compare.png")
+
+
+@needs_napari
+@needs_display
 def test_widget_errors_are_one_line(viewer, tmp_path, monkeypatch):
     from contactscope.napari import series_widget
     from contactscope.napari.series_widget import LoadSeriesWidget
@@ -390,7 +440,7 @@ def test_widget_errors_are_one_line(viewer, tmp_path, monkeypatch):
     assert w.start() is None  # the forces are refused before any work
     assert "oops" in shown[-1] and "\n" not in shown[-1]
     w.forces.setText("4mN")
-    worker = w.start()
-    _wait(worker)
+    assert w.start() is not None
+    _wait(w)
     assert "missing.tif" in shown[-1] and "\n" not in shown[-1]
     assert w.status.text().startswith("error: ")

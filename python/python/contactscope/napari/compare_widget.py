@@ -23,8 +23,8 @@ from qtpy.QtWidgets import (QCheckBox, QComboBox, QDoubleSpinBox, QFileDialog, Q
 import contactscope as cs
 
 from ._common import ERRORS, META, notify_error, one_line, stem
-from .series_widget import (LOAD_AXES, SeriesRequest, _green, selected, selection_boxes,
-                            selection_row)
+from .series_widget import (LOAD_AXES, SeriesRequest, _coloured, _green, selected,
+                            selection_boxes, selection_row)
 
 LAYERS = ("compared micrographs", "experiment contact edges", "simulation imaged",
           "simulated contact edges")
@@ -238,13 +238,3 @@ class CompareWidget(QWidget):
             f"PSF FWHM {result['psf_fwhm_m'] * 1e9:.0f} nm; simulation "
             f"{os.path.basename(os.path.normpath(result['simulation']))}")
 
-
-def _coloured(layer: Any, colour: str) -> None:
-    """Label 1 in ``colour``, the rest transparent."""
-    try:
-        from napari.utils.colormaps import DirectLabelColormap
-
-        layer.colormap = DirectLabelColormap(color_dict={None: "transparent", 0: "transparent",
-                                                         1: colour})
-    except (ImportError, TypeError, ValueError):  # pragma: no cover - older napari
-        pass

@@ -193,6 +193,7 @@ class LoadSeriesWidget(QWidget):
         self._progress = _Progress()
         self._progress.changed.connect(self._on_progress)
         self.refresh_sources()
+        self.source.currentTextChanged.connect(self.take_layer)
         self.viewer.layers.events.inserted.connect(self.refresh_sources)
         self.viewer.layers.events.removed.connect(self.refresh_sources)
 
@@ -210,6 +211,25 @@ class LoadSeriesWidget(QWidget):
         index = self.source.findText(current)
         self.source.setCurrentIndex(max(index, 0))
         self.source.blockSignals(False)
+
+    def take_layer(self, name: str) -> None:
+        """Fill the selection from a layer a reader made: its channel and series, the load
+        axis "t" where the file has a T axis, and the plane now shown on the other axes (the
+        Z slider's position for a z stack)."""
+        if not name or name == FILES or name not in self.viewer.layers:
+            return
+        layer = self.viewer.layers[name]
+        meta = layer.metadata.get(META, {})
+        axes = list(meta.get("axes") or [])
+        for key in ("channel", "series"):
+            if meta.get(key) is not None and key in self.selection:
+                self.selection[key].setValue(int(meta[key]))
+        if "T" in axes:
+            self.load_axis.setCurrentText("t")
+        if "Z" in axes and "T" in axes:
+            # The viewer's point in the layer's pixel indices.
+            here = layer.world_to_data(self.viewer.dims.point[-layer.ndim:])
+            self.selection["z"].setValue(int(round(here[axes.index("Z")])))
 
     def _browse_files(self) -> None:
         names, _ = QFileDialog.getOpenFileNames(
@@ -320,11 +340,16 @@ class LoadSeriesWidget(QWidget):
             if name in self.viewer.layers:
                 self.viewer.layers.remove(name)
         source = self.source.currentText()
-        if source == FILES or source not in self.viewer.layers or \
-                np.shape(self.viewer.layers[source].data) != images.shape:
+        layer = self.viewer.layers[source] if source in self.viewer.layers else None
+        embedded = None if layer is None else _embed(layer, request, masks)
+        if embedded is not None:
+            # Drawn in the file's layer's own axes: the masks sit on the plane analysed.
+            masks, common = embedded
+        elif layer is None or np.shape(layer.data) != images.shape:
             self.viewer.add_image(images, name="contact micrographs", **common,
                                   metadata={META: {"inputs": request.inputs}})
-        mask_layer = self.viewer.add_labels(masks, name="contact mask", opacity=0.3, **common)
+        mask_layer = self.viewer.add_labels(masks, name="contact mask", opacity=0.25, **common)
+        _coloured(mask_layer, "cyan")
         edges = self.viewer.add_labels(masks, name="contact edges", opacity=1.0, **common)
         edges.contour = 1
         _green(edges)
@@ -410,6 +435,32 @@ class LoadSeriesWidget(QWidget):
         return export(self.request, out, progress=self._report)
 
 
+def _embed(layer: Any, request: SeriesRequest, masks: np.ndarray) -> Optional[Any]:
+    """Masks (loads, rows, columns) of a series read along a file's T or Z axis, placed in the
+    axes of the file's layer (T, Z, …, y, x): the load axis full, every other axis one plane
+    at the index analysed. ``None`` where the layer is not such a file's layer."""
+    axes = list(layer.metadata.get(META, {}).get("axes") or [])
+    load = {"t": "T", "z": "Z"}.get(request.load_axis or "")
+    if load not in axes or len(axes) != layer.ndim or layer.ndim < 3 or \
+            tuple(layer.data.shape[-2:]) != masks.shape[-2:] or \
+            layer.data.shape[axes.index(load)] != masks.shape[0]:
+        return None
+    index = {"T": request.t, "Z": request.z}
+    translate = list(np.asarray(layer.translate, dtype=float))
+    others = [a for a in axes[:-2] if a != load]
+    data = masks
+    for a in others:
+        data = data[np.newaxis]
+        i = axes.index(a)
+        translate[i] += (index.get(a) or 0) * float(layer.scale[i])
+    # data's axes: (others reversed…, load, y, x); transposed to the layer's order.
+    current = list(reversed(others)) + [load]
+    data = np.transpose(data, [current.index(a) for a in axes[:-2]] +
+                        [data.ndim - 2, data.ndim - 1])
+    return data, {"scale": list(layer.scale), "translate": translate,
+                  "axis_labels": list(layer.axis_labels), "units": list(layer.units)}
+
+
 def selection_boxes() -> Dict[str, QSpinBox]:
     """Spin boxes for the plane of a vendor file (the command line's --series, --channel, --z,
     --t); "—" (the lowest value) leaves one unset (index 0 where the file has the axis)."""
@@ -419,15 +470,16 @@ def selection_boxes() -> Dict[str, QSpinBox]:
         box.setRange(-1, 9999)
         box.setValue(-1)
         box.setSpecialValueText("—")
-        box.setPrefix(f"{name} ")
+        box.setToolTip(f"--{name} of the command line (— : not given)")
         boxes[name] = box
     return boxes
 
 
 def selection_row(boxes: Dict[str, QSpinBox]) -> QHBoxLayout:
     row = QHBoxLayout()
-    for box in boxes.values():
-        row.addWidget(box)
+    for name, box in boxes.items():
+        row.addWidget(QLabel({"channel": "ch"}.get(name, name)))
+        row.addWidget(box, 1)
     return row
 
 
@@ -436,12 +488,17 @@ def selected(boxes: Dict[str, QSpinBox]) -> Dict[str, Optional[int]]:
     return {name: (None if box.value() < 0 else box.value()) for name, box in boxes.items()}
 
 
-def _green(layer: Any) -> None:
-    """Label 1 drawn in green (the command line's overlay colour), the rest transparent."""
+def _coloured(layer: Any, colour: str) -> None:
+    """Label 1 in ``colour``, the rest transparent."""
     try:
         from napari.utils.colormaps import DirectLabelColormap
 
         layer.colormap = DirectLabelColormap(color_dict={None: "transparent", 0: "transparent",
-                                                         1: "lime"})
+                                                         1: colour})
     except (ImportError, TypeError, ValueError):  # pragma: no cover - older napari
         pass
+
+
+def _green(layer: Any) -> None:
+    """Label 1 drawn in green (the command line's overlay colour), the rest transparent."""
+    _coloured(layer, "lime")
