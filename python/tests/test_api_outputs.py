@@ -37,8 +37,8 @@ def test_analyze_out_is_the_cli_folder(series_tif, tmp_path, cli):
         "--save-masks")
     for name in names:
         if name != "summary.json":
-            assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), \
-                name
+            mine_bytes = (tmp_path / "py" / name).read_bytes()
+            assert mine_bytes == (tmp_path / "cli" / name).read_bytes(), name
     mine = json.loads((tmp_path / "py" / "summary.json").read_text())
     theirs = json.loads((tmp_path / "cli" / "summary.json").read_text())
     assert mine.pop("command_line") == words

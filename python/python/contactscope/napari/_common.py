@@ -6,7 +6,7 @@ Nothing here imports Qt at import time except through napari, which the plugin n
 from __future__ import annotations
 
 import os
-from typing import Any, Callable, Dict, Optional, Sequence
+from typing import Any, Callable, Dict, Optional
 
 import contactscope as cs
 
@@ -60,7 +60,3 @@ def layer_meta(**fields: Any) -> Dict[str, Any]:
     """The plugin's entry of a layer's metadata."""
     return {META: dict(fields)}
 
-
-def forces_text_of(forces_n: Sequence[Optional[float]]) -> str:
-    """Forces (N) written as the command line's ``--forces`` list in mN (``4,10,20mN``)."""
-    return ",".join(f"{f * 1e3:g}" for f in forces_n if f is not None) + "mN"

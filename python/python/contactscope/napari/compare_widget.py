@@ -225,8 +225,11 @@ class CompareWidget(QWidget):
             layer.contour = 1
             _green(layer) if colour is None else _coloured(layer, colour)
         if self.grid.isChecked():
-            self.viewer.grid.stride = 2
-            self.viewer.grid.enabled = True
+            # napari ≥ 0.9 keeps the grid on the canvas (viewer.grid before).
+            canvas = getattr(self.viewer, "canvas", None)
+            grid = getattr(canvas, "grid", None) or self.viewer.grid
+            grid.stride = 2
+            grid.enabled = True
         rows = table_rows(result)
         self.table.setRowCount(len(rows))
         for i, row in enumerate(rows):
