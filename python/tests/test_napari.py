@@ -319,6 +319,7 @@ def test_three_clicks_from_a_czi(viewer, tmp_path, cli):
     w.source.setCurrentText("CellDivision_T3_Z5_CH2_X240_Y170 C1")
     assert w.load_axis.currentText() == "t"
     assert (w.selection["channel"].value(), w.selection["z"].value()) == (1, 2)
+    assert w.selection["series"].value() == -1  # one series: no --series, as on the CLI
     w.forces.setText("4,40,400mN")
     w.run_now()
     # The masks in the file's axes (T, Z, y, x), on the Z plane analysed.
@@ -327,7 +328,11 @@ def test_three_clicks_from_a_czi(viewer, tmp_path, cli):
     assert mask.translate[1] == pytest.approx(2 * 0.32)
     assert "contact micrographs" not in viewer.layers
     assert w.table.rowCount() == 3
-    w.export_now(str(tmp_path / "w2"))
+    words = json.loads(w.export_now(str(tmp_path / "w2")) and
+                       (tmp_path / "w2" / "summary.json").read_text())["command_line"]
+    assert words == ["contactscope", "analyze", str(czi), "--forces", "4,40,400mN",
+                     "--channel", "1", "--z", "2", "--load-axis", "t", "--out",
+                     str(tmp_path / "w2")]
     cli("analyze", str(czi), "--forces", "4,40,400mN", "--channel", "1", "--z", "2",
         "--load-axis", "t", "--out", str(tmp_path / "c2"))
     assert (tmp_path / "w2" / "areas.csv").read_bytes() == \

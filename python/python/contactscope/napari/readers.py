@@ -155,6 +155,7 @@ def micrograph_layers(path: str) -> List[LayerData]:
             base += f" [{s['index']}{': ' + s['name'] if s.get('name') else ''}]"
         names = [f"{base} C{c}" if channels > 1 else base for c in range(channels)]
         meta = layer_meta(path=os.fspath(path), format=fmt, series=s["index"], axes=labels,
+                          series_count=len(described["series"]), channels=channels,
                           pixel_size_m=None if x_um is None else (px["x"], px["y"]),
                           pixel_size_source=s.get("pixel_size_source"),
                           z_step_m=px.get("z"), dtype=s.get("dtype"))

@@ -221,8 +221,9 @@ class LoadSeriesWidget(QWidget):
         layer = self.viewer.layers[name]
         meta = layer.metadata.get(META, {})
         axes = list(meta.get("axes") or [])
-        for key in ("channel", "series"):
-            if meta.get(key) is not None and key in self.selection:
+        # The file's channel and series, where it has more than one (as the CLI asks for).
+        for key, count in (("channel", "channels"), ("series", "series_count")):
+            if meta.get(key) is not None and (meta.get(count) or 1) > 1:
                 self.selection[key].setValue(int(meta[key]))
         if "T" in axes:
             self.load_axis.setCurrentText("t")
@@ -262,9 +263,9 @@ class LoadSeriesWidget(QWidget):
                 text = ",".join(f"{f * 1e3:g}" for f in forces) + "mN"
             inputs = meta.get("inputs") or ([meta["path"]] if meta.get("path") else None)
             if inputs:
-                if channel is None and meta.get("channel"):
+                if channel is None and (meta.get("channels") or 1) > 1:
                     channel = int(meta["channel"])
-                if chosen["series"] is None and meta.get("series"):
+                if chosen["series"] is None and (meta.get("series_count") or 1) > 1:
                     chosen["series"] = int(meta["series"])
                 return SeriesRequest(inputs=list(inputs), forces_text=text, forces_n=forces,
                                      channel=channel, load_axis=load_axis, label=name,
@@ -398,7 +399,7 @@ class LoadSeriesWidget(QWidget):
                     * (grid * 1e-3) ** fit["exponent"]
                 ax.loglog(grid, area_um2, "-", color="tab:orange",
                           label=f"A ∝ N^β, β = {fit['exponent']:.3f}")
-            ax.legend(loc="upper left", fontsize=8)
+            ax.legend(loc="best", fontsize=8)
         else:
             ax.text(0.5, 0.5, "no forces or no contact: nothing on log axes",
                     ha="center", va="center", transform=ax.transAxes)
