@@ -4,7 +4,8 @@
 
 use std::path::PathBuf;
 
-use numpy::PyReadonlyArray3;
+use ndarray::Array3;
+use numpy::{IntoPyArray, PyReadonlyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -78,8 +79,14 @@ fn simulation(
 }
 
 /// Simulated contact maps against micrographs, load by load (the command line's `compare`).
+/// With `images`, also the registered pairs the scores are computed on (the panels of
+/// `panel_NNN.png`), each a (loads, rows, columns) stack on the micrograph's grid:
+/// `micrographs` (grey levels), `simulated_images` (the blurred, resampled and registered
+/// contact map on the micrograph's grey scale, NaN outside the simulated region),
+/// `experiment_contact` and `simulated_contact` (bool: contact as the Dice counts it, inside
+/// the compared region).
 #[pyfunction]
-#[pyo3(signature = (micrographs, forces, pixel_size, maps, map_forces, map_pixel_size, psf_fwhm, dihedral=None, upsample=None, force_tolerance=None))]
+#[pyo3(signature = (micrographs, forces, pixel_size, maps, map_forces, map_pixel_size, psf_fwhm, dihedral=None, upsample=None, force_tolerance=None, images=false))]
 #[allow(clippy::too_many_arguments)]
 fn compare<'py>(
     py: Python<'py>,
@@ -93,6 +100,7 @@ fn compare<'py>(
     dihedral: Option<bool>,
     upsample: Option<usize>,
     force_tolerance: Option<f64>,
+    images: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut request = CompareRequest::new(
         crate::series::micrographs(micrographs, forces)?,
@@ -104,7 +112,37 @@ fn compare<'py>(
     request.upsample = upsample.unwrap_or(request.upsample);
     request.force_tolerance = force_tolerance.unwrap_or(request.force_tolerance);
     let outcome = compute(py, move || contactscope_jobs::compare::run(&request))?;
-    outcome_dict(py, &outcome)
+    let d = outcome_dict(py, &outcome)?;
+    if images && !outcome.prepared.is_empty() {
+        let (w, h) = outcome.prepared[0].size();
+        let n = outcome.prepared.len();
+        let pairs = || outcome.prepared.iter().zip(&outcome.loads);
+        let f64_stack = |values: Vec<f64>| {
+            Array3::from_shape_vec((n, h, w), values).map_err(|e| bad(format!("images: {e}")))
+        };
+        let bool_stack = |values: Vec<bool>| {
+            Array3::from_shape_vec((n, h, w), values).map_err(|e| bad(format!("images: {e}")))
+        };
+        let micrographs: Vec<f64> = pairs().flat_map(|(p, _)| p.micrograph().to_vec()).collect();
+        let simulated: Vec<f64> = pairs().flat_map(|(p, l)| p.simulated_on_scale(l)).collect();
+        let experiment: Vec<bool> = pairs()
+            .flat_map(|(p, _)| p.experiment_contact(outcome.experiment_threshold))
+            .collect();
+        let simulated_contact: Vec<bool> = pairs()
+            .flat_map(|(p, _)| p.simulated_contact(outcome.simulated_threshold))
+            .collect();
+        d.set_item("micrographs", f64_stack(micrographs)?.into_pyarray(py))?;
+        d.set_item("simulated_images", f64_stack(simulated)?.into_pyarray(py))?;
+        d.set_item(
+            "experiment_contact",
+            bool_stack(experiment)?.into_pyarray(py),
+        )?;
+        d.set_item(
+            "simulated_contact",
+            bool_stack(simulated_contact)?.into_pyarray(py),
+        )?;
+    }
+    Ok(d)
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

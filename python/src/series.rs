@@ -11,10 +11,12 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use contactscope::analysis::Pass;
 use contactscope::image::{PixelSize, Plane, SampleType};
 use contactscope::threshold::{Method, Threshold};
 use contactscope_formats::microscopy::select::{LoadAxis, Selection};
 use contactscope_formats::param::Param;
+use contactscope_jobs::analyze::files::{run_to_folder, ImageOutputs};
 use contactscope_jobs::analyze::{AnalyzeRequest, HertzParams};
 use contactscope_jobs::series::{self, MemorySeries, Micrographs, SeriesSpec};
 use contactscope_jobs::threshold::{self, ThresholdRequest};
@@ -202,9 +204,13 @@ enum MethodArg {
 
 /// The series analysis (the command line's `analyze`): files or arrays, forces in N, pixel
 /// size in m, Hertz reference with `radius` (m) and `modulus` (Pa). With `masks`, the contact
-/// masks as a (images, rows, columns) bool array.
+/// masks as a (images, rows, columns) bool array. With `out`, the folder the command line's
+/// `analyze --out` writes, by the same writer (`areas.csv`, `summary.json` with `command_line`
+/// as its `command_line`, `area_vs_load.png/.svg`; `overlays` and `save_masks` as its
+/// `--overlays` and `--save-masks`), and `written`: the files' paths. `progress(pass, done,
+/// total)` is called as the images are read ("histogram") and measured ("measure").
 #[pyfunction]
-#[pyo3(signature = (images, forces=None, pixel_size=None, method=None, radius=None, modulus=None, masks=false))]
+#[pyo3(signature = (images, forces=None, pixel_size=None, method=None, radius=None, modulus=None, masks=false, out=None, command_line=None, overlays=false, save_masks=false, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn analyze<'py>(
     py: Python<'py>,
@@ -215,6 +221,11 @@ fn analyze<'py>(
     radius: Option<f64>,
     modulus: Option<f64>,
     masks: bool,
+    out: Option<PathBuf>,
+    command_line: Option<Vec<String>>,
+    overlays: bool,
+    save_masks: bool,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut request = AnalyzeRequest::new(micrographs(images, forces)?);
     request.method = match method {
@@ -237,6 +248,40 @@ fn analyze<'py>(
             )))
         }
     };
+    if out.is_some() && masks {
+        return Err(bad(
+            "masks are returned by an analysis in memory; with out, ask for save_masks \
+             (mask TIFFs in the folder) instead",
+        ));
+    }
+    // Progress reported to Python from the threads the analysis runs on (the GIL taken for
+    // each call; an exception in the callback is printed, not raised, and the work goes on).
+    let report = move |pass: Pass, done: usize, total: usize| {
+        if let Some(callback) = &progress {
+            Python::attach(|py| {
+                let name = match pass {
+                    Pass::Histogram => "histogram",
+                    Pass::Measure => "measure",
+                };
+                if let Err(e) = callback.call1(py, (name, done, total)) {
+                    e.print(py);
+                }
+            });
+        }
+    };
+    if let Some(out) = out {
+        let command_line = command_line.unwrap_or_default();
+        let outputs = ImageOutputs {
+            overlays,
+            masks: save_masks,
+        };
+        let (outcome, written) = compute(py, move || {
+            run_to_folder(&request, &out, &command_line, outputs, &report)
+        })?;
+        let d = outcome_dict(py, &outcome)?;
+        d.set_item("written", written)?;
+        return Ok(d);
+    }
     let (outcome, kept) = compute(py, move || {
         let kept = std::sync::Mutex::new(Vec::new());
         let sink = |i: usize, _: &Plane, mask: &contactscope::measure::Mask| {
@@ -245,7 +290,7 @@ fn analyze<'py>(
             }
             Ok(())
         };
-        let outcome = contactscope_jobs::analyze::run(&request, &|_, _, _| {}, &sink)?;
+        let outcome = contactscope_jobs::analyze::run(&request, &report, &sink)?;
         let mut kept = kept.into_inner().expect("lock");
         kept.sort_by_key(|(i, _)| *i);
         Ok::<_, contactscope_jobs::Error>((outcome, kept))
@@ -305,7 +350,15 @@ fn measure<'py>(
     Ok(d)
 }
 
+/// Forces as the command line's `--forces` reads them: a list with units (`4,10,20,40mN`; a 0
+/// is a reference frame) or a log-spaced range (`4mN..400mN:12`); newtons.
+#[pyfunction]
+fn parse_forces(text: &str) -> PyResult<Vec<f64>> {
+    contactscope_formats::units::parse_forces(text).map_err(crate::to_py)
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(parse_forces, m)?)?;
     m.add_function(wrap_pyfunction!(read_series, m)?)?;
     m.add_function(wrap_pyfunction!(otsu_threshold, m)?)?;
     m.add_function(wrap_pyfunction!(analyze, m)?)?;

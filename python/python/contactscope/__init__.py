@@ -59,6 +59,7 @@ __all__ = [
     "misfit",
     "newton",
     "otsu_threshold",
+    "parse_forces",
     "psf",
     "ramp",
     "read_image",
@@ -269,7 +270,10 @@ def measure(image: Any, threshold: float, pixel_size: Optional[PixelSize] = None
 def analyze(series: Any, forces: Optional[Sequence[float]] = None,
             pixel_size: Optional[PixelSize] = None,
             method: Union[str, float, None] = None, *, radius: Optional[float] = None,
-            modulus: Optional[float] = None, masks: bool = False) -> Results:
+            modulus: Optional[float] = None, masks: bool = False,
+            out: Optional[PathLike] = None, overlays: bool = False, save_masks: bool = False,
+            command_line: Optional[Sequence[str]] = None,
+            progress: Optional[Any] = None) -> Results:
     """The paper's series analysis, the command line's ``analyze``: one global Otsu threshold
     over all images, then each image measured. ``series``: a :class:`Series` (its files are read
     as the command line reads them, with its forces and pixel size unless given here) or
@@ -285,12 +289,21 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
     ``method``, ``histogram_pixels``, …), ``fits`` (``power_law``, ``proportional``),
     ``inputs``, ``area_unit`` and ``warnings`` (also issued as :class:`ContactscopeWarning`);
     ``to_pandas()`` gives the table.
+
+    ``out``: also write the folder the command line's ``analyze --out`` writes, by the same
+    writer (``areas.csv``, ``summary.json``, ``area_vs_load.png``/``.svg``; ``overlays`` and
+    ``save_masks`` as ``--overlays`` and ``--save-masks``), all or nothing; ``summary.json``
+    records ``command_line`` (a list of words, e.g. the equivalent command) and ``written``
+    lists the files. ``progress(pass, done, total)`` is called as the images are read
+    (``"histogram"``) and measured (``"measure"``), from the threads doing the work.
     """
     if isinstance(series, Series) and pixel_size is None:
         pixel_size = series._pixel_size
     forces = None if forces is None else [float(f) for f in forces]
     result = Results(_cs.analyze(_images(series), forces, pixel_size, method, radius, modulus,
-                                 masks), table="rows")
+                                 masks, None if out is None else os.fspath(out),
+                                 None if command_line is None else [str(w) for w in command_line],
+                                 bool(overlays), bool(save_masks), progress), table="rows")
     _warn(result)
     return result
 
@@ -402,7 +415,7 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
             maps: Any, map_forces: Optional[Sequence[float]] = None,
             map_pixel_size: Optional[PixelSize] = None, psf_fwhm: float = 450e-9, *,
             dihedral: Optional[bool] = None, upsample: Optional[int] = None,
-            force_tolerance: Optional[float] = None) -> Results:
+            force_tolerance: Optional[float] = None, images: bool = False) -> Results:
     """Simulated contact maps against micrographs, load by load: the command line's ``compare``
     with its defaults and checks. ``micrographs``: a :class:`Series` (its files and forces) or
     images in their stored sample type with ``forces`` (N) and ``pixel_size`` (m). ``maps``: a
@@ -418,6 +431,13 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
     ``refinement``, ``edge_distance_m``, …; also :attr:`Results.rows`),
     ``series_registration`` (the one transform and shift of the whole series, each load
     refined within ``window_px`` of it), ``dice_mean``, the thresholds and ``warnings``.
+
+    ``images``: also the registered pairs the scores are computed on (the panels the command
+    line draws), each a (matched loads, rows, columns) stack on the micrograph's grid:
+    ``micrographs`` (grey levels), ``simulated_images`` (each map blurred with the PSF, resampled
+    to the micrograph's pixels, registered and put on the micrograph's grey scale; NaN outside
+    the simulated region), ``experiment_contact`` and ``simulated_contact`` (bool: contact as
+    the Dice counts it, inside the compared region).
     """
     if isinstance(micrographs, Series) and pixel_size is None:
         pixel_size = micrographs._pixel_size
@@ -429,7 +449,7 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
     map_forces = None if map_forces is None else [float(f) for f in map_forces]
     result = Results(_cs.compare(_images(micrographs), forces, pixel_size, maps, map_forces,
                                  map_pixel_size, float(psf_fwhm), dihedral, upsample,
-                                 force_tolerance), table="loads")
+                                 force_tolerance, bool(images)), table="loads")
     _warn(result)
     return result
 
@@ -666,7 +686,7 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
 
 def friction(traces: Union[PathLike, Sequence[PathLike]], normal_force: Optional[float] = None,
              rotation_radius: Optional[float] = None, areas: Optional[PathLike] = None,
-             force_tolerance: Optional[float] = None) -> Results:
+             force_tolerance: Optional[float] = None, images: bool = False) -> Results:
     """Static and kinetic friction from rheometer traces, the command line's ``friction`` on the
     same files (the same defaults, checks, warnings and numbers).
 
@@ -716,6 +736,13 @@ def hertz(squeeze: PathLike, radius: float, loads: Optional[Sequence[float]] = N
     """
     loads = None if loads is None else [float(f) for f in loads]
     return Results(_cs.hertz(os.fspath(squeeze), float(radius), loads), table="predicted")
+
+
+def parse_forces(text: str) -> list:
+    """Forces as the command line's ``--forces`` reads them, in N: a list with a unit
+    (``"4,10,20,40mN"``; a 0 is a reference frame) or a log-spaced range (``"4mN..400mN:12"``).
+    Raises :class:`InputError` with the command line's message for anything else."""
+    return _cs.parse_forces(str(text))
 
 
 def info(path: PathLike, stats: bool = False) -> Results:

@@ -4,7 +4,7 @@ The public, documented API is the package :mod:`contactscope`, which wraps these
 """
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Sequence, Tuple, TypedDict, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -83,7 +83,13 @@ def analyze(
     radius: Optional[float] = None,
     modulus: Optional[float] = None,
     masks: bool = False,
+    out: Optional[Path] = None,
+    command_line: Optional[Sequence[str]] = None,
+    overlays: bool = False,
+    save_masks: bool = False,
+    progress: Optional[Callable[[str, int, int], Any]] = None,
 ) -> AnalyzeResult: ...
+def parse_forces(text: str) -> List[float]: ...
 Selection = Optional[Dict[str, int]]
 
 class PsfBead(TypedDict):
@@ -331,6 +337,7 @@ def compare(
     dihedral: Optional[bool] = None,
     upsample: Optional[int] = None,
     force_tolerance: Optional[float] = None,
+    images: bool = False,
 ) -> CompareResult: ...
 
 # Height maps and contact mechanics

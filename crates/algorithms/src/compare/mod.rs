@@ -172,6 +172,18 @@ impl Prepared {
             .collect()
     }
 
+    /// The experiment's contact (micrograph value > `t_exp`) inside the compared region, as
+    /// the scores count it.
+    pub fn experiment_contact(&self, t_exp: f64) -> Vec<bool> {
+        contact_in_region(&self.experiment, &self.footprint, t_exp)
+    }
+
+    /// The simulation's contact (blurred, registered contact fraction > `t_sim`) inside the
+    /// compared region, as the scores count it.
+    pub fn simulated_contact(&self, t_sim: f64) -> Vec<bool> {
+        contact_in_region(&self.simulated, &self.footprint, t_sim)
+    }
+
     /// Micrograph values inside the simulated region, NaN outside.
     pub fn micrograph_in_region(&self) -> Vec<f64> {
         self.experiment

@@ -1,0 +1,243 @@
+"""The compare dock widget: simulated contact maps against the micrographs, as layers.
+
+Weber et al., Nat. Commun. 9, 888 (2018), Fig. 2: each simulated contact map (a folder written
+by ``contactscope simulate``) is imaged as the microscope would — blurred with a Gaussian PSF of
+the measured FWHM, integrated over the micrograph's pixels, registered once for the series —
+and compared with the micrograph at the same load (Dice, Jaccard). Everything is computed by
+:func:`contactscope.compare` (the command line's ``compare``, same defaults and scores); the
+widget only shows what it returns: the micrographs and the imaged simulations as image layers
+(side by side in napari's grid), the contact of each as edge layers (experiment green,
+simulation magenta) and the Dice per load in a table.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Dict, List, Optional
+
+import numpy as np
+from qtpy.QtWidgets import (QCheckBox, QComboBox, QDoubleSpinBox, QFileDialog, QFormLayout,
+                            QHBoxLayout, QLabel, QLineEdit, QProgressBar, QPushButton,
+                            QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
+
+import contactscope as cs
+
+from ._common import ERRORS, META, notify_error, one_line, stem
+from .series_widget import (LOAD_AXES, SeriesRequest, _coloured, _green, selected,
+                            selection_boxes, selection_row)
+
+LAYERS = ("compared micrographs", "experiment contact edges", "simulation imaged",
+          "simulated contact edges")
+
+
+def compare(request: SeriesRequest, simulation: str, psf_fwhm_m: float,
+            dihedral: bool = False) -> Dict[str, Any]:
+    """Read the micrographs and compare them with the simulation folder (the command line's
+    ``compare``), with the registered pairs."""
+    import warnings
+
+    series = request.read()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", cs.ContactscopeWarning)
+        if request.images is not None:
+            result = cs.compare(series, request.forces_n, request.pixel_size_m, simulation,
+                                psf_fwhm=psf_fwhm_m, dihedral=dihedral, images=True)
+            px = request.pixel_size_m
+        else:
+            result = cs.compare(series, None, None, simulation, psf_fwhm=psf_fwhm_m,
+                                dihedral=dihedral, images=True)
+            px = series["pixel_size_m"]
+    return {"result": result, "pixel_size_m": px}
+
+
+def table_rows(result: Dict[str, Any]) -> List[List[str]]:
+    """Per matched load: force (mN), simulated force (mN), Dice, Jaccard, shift (µm), areas
+    (µm²)."""
+    rows = []
+    for r in result["loads"]:
+        rows.append([f"{r['force_n'] * 1e3:g}", f"{r['simulated_force_n'] * 1e3:g}",
+                     f"{r['dice']:.3f}", f"{r['jaccard']:.3f}",
+                     f"{r['shift_x_m'] * 1e6:.2f}, {r['shift_y_m'] * 1e6:.2f}",
+                     f"{r['experiment_area_m2'] * 1e12:.1f}",
+                     f"{r['simulated_area_m2'] * 1e12:.1f}"])
+    return rows
+
+
+class CompareWidget(QWidget):
+    """Dock widget: a simulation folder, the micrograph series and the PSF FWHM in; the imaged
+    simulation next to each micrograph and the Dice per load out."""
+
+    def __init__(self, napari_viewer: Any) -> None:
+        super().__init__()
+        self.viewer = napari_viewer
+        self.outcome: Optional[Dict[str, Any]] = None
+        self._worker = None
+
+        self.simulation = QLineEdit()
+        self.simulation.setPlaceholderText("a folder written by contactscope simulate")
+        browse_sim = QPushButton("Folder…")
+        browse_sim.clicked.connect(self._browse_simulation)
+        self.paths = QLineEdit()
+        self.paths.setPlaceholderText("micrographs: files, a folder or a manifest .csv")
+        browse = QPushButton("Files…")
+        browse.clicked.connect(self._browse_files)
+        self.forces = QLineEdit()
+        self.forces.setPlaceholderText("4,10,20,40mN (not with a manifest)")
+        self.load_axis = QComboBox()
+        self.load_axis.addItems(LOAD_AXES)
+        self.selection = selection_boxes()
+        self.channel = self.selection["channel"]
+        self.fwhm = QDoubleSpinBox()
+        self.fwhm.setRange(50.0, 5000.0)
+        self.fwhm.setDecimals(1)
+        self.fwhm.setValue(450.0)
+        self.fwhm.setSuffix(" nm")
+        self.dihedral = QCheckBox("also try mirror images and 90° rotations")
+        self.grid = QCheckBox("side by side (napari grid)")
+        self.grid.setChecked(True)
+        self.run_button = QPushButton("Compare")
+        self.run_button.clicked.connect(self.start)
+        self.bar = QProgressBar()
+        self.bar.setRange(0, 1)
+        self.status = QLabel("")
+        self.status.setWordWrap(True)
+        self.table = QTableWidget(0, 7)
+        self.table.setHorizontalHeaderLabels(["force (mN)", "simulated (mN)", "Dice", "Jaccard",
+                                              "shift x, y (µm)", "A exp (µm²)", "A sim (µm²)"])
+
+        sim_row = QHBoxLayout()
+        sim_row.addWidget(self.simulation)
+        sim_row.addWidget(browse_sim)
+        files_row = QHBoxLayout()
+        files_row.addWidget(self.paths)
+        files_row.addWidget(browse)
+        form = QFormLayout()
+        form.addRow("simulation", sim_row)
+        form.addRow("micrographs", files_row)
+        form.addRow("forces", self.forces)
+        form.addRow("load axis", self.load_axis)
+        form.addRow("plane", selection_row(self.selection))
+        form.addRow("PSF FWHM", self.fwhm)
+        layout = QVBoxLayout(self)
+        layout.addLayout(form)
+        layout.addWidget(self.dihedral)
+        layout.addWidget(self.grid)
+        layout.addWidget(self.run_button)
+        layout.addWidget(self.bar)
+        layout.addWidget(self.status)
+        layout.addWidget(self.table)
+
+    def _browse_simulation(self) -> None:
+        name = QFileDialog.getExistingDirectory(self, "A simulate output folder")
+        if name:
+            self.simulation.setText(name)
+
+    def _browse_files(self) -> None:
+        names, _ = QFileDialog.getOpenFileNames(
+            self, "Micrographs or a manifest", "",
+            "Micrographs (*.tif *.tiff *.czi *.nd2 *.lif);;Manifest (*.csv);;All files (*)")
+        if names:
+            self.paths.setText(";".join(names))
+
+    def current_request(self) -> SeriesRequest:
+        """The micrograph series the fields describe."""
+        text = self.forces.text().strip()
+        inputs = [p.strip() for p in self.paths.text().split(";") if p.strip()]
+        if not inputs:
+            raise cs.InputError("choose the micrographs: files, a folder or a manifest")
+        if not self.simulation.text().strip():
+            raise cs.InputError("choose the simulation: a folder written by contactscope "
+                                "simulate")
+        axis = self.load_axis.currentText()
+        return SeriesRequest(inputs=inputs, forces_text=text,
+                             forces_n=cs.parse_forces(text) if text else None,
+                             load_axis=None if axis == LOAD_AXES[0] else axis,
+                             label=stem(inputs[0]), **selected(self.selection))
+
+    def _arguments(self):
+        return (self.current_request(), self.simulation.text().strip(),
+                self.fwhm.value() * 1e-9, self.dihedral.isChecked())
+
+    def start(self) -> Any:
+        """Run the comparison in a worker thread; the worker."""
+        from napari.qt.threading import create_worker
+
+        try:
+            args = self._arguments()
+        except ERRORS as e:
+            self._fail(e)
+            return None
+        self.run_button.setEnabled(False)
+        self.bar.setRange(0, 0)  # busy: the comparison reports no steps
+        self.status.setText("imaging the simulated maps, registering, scoring…")
+        # Errors go to _fail (one line), never re-raised from the thread as a traceback.
+        worker = create_worker(compare, *args, _start_thread=False, _connect={
+            "returned": self.show, "errored": self._fail, "finished": self._done})
+        self._worker = worker
+        worker.start()
+        return worker
+
+    def run_now(self) -> Dict[str, Any]:
+        """The same comparison in this thread (scripts and tests): the outcome, shown."""
+        outcome = compare(*self._arguments())
+        self.show(outcome)
+        return outcome
+
+    def _done(self) -> None:
+        self.run_button.setEnabled(True)
+        self.bar.setRange(0, 1)
+        self.bar.setValue(1)
+
+    def _fail(self, error: BaseException) -> None:
+        message = one_line(error)
+        self.status.setText(f"error: {message}")
+        notify_error(f"contactscope: {message}")
+
+    def show(self, outcome: Dict[str, Any]) -> None:
+        """The registered pairs as layers and the scores in the table."""
+        self.outcome = outcome
+        result = outcome["result"]
+        px = outcome["pixel_size_m"]
+        scale = [1.0, 1.0, 1.0] if px is None else [1.0, px[1] * 1e6, px[0] * 1e6]
+        common = {"scale": scale, "axis_labels": ["load", "y", "x"],
+                  "units": ["pixel"] + (["pixel"] * 2 if px is None else ["µm", "µm"])}
+        for name in LAYERS:
+            if name in self.viewer.layers:
+                self.viewer.layers.remove(name)
+        micrographs = np.asarray(result["micrographs"])
+        simulated = np.asarray(result["simulated_images"])
+        finite = micrographs[np.isfinite(micrographs)]
+        limits = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+        if limits[0] == limits[1]:
+            limits = (limits[0], limits[0] + 1.0)
+        meta = {META: {"simulation": result["simulation"],
+                       "forces_n": [r["force_n"] for r in result["loads"]],
+                       "dice": [r["dice"] for r in result["loads"]]}}
+        self.viewer.add_image(micrographs, name=LAYERS[0], contrast_limits=limits,
+                              metadata=meta, **common)
+        exp = self.viewer.add_labels(np.asarray(result["experiment_contact"]).astype(np.uint8),
+                                     name=LAYERS[1], **common)
+        self.viewer.add_image(simulated, name=LAYERS[2], contrast_limits=limits, metadata=meta,
+                              **common)
+        sim = self.viewer.add_labels(np.asarray(result["simulated_contact"]).astype(np.uint8),
+                                     name=LAYERS[3], **common)
+        for layer, colour in ((exp, None), (sim, "magenta")):
+            layer.contour = 1
+            _green(layer) if colour is None else _coloured(layer, colour)
+        if self.grid.isChecked():
+            # napari ≥ 0.9 keeps the grid on the canvas (viewer.grid before).
+            canvas = getattr(self.viewer, "canvas", None)
+            grid = getattr(canvas, "grid", None) or self.viewer.grid
+            grid.stride = 2
+            grid.enabled = True
+        rows = table_rows(result)
+        self.table.setRowCount(len(rows))
+        for i, row in enumerate(rows):
+            for j, text in enumerate(row):
+                self.table.setItem(i, j, QTableWidgetItem(text))
+        self.table.resizeColumnsToContents()
+        self.status.setText(
+            f"{result['loads_matched']} loads matched, mean Dice {result['dice_mean']:.3f}, "
+            f"PSF FWHM {result['psf_fwhm_m'] * 1e9:.0f} nm; simulation "
+            f"{os.path.basename(os.path.normpath(result['simulation']))}")
+
