@@ -7,7 +7,9 @@ and compared with the micrograph at the same load (Dice, Jaccard). Everything is
 :func:`contactscope.compare` (the command line's ``compare``, same defaults and scores); the
 widget only shows what it returns: the micrographs and the imaged simulations as image layers
 (side by side in napari's grid), the contact of each as edge layers (experiment green,
-simulation magenta) and the Dice per load in a table.
+simulation magenta) and the Dice per load in a table. Several simulation folders (one per
+model, separated by ``;``) are compared one after the other with the same micrographs and shown
+side by side, as the paper's Fig. 2 shows its models.
 """
 
 from __future__ import annotations
@@ -26,36 +28,50 @@ from ._common import ERRORS, META, notify_error, one_line, stem
 from .series_widget import (LOAD_AXES, SeriesRequest, _coloured, _green, selected,
                             selection_boxes, selection_row)
 
-LAYERS = ("compared micrographs", "experiment contact edges", "simulation imaged",
-          "simulated contact edges")
+#: The experiment's layers; each simulation adds "<name>: imaged" and "<name>: contact edges".
+LAYERS = ("compared micrographs", "experiment contact edges")
 
 
-def compare(request: SeriesRequest, simulation: str, psf_fwhm_m: float,
+def model_name(simulation: str) -> str:
+    """A simulation folder's name, as its layers and table rows call it."""
+    return os.path.basename(os.path.normpath(simulation))
+
+
+def compare(request: SeriesRequest, simulation: Any, psf_fwhm_m: float,
             dihedral: bool = False) -> Dict[str, Any]:
-    """Read the micrographs and compare them with the simulation folder (the command line's
-    ``compare``), with the registered pairs."""
+    """Read the micrographs once and compare them with each simulation folder (one, or a list:
+    one per model) by the command line's ``compare``, with the registered pairs. Returns
+    ``results`` (name, result) per folder, ``result`` (the first) and ``pixel_size_m``."""
     import warnings
 
+    folders = [simulation] if isinstance(simulation, (str, os.PathLike)) else list(simulation)
+    names = [model_name(os.fspath(f)) for f in folders]
+    if len(set(names)) != len(names):
+        raise cs.InputError(f"two simulation folders have the same name ({', '.join(names)}): "
+                            "the layers are named after them")
     series = request.read()
+    results = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", cs.ContactscopeWarning)
-        if request.images is not None:
-            result = cs.compare(series, request.forces_n, request.pixel_size_m, simulation,
-                                psf_fwhm=psf_fwhm_m, dihedral=dihedral, images=True)
-            px = request.pixel_size_m
-        else:
-            result = cs.compare(series, None, None, simulation, psf_fwhm=psf_fwhm_m,
-                                dihedral=dihedral, images=True)
-            px = series["pixel_size_m"]
-    return {"result": result, "pixel_size_m": px}
+        for name, folder in zip(names, folders):
+            if request.images is not None:
+                result = cs.compare(series, request.forces_n, request.pixel_size_m, folder,
+                                    psf_fwhm=psf_fwhm_m, dihedral=dihedral, images=True)
+                px = request.pixel_size_m
+            else:
+                result = cs.compare(series, None, None, folder, psf_fwhm=psf_fwhm_m,
+                                    dihedral=dihedral, images=True)
+                px = series["pixel_size_m"]
+            results.append((name, result))
+    return {"results": results, "result": results[0][1], "pixel_size_m": px}
 
 
-def table_rows(result: Dict[str, Any]) -> List[List[str]]:
-    """Per matched load: force (mN), simulated force (mN), Dice, Jaccard, shift (µm), areas
-    (µm²)."""
+def table_rows(result: Dict[str, Any], name: str = "") -> List[List[str]]:
+    """Per matched load: model, force (mN), simulated force (mN), Dice, Jaccard, shift (µm),
+    areas (µm²)."""
     rows = []
     for r in result["loads"]:
-        rows.append([f"{r['force_n'] * 1e3:g}", f"{r['simulated_force_n'] * 1e3:g}",
+        rows.append([name, f"{r['force_n'] * 1e3:g}", f"{r['simulated_force_n'] * 1e3:g}",
                      f"{r['dice']:.3f}", f"{r['jaccard']:.3f}",
                      f"{r['shift_x_m'] * 1e6:.2f}, {r['shift_y_m'] * 1e6:.2f}",
                      f"{r['experiment_area_m2'] * 1e12:.1f}",
@@ -74,7 +90,8 @@ class CompareWidget(QWidget):
         self._worker = None
 
         self.simulation = QLineEdit()
-        self.simulation.setPlaceholderText("a folder written by contactscope simulate")
+        self.simulation.setPlaceholderText(
+            "folders written by contactscope simulate (one per model, separated by ;)")
         browse_sim = QPushButton("Folder…")
         browse_sim.clicked.connect(self._browse_simulation)
         self.paths = QLineEdit()
@@ -101,8 +118,9 @@ class CompareWidget(QWidget):
         self.bar.setRange(0, 1)
         self.status = QLabel("")
         self.status.setWordWrap(True)
-        self.table = QTableWidget(0, 7)
-        self.table.setHorizontalHeaderLabels(["force (mN)", "simulated (mN)", "Dice", "Jaccard",
+        self._layers: List[Any] = []
+        self.table = QTableWidget(0, 8)
+        self.table.setHorizontalHeaderLabels(["model", "force (mN)", "simulated (mN)", "Dice", "Jaccard",
                                               "shift x, y (µm)", "A exp (µm²)", "A sim (µm²)"])
 
         sim_row = QHBoxLayout()
@@ -128,9 +146,10 @@ class CompareWidget(QWidget):
         layout.addWidget(self.table)
 
     def _browse_simulation(self) -> None:
-        name = QFileDialog.getExistingDirectory(self, "A simulate output folder")
-        if name:
-            self.simulation.setText(name)
+        name = QFileDialog.getExistingDirectory(self, "A simulate output folder (one model)")
+        if name:  # each folder chosen is added: one per model
+            known = [s.strip() for s in self.simulation.text().split(";") if s.strip()]
+            self.simulation.setText(";".join(known + [name]))
 
     def _browse_files(self) -> None:
         names, _ = QFileDialog.getOpenFileNames(
@@ -145,18 +164,22 @@ class CompareWidget(QWidget):
         inputs = [p.strip() for p in self.paths.text().split(";") if p.strip()]
         if not inputs:
             raise cs.InputError("choose the micrographs: files, a folder or a manifest")
-        if not self.simulation.text().strip():
+        if not self.simulations():
             raise cs.InputError("choose the simulation: a folder written by contactscope "
-                                "simulate")
+                                "simulate (or several, one per model)")
         axis = self.load_axis.currentText()
         return SeriesRequest(inputs=inputs, forces_text=text,
                              forces_n=cs.parse_forces(text) if text else None,
                              load_axis=None if axis == LOAD_AXES[0] else axis,
                              label=stem(inputs[0]), **selected(self.selection))
 
+    def simulations(self) -> List[str]:
+        """The simulation folders typed or chosen, in order."""
+        return [s.strip() for s in self.simulation.text().split(";") if s.strip()]
+
     def _arguments(self):
-        return (self.current_request(), self.simulation.text().strip(),
-                self.fwhm.value() * 1e-9, self.dihedral.isChecked())
+        request = self.current_request()
+        return (request, self.simulations(), self.fwhm.value() * 1e-9, self.dihedral.isChecked())
 
     def start(self) -> Any:
         """Run the comparison in a worker thread; the worker."""
@@ -194,50 +217,59 @@ class CompareWidget(QWidget):
         notify_error(f"contactscope: {message}")
 
     def show(self, outcome: Dict[str, Any]) -> None:
-        """The registered pairs as layers and the scores in the table."""
+        """The registered pairs as layers (the micrographs, then each model's imaged map) and
+        the scores in the table."""
         self.outcome = outcome
-        result = outcome["result"]
+        results = outcome["results"]
+        first = results[0][1]
         px = outcome["pixel_size_m"]
         scale = [1.0, 1.0, 1.0] if px is None else [1.0, px[1] * 1e6, px[0] * 1e6]
         common = {"scale": scale, "axis_labels": ["load", "y", "x"],
                   "units": ["pixel"] + (["pixel"] * 2 if px is None else ["µm", "µm"])}
-        for name in LAYERS:
-            if name in self.viewer.layers:
-                self.viewer.layers.remove(name)
-        micrographs = np.asarray(result["micrographs"])
-        simulated = np.asarray(result["simulated_images"])
+        for layer in self._layers:
+            if layer in self.viewer.layers:
+                self.viewer.layers.remove(layer)
+        micrographs = np.asarray(first["micrographs"])
         finite = micrographs[np.isfinite(micrographs)]
         limits = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
         if limits[0] == limits[1]:
             limits = (limits[0], limits[0] + 1.0)
-        meta = {META: {"simulation": result["simulation"],
-                       "forces_n": [r["force_n"] for r in result["loads"]],
-                       "dice": [r["dice"] for r in result["loads"]]}}
-        self.viewer.add_image(micrographs, name=LAYERS[0], contrast_limits=limits,
-                              metadata=meta, **common)
-        exp = self.viewer.add_labels(np.asarray(result["experiment_contact"]).astype(np.uint8),
-                                     name=LAYERS[1], **common)
-        self.viewer.add_image(simulated, name=LAYERS[2], contrast_limits=limits, metadata=meta,
-                              **common)
-        sim = self.viewer.add_labels(np.asarray(result["simulated_contact"]).astype(np.uint8),
-                                     name=LAYERS[3], **common)
-        for layer, colour in ((exp, None), (sim, "magenta")):
+
+        def meta(name: str, result: Dict[str, Any]) -> Dict[str, Any]:
+            return {META: {"model": name, "simulation": result["simulation"],
+                           "forces_n": [r["force_n"] for r in result["loads"]],
+                           "dice": [r["dice"] for r in result["loads"]]}}
+
+        added = [self.viewer.add_image(micrographs, name=LAYERS[0], contrast_limits=limits,
+                                       metadata=meta("experiment", first), **common),
+                 self.viewer.add_labels(
+                     np.asarray(first["experiment_contact"]).astype(np.uint8), name=LAYERS[1],
+                     **common)]
+        _green(added[1])
+        for name, result in results:
+            added.append(self.viewer.add_image(np.asarray(result["simulated_images"]),
+                                               name=f"{name}: imaged", contrast_limits=limits,
+                                               metadata=meta(name, result), **common))
+            edges = self.viewer.add_labels(
+                np.asarray(result["simulated_contact"]).astype(np.uint8),
+                name=f"{name}: contact edges", **common)
+            _coloured(edges, "magenta")
+            added.append(edges)
+        for layer in added[1::2]:
             layer.contour = 1
-            _green(layer) if colour is None else _coloured(layer, colour)
+        self._layers = added
         if self.grid.isChecked():
             # napari ≥ 0.9 keeps the grid on the canvas (viewer.grid before).
             canvas = getattr(self.viewer, "canvas", None)
             grid = getattr(canvas, "grid", None) or self.viewer.grid
             grid.stride = 2
             grid.enabled = True
-        rows = table_rows(result)
+        rows = [row for name, result in results for row in table_rows(result, name)]
         self.table.setRowCount(len(rows))
         for i, row in enumerate(rows):
             for j, text in enumerate(row):
                 self.table.setItem(i, j, QTableWidgetItem(text))
         self.table.resizeColumnsToContents()
-        self.status.setText(
-            f"{result['loads_matched']} loads matched, mean Dice {result['dice_mean']:.3f}, "
-            f"PSF FWHM {result['psf_fwhm_m'] * 1e9:.0f} nm; simulation "
-            f"{os.path.basename(os.path.normpath(result['simulation']))}")
-
+        scores = "; ".join(f"{name}: mean Dice {r['dice_mean']:.3f} over {r['loads_matched']} "
+                           "loads" for name, r in results)
+        self.status.setText(f"{scores} (PSF FWHM {first['psf_fwhm_m'] * 1e9:.0f} nm)")
