@@ -250,6 +250,25 @@ def test_a_ramp_that_does_not_converge_fills_its_row_with_the_error(client):
     assert r.rows[1]["error"] == serial.rows[1]["error"]
 
 
+def test_a_sweep_on_the_gpu_equals_the_cpu_or_says_why_not(client):
+    """device= reaches every worker's ramp: with a usable GPU the areas equal the CPU's (the
+    GPU solver gives the same contact maps), without one each row says why; "auto" falls back
+    to the CPU; an unknown device is refused before any task."""
+    h = cs.surface(seed=1, **SPEC)
+    kwargs = dict(values=[1e15, 4e15], heights=h, radius=RADIUS, client=client)
+    cpu = dd.sweep(LOADS, 2e-7, 1e9, **kwargs)
+    gpu = dd.sweep(LOADS, 2e-7, 1e9, device="cuda", **kwargs)
+    auto = dd.sweep(LOADS, 2e-7, 1e9, device="auto", **kwargs)
+    for g, a, c in zip(gpu.rows, auto.rows, cpu.rows):
+        if g["error"] is not None:  # no usable GPU (or a build without CUDA) on this worker
+            assert g["areas_m2"] is None and "GPU" in g["error"] and "\n" not in g["error"]
+        else:
+            np.testing.assert_array_equal(g["areas_m2"], c["areas_m2"])
+        np.testing.assert_array_equal(a["areas_m2"], c["areas_m2"])
+    with pytest.raises(cs.InputError, match="not one of cpu, cuda, auto"):
+        dd.sweep(LOADS, 2e-7, 1e9, device="gpu", **kwargs)
+
+
 def test_a_sweep_writes_its_folder_whole(client, tmp_path):
 
     h = cs.surface(seed=1, **SPEC)
@@ -268,7 +287,7 @@ def test_a_sweep_writes_its_folder_whole(client, tmp_path):
         [a * 1e12 for a in r.rows[1]["areas_m2"]], rel=1e-15)
     summary = json.loads((out / "sweep.json").read_text())
     assert summary["loads_mN"] == pytest.approx([f * 1e3 for f in LOADS])
-    assert summary["failed"] == 1 and summary["ramps"] == 2
+    assert summary["failed"] == 1 and summary["ramps"] == 2 and summary["device"] == "cpu"
     # A second run replaces the folder as a whole; a folder of someone else's is refused
     # before any ramp runs, and nothing in it changes.
     dd.sweep(LOADS, 2e-7, 1e9, values=[4e15], heights=h, radius=RADIUS, client="serial",

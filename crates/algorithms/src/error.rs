@@ -112,7 +112,7 @@ pub enum Error {
         tolerance: f64,
     },
     /// The GPU asked for cannot be used, or failed (feature `cuda`; [`crate::solver::gpu`]).
-    #[error("GPU (--device cuda): {reason}")]
+    #[error("GPU ({}): {reason}", contactscope_formats::param::Param::Device.with_value("cuda"))]
     Device {
         /// What is missing or what failed.
         reason: String,

@@ -113,6 +113,8 @@ params! {
     Tolerance: "--tolerance", "tolerance", "the solver tolerance";
     /// Most solver iterations per load.
     MaxIterations: "--max-iterations", "max_iterations", "the iteration limit";
+    /// Where the solver runs (cpu, cuda, auto).
+    Device: "--device", "device", "the device";
     /// Height map of a simulation.
     Topography: "--topography", "heights", "the height map";
     /// Micrographs of a measured load series.

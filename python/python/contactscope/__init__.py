@@ -666,7 +666,8 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
                                          grid=grid, ln_tolerance=ln_tolerance,
                                          tolerance=tolerance, max_iterations=max_iterations,
                                          imaging_fwhm=imaging_fwhm,
-                                         imaging_pixel_size=imaging_pixel_size, client=client)
+                                         imaging_pixel_size=imaging_pixel_size, client=client,
+                                         device=device)
     if isinstance(forces, (str, os.PathLike)):
         if areas is not None:
             raise InputError("give forces and areas, or an areas.csv alone")

@@ -186,15 +186,17 @@ def _tune_malloc() -> bool:
 def _ramp_task(heights: np.ndarray, pixel_size: Any, modulus: float, family: str,
                parameter: Optional[float], loads: List[float], radius: Optional[float],
                tolerance: float, max_iterations: int, imaging_fwhm: Optional[float],
-               imaging_pixel_size: Any, threads: Plan) -> Dict[str, Any]:
+               imaging_pixel_size: Any, threads: Plan,
+               device: str = "cpu") -> Dict[str, Any]:
     """One load ramp on a worker: areas (m²) and whether contact reached the map's border.
     A parameter the ramp cannot be solved with gives ``error`` (its message) in place of
     areas: an infeasible one (e.g. a hardness too low for the load) or one the solver does not
-    converge for within ``max_iterations`` (:class:`contactscope.ConvergenceError`)."""
+    converge for within ``max_iterations`` (:class:`contactscope.ConvergenceError`), or a
+    ``device="cuda"`` the worker has no usable GPU for."""
     _threads(threads)
     try:
         r = _cs.ramp(heights, pixel_size, modulus, family, parameter, loads, radius, tolerance,
-                     max_iterations, imaging_fwhm, imaging_pixel_size)
+                     max_iterations, imaging_fwhm, imaging_pixel_size, device=device)
     except ValueError as e:  # InputError and ConvergenceError
         return {"areas_m2": None, "edge_contact": False, "error": str(e)}
     return {"areas_m2": np.asarray(r["areas_m2"]), "edge_contact": r["edge_contact"],
@@ -321,7 +323,7 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
           max_iterations: int = 5000, imaging_fwhm: Optional[float] = None,
           imaging_pixel_size: Any = None, client: Any = None,
           threads_per_task: Optional[int] = None, progress: bool = False,
-          out: Any = None) -> Results:
+          out: Any = None, device: str = "cpu") -> Results:
     """Load ramps over a parameter grid, one Dask task per ramp.
 
     The grid is every combination of a model parameter in ``values`` (k in Pa/m for
@@ -336,7 +338,9 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
     (:func:`thread_plan`). ``progress``: print the Dask dashboard's address and show Dask's
     progress bar. ``out``: a folder to write ``sweep.csv`` (one row per ramp and load, units in
     the column names) and ``sweep.json`` into, as the command line writes its folders — only
-    once every ramp is back, all files or none.
+    once every ramp is back, all files or none. ``device``: where each worker solves its ramps,
+    ``"cpu"``, ``"cuda"`` (a worker without a usable GPU gives its rows that error) or
+    ``"auto"`` (its GPU where it has one), as :func:`contactscope.simulate`.
 
     Returns ``rows`` (per ramp: ``surface``, ``seed``, ``family``, ``parameter``, ``areas_m2``,
     ``edge_contact``, ``error``) in grid order; ``to_pandas()`` gives one row per ramp and load.
@@ -357,6 +361,7 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
     if not maps and not seeds:
         raise _cs.InputError("give heights, surfaces or seeds with surface_spec")
     values = list(values)
+    _check_device(device)
     if out is not None:
         _check_out(out)
     n_ramps = (len(maps) + len(seeds)) * len(values)
@@ -375,7 +380,7 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
             tasks.append(ex.submit(_ramp_task, futures[surface], pixel_size, float(modulus),
                                    family, None if value is None else float(value), loads,
                                    radius, tolerance, max_iterations, imaging_fwhm,
-                                   imaging_pixel_size, plan, **_pure(ex)))
+                                   imaging_pixel_size, plan, device, **_pure(ex)))
         show(tasks)
         outcomes = ex.gather(tasks)
     rows = []
@@ -385,7 +390,7 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
                      "loads_n": loads, **result})
     results = _SweepResults(rows=rows)
     if out is not None:
-        _write_sweep(out, results, modulus=float(modulus), radius=radius)
+        _write_sweep(out, results, modulus=float(modulus), radius=radius, device=device)
     return results
 
 
@@ -396,6 +401,11 @@ def _parameter_column(family: str) -> Tuple[Optional[str], float]:
     if family == "hardness":
         return "hardness_MPa", 1e-6
     return None, 1.0
+
+
+def _check_device(device: str) -> None:
+    if device not in ("cpu", "cuda", "auto"):
+        raise _cs.InputError(f"device '{device}' is not one of cpu, cuda, auto")
 
 
 def _check_out(out: Any) -> None:
@@ -415,7 +425,7 @@ def _check_out(out: Any) -> None:
 
 
 def _write_sweep(out: Any, results: "_SweepResults", modulus: float,
-                 radius: Optional[float]) -> None:
+                 radius: Optional[float], device: str) -> None:
     """``sweep.csv`` and ``sweep.json`` in lab units (mN, µm², MPa/nm), written as one folder."""
     rows = results["rows"]
     name, factor = _parameter_column(rows[0]["family"] if rows else "elastic")
@@ -441,7 +451,8 @@ def _write_sweep(out: Any, results: "_SweepResults", modulus: float,
     summary = {"loads_mN": [f * 1e3 for f in rows[0]["loads_n"]] if rows else [],
                "contact_modulus_GPa": modulus * 1e-9,
                "radius_um": None if radius is None else radius * 1e6,
-               "ramps": len(rows), "failed": sum(r["error"] is not None for r in rows),
+               "device": device, "ramps": len(rows),
+               "failed": sum(r["error"] is not None for r in rows),
                "rows": records}
     _cs.write_folder(os.fspath(out), [("sweep.csv", text.getvalue().encode()),
                                       ("sweep.json", (json.dumps(summary, indent=1) + "\n")
@@ -524,7 +535,7 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
                   tolerance: Optional[float] = None, max_iterations: Optional[int] = None,
                   imaging_fwhm: Optional[float] = None, imaging_pixel_size: Any = None,
                   client: Any = None, threads_per_task: Optional[int] = None,
-                  progress: bool = False) -> FitResults:
+                  progress: bool = False, device: str = "cpu") -> FitResults:
     """:func:`contactscope.fit_hardening` with every model evaluation (one load ramp) a Dask task.
 
     The same search as the library's: a log-spaced grid of ``grid`` values over ``range``
@@ -534,8 +545,8 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
     Misfit: RMS of ln(A_sim/A_exp) (forces in N, areas in m²). "elastic" and "gt" are one ramp.
     The result equals the serial path (``client="serial"``) exactly; it agrees with the
     library's own fit to the search tolerance (their Brent implementations differ in detail).
-    ``threads_per_task`` and ``progress`` as for :func:`sweep` (the grid's ramps share the
-    cores, each Brent step, a lone task, gets all of its worker's share). Returns a
+    ``threads_per_task``, ``progress`` and ``device`` as for :func:`sweep` (the grid's ramps
+    share the cores, each Brent step, a lone task, gets all of its worker's share). Returns a
     :class:`contactscope.FitResults` with one model (no ``measured`` or ``roughness``: the
     tasks see only the ramps).
     """
@@ -559,6 +570,7 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
     if not (0 < lo < hi < math.inf):
         raise _cs.InputError(f"search range {lo:e}..{hi:e} is not usable")
     h = _f64(heights, 2, "heights")
+    _check_device(device)
 
     with _executor(client, grid if has_parameter else 1, threads_per_task) as ex:
         threads = _Threads(ex, threads_per_task)
@@ -568,7 +580,7 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
         def submit(parameter: Optional[float], plan: Plan) -> Any:
             return ex.submit(_ramp_task, body, pixel_size, float(modulus), family, parameter,
                              fs, radius, tolerance, max_iterations, imaging_fwhm,
-                             imaging_pixel_size, plan, **_pure(ex))
+                             imaging_pixel_size, plan, device, **_pure(ex))
 
         def score(out: Dict[str, Any]) -> float:
             if out["error"] is not None:
