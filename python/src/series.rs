@@ -357,8 +357,16 @@ fn parse_forces(text: &str) -> PyResult<Vec<f64>> {
     contactscope_formats::units::parse_forces(text).map_err(crate::to_py)
 }
 
+/// A pixel size as the command line's `--pixel-size` reads it (`200nm`, `0.2um`, `200x210nm`
+/// for x × y): (x, y) in metres.
+#[pyfunction]
+fn parse_pixel_size(text: &str) -> PyResult<(f64, f64)> {
+    contactscope_formats::units::parse_pixel_size(text).map_err(crate::to_py)
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parse_forces, m)?)?;
+    m.add_function(wrap_pyfunction!(parse_pixel_size, m)?)?;
     m.add_function(wrap_pyfunction!(read_series, m)?)?;
     m.add_function(wrap_pyfunction!(otsu_threshold, m)?)?;
     m.add_function(wrap_pyfunction!(analyze, m)?)?;

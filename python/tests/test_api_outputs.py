@@ -1,7 +1,8 @@
 """The API the napari plugin is built on (no napari needed): ``analyze(out=…)`` writes the
 command line's folder by its own writer, ``analyze(progress=…)`` reports both passes,
 ``compare(images=True)`` returns the registered pairs the scores are computed on, and
-``parse_forces`` reads ``--forces`` as the command line does."""
+``parse_forces`` and ``parse_pixel_size`` read ``--forces`` and ``--pixel-size`` as the command
+line does."""
 
 import json
 import pathlib
@@ -19,6 +20,14 @@ def test_parse_forces_is_the_command_lines():
     assert cs.parse_forces("4mN..400mN:3") == pytest.approx([4e-3, 40e-3, 400e-3])
     with pytest.raises(cs.InputError, match="oops"):
         cs.parse_forces("4,oops")
+
+
+def test_parse_pixel_size_is_the_command_lines():
+    assert cs.parse_pixel_size("200nm") == pytest.approx((2e-7, 2e-7))
+    assert cs.parse_pixel_size("0.2um") == pytest.approx((2e-7, 2e-7))
+    assert cs.parse_pixel_size("200x210nm") == pytest.approx((2e-7, 2.1e-7))
+    with pytest.raises(cs.InputError):
+        cs.parse_pixel_size("200")  # a bare number has no unit
 
 
 def test_analyze_out_is_the_cli_folder(series_tif, tmp_path, cli):

@@ -288,6 +288,62 @@ def test_series_widget_exports_the_cli_folder(viewer, series_tif, tmp_path, cli)
 
 @needs_napari
 @needs_display
+@pytest.mark.parametrize("threshold", ["per-image", "1500"])
+def test_series_widget_threshold_and_pixel_size_as_the_cli(viewer, series_tif, tmp_path, cli,
+                                                           threshold):
+    """The widget's threshold and pixel-size fields are the command line's --threshold and
+    --pixel-size: the same areas.csv byte for byte, the same command recorded."""
+    from contactscope.napari.series_widget import LoadSeriesWidget
+
+    path, _ = series_tif
+    w = LoadSeriesWidget(viewer)
+    w.paths.setText(str(path))
+    w.forces.setText("2,4,8mN")
+    w.threshold.setText(threshold)
+    w.pixel_size.setText("250nm")
+    result = w.run_now()["result"]
+    assert result["threshold"]["method"] != "otsu-global"
+    # 250 nm pixels: each area is its contact pixels × 0.0625 µm².
+    for r in result.rows:
+        assert r["area_m2"] == pytest.approx(r["contact_pixels"] * 0.0625e-12, rel=1e-12)
+    assert viewer.layers["contact mask"].scale[-1] == pytest.approx(0.25)
+    mine, theirs = tmp_path / "widget", tmp_path / "cli"
+    w.export_now(str(mine))
+    cli("analyze", str(path), "--forces", "2,4,8mN", "--threshold", threshold, "--pixel-size",
+        "250nm", "--out", str(theirs))
+    assert (mine / "areas.csv").read_bytes() == (theirs / "areas.csv").read_bytes()
+    a = json.loads((mine / "summary.json").read_text())
+    b = json.loads((theirs / "summary.json").read_text())
+    assert a.pop("command_line")[1:-1] == b.pop("command_line")[1:-1]
+    # Where the pixel size came from, each in its own front-end's words.
+    assert a["inputs"]["pixel_size_used"].pop("source") == "given (pixel_size=)"
+    assert b["inputs"]["pixel_size_used"].pop("source") == "command line (--pixel-size)"
+    assert a == b
+
+
+@needs_napari
+@needs_display
+def test_series_widget_refuses_a_bad_threshold_or_pixel_size(viewer, series_tif, monkeypatch):
+    from contactscope.napari import series_widget
+    from contactscope.napari.series_widget import LoadSeriesWidget
+
+    shown = []
+    monkeypatch.setattr(series_widget, "notify_error", shown.append)
+    path, _ = series_tif
+    w = LoadSeriesWidget(viewer)
+    w.paths.setText(str(path))
+    w.forces.setText("2,4,8mN")
+    w.threshold.setText("bright")
+    assert w.start() is None
+    assert "bright" in shown[-1] and "\n" not in shown[-1]
+    w.threshold.setText("")
+    w.pixel_size.setText("200")  # no unit
+    assert w.start() is None
+    assert "200" in shown[-1] and "\n" not in shown[-1]
+
+
+@needs_napari
+@needs_display
 def test_series_widget_manifest_matches_cli(viewer, series_tif, tmp_path, cli):
     from contactscope.napari.series_widget import LoadSeriesWidget
 

@@ -60,6 +60,7 @@ __all__ = [
     "newton",
     "otsu_threshold",
     "parse_forces",
+    "parse_pixel_size",
     "psf",
     "ramp",
     "read_image",
@@ -744,6 +745,13 @@ def parse_forces(text: str) -> list:
     (``"4,10,20,40mN"``; a 0 is a reference frame) or a log-spaced range (``"4mN..400mN:12"``).
     Raises :class:`InputError` with the command line's message for anything else."""
     return _cs.parse_forces(str(text))
+
+
+def parse_pixel_size(text: str) -> tuple:
+    """A pixel size as the command line's ``--pixel-size`` reads it: (x, y) in m from
+    ``"200nm"``, ``"0.2um"`` or ``"200x210nm"`` (x × y). Raises :class:`InputError` with the
+    command line's message for anything else."""
+    return tuple(_cs.parse_pixel_size(str(text)))
 
 
 def info(path: PathLike, stats: bool = False) -> Results:

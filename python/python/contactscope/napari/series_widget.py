@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
 from qtpy.QtCore import QObject, Signal
@@ -51,6 +51,12 @@ class SeriesRequest:
     images: Optional[np.ndarray] = None
     pixel_size_m: Optional[Any] = None
     label: str = "series"
+    #: The command line's ``--threshold`` as typed ("" for its default, otsu) and as
+    #: :func:`contactscope.analyze` takes it.
+    threshold_text: str = ""
+    method: Optional[Union[str, float]] = None
+    #: The command line's ``--pixel-size`` as typed ("" for the files' own).
+    pixel_size_text: str = ""
 
     def read(self) -> Any:
         """The series (files as the command line reads them, or the stack)."""
@@ -75,7 +81,16 @@ class SeriesRequest:
                 words += [flag, str(value)]
         if self.load_axis is not None:
             words += ["--load-axis", self.load_axis]
+        if self.threshold_text:
+            words += ["--threshold", self.threshold_text]
+        if self.pixel_size_text and self.images is None:
+            words += ["--pixel-size", self.pixel_size_text]
         return words + ["--out", out]
+
+    def options(self) -> Dict[str, Any]:
+        """The analysis' keyword arguments beyond the series: the threshold rule, and the pixel
+        size where one is typed or the stack in memory carries one."""
+        return {"method": self.method, "pixel_size": self.pixel_size_m}
 
 
 def analyze(request: SeriesRequest, progress=None) -> Dict[str, Any]:
@@ -86,12 +101,13 @@ def analyze(request: SeriesRequest, progress=None) -> Dict[str, Any]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", cs.ContactscopeWarning)
         if request.images is not None:
-            result = cs.analyze(series, request.forces_n, request.pixel_size_m, masks=True,
-                                progress=progress)
+            result = cs.analyze(series, request.forces_n, masks=True, progress=progress,
+                                **request.options())
             images, px = series, request.pixel_size_m
         else:
-            result = cs.analyze(series, masks=True, progress=progress)
-            images, px = series["images"], series["pixel_size_m"]
+            result = cs.analyze(series, masks=True, progress=progress, **request.options())
+            images = series["images"]
+            px = request.pixel_size_m or series["pixel_size_m"]
     return {"result": result, "images": images, "pixel_size_m": px}
 
 
@@ -102,9 +118,10 @@ def export(request: SeriesRequest, out: str, progress=None) -> Dict[str, Any]:
     series = request.read()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", cs.ContactscopeWarning)
-        kwargs = dict(out=out, command_line=request.command_line(out), progress=progress)
+        kwargs = dict(out=out, command_line=request.command_line(out), progress=progress,
+                      **request.options())
         if request.images is not None:
-            return cs.analyze(series, request.forces_n, request.pixel_size_m, **kwargs)
+            return cs.analyze(series, request.forces_n, **kwargs)
         return cs.analyze(series, **kwargs)
 
 
@@ -152,7 +169,12 @@ class LoadSeriesWidget(QWidget):
         self.load_axis.addItems(LOAD_AXES)
         self.selection = selection_boxes()
         self.channel = self.selection["channel"]
-        self.run_button = QPushButton("Analyze (global Otsu)")
+        self.threshold = QLineEdit()
+        self.threshold.setPlaceholderText("otsu: one threshold for the series (or per-image, "
+                                          "or a grey value)")
+        self.pixel_size = QLineEdit()
+        self.pixel_size.setPlaceholderText("from the files (or 200nm, 200x210nm)")
+        self.run_button = QPushButton("Analyze")
         self.run_button.clicked.connect(self.start)
         self.export_button = QPushButton("Export areas.csv, summary.json, plot…")
         self.export_button.clicked.connect(self._export_clicked)
@@ -181,6 +203,8 @@ class LoadSeriesWidget(QWidget):
         form.addRow("forces", self.forces)
         form.addRow("load axis", self.load_axis)
         form.addRow("plane", selection_row(self.selection))
+        form.addRow("threshold", self.threshold)
+        form.addRow("pixel size", self.pixel_size)
         layout = QVBoxLayout(self)
         layout.addLayout(form)
         layout.addWidget(self.run_button)
@@ -247,7 +271,21 @@ class LoadSeriesWidget(QWidget):
             self.source.setCurrentIndex(0)
 
     def current_request(self) -> SeriesRequest:
-        """The series the fields describe (raises InputError with a one-line message)."""
+        """The series and options the fields describe (raises InputError with a one-line
+        message)."""
+        request = self._series_request()
+        threshold = self.threshold.text().strip()
+        if threshold and threshold != "otsu":
+            request.threshold_text = threshold
+            request.method = threshold if threshold == "per-image" else _grey_value(threshold)
+        text = self.pixel_size.text().strip()
+        if text:
+            request.pixel_size_text = text
+            request.pixel_size_m = cs.parse_pixel_size(text)
+        return request
+
+    def _series_request(self) -> SeriesRequest:
+        """The series the fields describe."""
         text = self.forces.text().strip()
         forces = cs.parse_forces(text) if text else None
         axis = self.load_axis.currentText()
@@ -487,6 +525,18 @@ def selection_row(boxes: Dict[str, QSpinBox]) -> QHBoxLayout:
 def selected(boxes: Dict[str, QSpinBox]) -> Dict[str, Optional[int]]:
     """The selection the boxes give (``None`` where unset)."""
     return {name: (None if box.value() < 0 else box.value()) for name, box in boxes.items()}
+
+
+def _grey_value(text: str) -> float:
+    """A fixed threshold as typed: a number in the images' grey values."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise cs.InputError(f"threshold '{text}': give otsu, per-image or a grey value "
+                            "(contact is value > it)") from None
+    if value != value or value in (float("inf"), float("-inf")):
+        raise cs.InputError(f"threshold '{text}' is not a finite grey value")
+    return value
 
 
 def _coloured(layer: Any, colour: str) -> None:
