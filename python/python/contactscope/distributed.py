@@ -72,7 +72,8 @@ def _worker_facts() -> Dict[str, Any]:
 
 
 def thread_plan(workers: Mapping[str, Mapping[str, Any]], tasks: int) -> Dict[str, int]:
-    """The size of each worker's contactscope thread pool for ``tasks`` concurrent-able tasks.
+    """The size of each worker's contactscope thread pool for ``tasks`` tasks that may run at
+    once.
 
     ``workers`` maps a worker's address to ``host``, ``job`` (a Slurm job ID or ``None``),
     ``cpus`` (cores it may use) and ``nthreads`` (Dask threads, i.e. tasks it runs at once).
@@ -86,7 +87,7 @@ def thread_plan(workers: Mapping[str, Mapping[str, Any]], tasks: int) -> Dict[st
     """
     tasks = max(1, int(tasks))
     groups: Dict[Tuple[str, Any], Dict[str, Any]] = {}
-    for address, w in workers.items():
+    for w in workers.values():
         g = groups.setdefault((w["host"], w.get("job")), {"cpus": int(w["cpus"]), "threads": 0})
         g["cpus"] = min(g["cpus"], int(w["cpus"]))
         g["threads"] += int(w["nthreads"])
@@ -221,8 +222,8 @@ def local_client(n_workers: Optional[int] = None,
 
     if n_workers is None:
         n_workers = max(1, _cpus() // max(1, threads_per_worker))
-    # One queued task per Dask thread (the default, 1.1, holds two per single-thread worker):
-    # ramps of unequal length then end together on a sweep's last round.
+    # One queued task per Dask thread: the default (1.1) lets a single-thread worker hold a
+    # second ramp while another worker has none left at a sweep's end.
     with dask.config.set({"distributed.scheduler.worker-saturation": 1.0}):
         cluster = LocalCluster(n_workers=n_workers, threads_per_worker=threads_per_worker,
                                host="127.0.0.1", dashboard_address="127.0.0.1:0",
