@@ -569,7 +569,8 @@ def test_to_pandas_gives_the_rows_as_a_table():
 
 def test_simulate_and_fit_say_which_device_ran(surface_npy):
     """``device``: "auto" runs on the CPU where no GPU is usable and says so; "cuda" there is a
-    one-line InputError naming the choice; an unknown name lists the choices."""
+    one-line InputError naming the choice as Python writes it (device=cuda); an unknown name
+    lists the choices."""
     h = cs.read_topography(surface_npy, pixel_size=100e-9).heights
     loads = [20e-6, 40e-6]
     auto = cs.simulate(h, 100e-9, 1e9, loads, "hardening", k=4e15, radius=20e-6, maps=False,
@@ -580,7 +581,7 @@ def test_simulate_and_fit_say_which_device_ran(surface_npy):
     if ran == "cpu":
         with pytest.raises(cs.InputError) as e:
             cs.simulate(h, 100e-9, 1e9, loads, "hardening", k=4e15, radius=20e-6, device="cuda")
-        assert "--device cuda" in str(e.value) and "\n" not in str(e.value)
+        assert "device=cuda" in str(e.value) and "\n" not in str(e.value)
         np.testing.assert_array_equal([r["area_m2"] for r in auto.rows],
                                       [r["area_m2"] for r in cpu.rows])
     else:
