@@ -9,6 +9,8 @@ use numpy::{IntoPyArray, PyReadonlyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use contactscope_jobs::compare::files::run_to_folder;
+
 use contactscope::compare::SimulatedMap;
 use contactscope::optics::blur::Grid;
 use contactscope_formats::param::Param;
@@ -84,9 +86,11 @@ fn simulation(
 /// `micrographs` (grey levels), `simulated_images` (the blurred, resampled and registered
 /// contact map on the micrograph's grey scale, NaN outside the simulated region),
 /// `experiment_contact` and `simulated_contact` (bool: contact as the Dice counts it, inside
-/// the compared region).
+/// the compared region). With `out`, the folder the command line's `compare --out` writes, by
+/// the same writer (`compare.csv`, `compare.json` with `command_line` as its `command_line`,
+/// `panel_NNN.png`), and `written`: the files' paths.
 #[pyfunction]
-#[pyo3(signature = (micrographs, forces, pixel_size, maps, map_forces, map_pixel_size, psf_fwhm, dihedral=None, upsample=None, force_tolerance=None, images=false))]
+#[pyo3(signature = (micrographs, forces, pixel_size, maps, map_forces, map_pixel_size, psf_fwhm, dihedral=None, upsample=None, force_tolerance=None, images=false, out=None, command_line=None))]
 #[allow(clippy::too_many_arguments)]
 fn compare<'py>(
     py: Python<'py>,
@@ -101,6 +105,8 @@ fn compare<'py>(
     upsample: Option<usize>,
     force_tolerance: Option<f64>,
     images: bool,
+    out: Option<PathBuf>,
+    command_line: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut request = CompareRequest::new(
         crate::series::micrographs(micrographs, forces)?,
@@ -111,8 +117,22 @@ fn compare<'py>(
     request.dihedral = dihedral.unwrap_or(request.dihedral);
     request.upsample = upsample.unwrap_or(request.upsample);
     request.force_tolerance = force_tolerance.unwrap_or(request.force_tolerance);
-    let outcome = compute(py, move || contactscope_jobs::compare::run(&request))?;
+    let (outcome, written) = match out {
+        Some(out) => {
+            let command_line = command_line.unwrap_or_default();
+            let (outcome, written) =
+                compute(py, move || run_to_folder(&request, &out, &command_line))?;
+            (outcome, Some(written))
+        }
+        None => (
+            compute(py, move || contactscope_jobs::compare::run(&request))?,
+            None,
+        ),
+    };
     let d = outcome_dict(py, &outcome)?;
+    if let Some(written) = written {
+        d.set_item("written", written)?;
+    }
     if images && !outcome.prepared.is_empty() {
         let (w, h) = outcome.prepared[0].size();
         let n = outcome.prepared.len();

@@ -500,6 +500,18 @@ def test_compare_widget_on_the_demo_experiment(viewer, tmp_path, cli, monkeypatc
     assert "elastic: imaged" not in viewer.layers and "hardening: imaged" in viewer.layers
     w.simulation.setText("elastic;hardening")
     w.run_now()
+    # Export: the command line's compare folder per model, by its own writer.
+    folders = w.export_now(str(tmp_path / "exported"))
+    assert [pathlib.Path(f).name for f in folders] == ["compare-elastic", "compare-hardening"]
+    for name, folder in zip(results, map(pathlib.Path, folders)):
+        theirs = tmp_path / f"cmp-{name}"
+        assert (folder / "compare.csv").read_bytes() == (theirs / "compare.csv").read_bytes()
+        a = json.loads((folder / "compare.json").read_text())
+        b = json.loads((theirs / "compare.json").read_text())
+        assert a.pop("command_line")[1:-1] == b.pop("command_line")[1:-1]
+        assert a == b
+        assert sorted(p.name for p in folder.glob("panel_*.png")) == \
+            sorted(p.name for p in theirs.glob("panel_*.png")) != []
     viewer.dims.set_point(0, 3)
     viewer.reset_view()
     _docs_image(viewer.screenshot(canvas_only=False), "napari-compare.png")

@@ -416,7 +416,9 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
             maps: Any, map_forces: Optional[Sequence[float]] = None,
             map_pixel_size: Optional[PixelSize] = None, psf_fwhm: float = 450e-9, *,
             dihedral: Optional[bool] = None, upsample: Optional[int] = None,
-            force_tolerance: Optional[float] = None, images: bool = False) -> Results:
+            force_tolerance: Optional[float] = None, images: bool = False,
+            out: Optional[PathLike] = None,
+            command_line: Optional[Sequence[str]] = None) -> Results:
     """Simulated contact maps against micrographs, load by load: the command line's ``compare``
     with its defaults and checks. ``micrographs``: a :class:`Series` (its files and forces) or
     images in their stored sample type with ``forces`` (N) and ``pixel_size`` (m). ``maps``: a
@@ -439,6 +441,10 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
     to the micrograph's pixels, registered and put on the micrograph's grey scale; NaN outside
     the simulated region), ``experiment_contact`` and ``simulated_contact`` (bool: contact as
     the Dice counts it, inside the compared region).
+
+    ``out``: also write the command line's ``compare --out`` folder there, by its own writer
+    (``compare.csv``, ``compare.json`` recording ``command_line``, one ``panel_NNN.png`` per
+    load), all files or none; ``written`` lists them.
     """
     if isinstance(micrographs, Series) and pixel_size is None:
         pixel_size = micrographs._pixel_size
@@ -450,7 +456,10 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
     map_forces = None if map_forces is None else [float(f) for f in map_forces]
     result = Results(_cs.compare(_images(micrographs), forces, pixel_size, maps, map_forces,
                                  map_pixel_size, float(psf_fwhm), dihedral, upsample,
-                                 force_tolerance, bool(images)), table="loads")
+                                 force_tolerance, bool(images),
+                                 None if out is None else os.fspath(out),
+                                 None if command_line is None else [str(w) for w in command_line]),
+                     table="loads")
     _warn(result)
     return result
 

@@ -339,6 +339,8 @@ def compare(
     upsample: Optional[int] = None,
     force_tolerance: Optional[float] = None,
     images: bool = False,
+    out: Optional[Path] = None,
+    command_line: Optional[Sequence[str]] = None,
 ) -> CompareResult: ...
 
 # Height maps and contact mechanics

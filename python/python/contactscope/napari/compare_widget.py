@@ -66,6 +66,53 @@ def compare(request: SeriesRequest, simulation: Any, psf_fwhm_m: float,
     return {"results": results, "result": results[0][1], "pixel_size_m": px}
 
 
+def command_line(request: SeriesRequest, simulation: str, psf_fwhm_m: float, dihedral: bool,
+                 out: str) -> List[str]:
+    """The command line's ``compare`` with the same micrographs, selection and options."""
+    if request.images is not None:
+        words = ["contactscope-napari", "compare", "--micrographs", request.label]
+    else:
+        words = ["contactscope", "compare", "--micrographs", *request.inputs]
+    if request.forces_text and not (request.inputs
+                                    and request.inputs[0].lower().endswith(".csv")):
+        words += ["--forces", request.forces_text]
+    words += ["--simulation", simulation, "--psf-fwhm", f"{psf_fwhm_m * 1e9:g}nm"]
+    for flag, value in (("--series", request.series), ("--channel", request.channel),
+                        ("--z", request.z), ("--t", request.t)):
+        if value is not None:
+            words += [flag, str(value)]
+    if request.load_axis is not None:
+        words += ["--load-axis", request.load_axis]
+    if dihedral:
+        words.append("--dihedral")
+    return words + ["--out", out]
+
+
+def export(request: SeriesRequest, simulation: Any, psf_fwhm_m: float, dihedral: bool,
+           parent: str) -> List[str]:
+    """The command line's ``compare`` folder for each simulation folder, written by its own
+    writer as ``<parent>/compare-<folder name>`` (each all files or none); the folders."""
+    import warnings
+
+    folders = [simulation] if isinstance(simulation, (str, os.PathLike)) else list(simulation)
+    series = request.read()
+    written = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", cs.ContactscopeWarning)
+        for folder in folders:
+            out = os.path.join(parent, f"compare-{model_name(os.fspath(folder))}")
+            words = command_line(request, os.fspath(folder), psf_fwhm_m, dihedral, out)
+            if request.images is not None:
+                cs.compare(series, request.forces_n, request.pixel_size_m, folder,
+                           psf_fwhm=psf_fwhm_m, dihedral=dihedral, out=out,
+                           command_line=words)
+            else:
+                cs.compare(series, None, None, folder, psf_fwhm=psf_fwhm_m, dihedral=dihedral,
+                           out=out, command_line=words)
+            written.append(out)
+    return written
+
+
 def table_rows(result: Dict[str, Any], name: str = "") -> List[List[str]]:
     """Per matched load: model, force (mN), simulated force (mN), Dice, Jaccard, shift (µm),
     areas (µm²)."""
@@ -87,6 +134,7 @@ class CompareWidget(QWidget):
         super().__init__()
         self.viewer = napari_viewer
         self.outcome: Optional[Dict[str, Any]] = None
+        self._compared: Optional[tuple] = None  # the arguments of the comparison shown
         self._worker = None
 
         self.simulation = QLineEdit()
@@ -114,6 +162,9 @@ class CompareWidget(QWidget):
         self.grid.setChecked(True)
         self.run_button = QPushButton("Compare")
         self.run_button.clicked.connect(self.start)
+        self.export_button = QPushButton("Export compare.csv, compare.json, panels…")
+        self.export_button.clicked.connect(self._export_clicked)
+        self.export_button.setEnabled(False)
         self.bar = QProgressBar()
         self.bar.setRange(0, 1)
         self.status = QLabel("")
@@ -144,6 +195,7 @@ class CompareWidget(QWidget):
         layout.addWidget(self.bar)
         layout.addWidget(self.status)
         layout.addWidget(self.table)
+        layout.addWidget(self.export_button)
 
     def _browse_simulation(self) -> None:
         name = QFileDialog.getExistingDirectory(self, "A simulate output folder (one model)")
@@ -179,7 +231,13 @@ class CompareWidget(QWidget):
 
     def _arguments(self):
         request = self.current_request()
-        return (request, self.simulations(), self.fwhm.value() * 1e-9, self.dihedral.isChecked())
+        return (request, self.simulations(), self.fwhm_m(), self.dihedral.isChecked())
+
+    def fwhm_m(self) -> float:
+        """The PSF FWHM in m, read from its text as the command line reads ``--psf-fwhm 450nm``
+        (450 × 1e-9 in floating point is one unit in the last place off, which moves every
+        score in its last digits)."""
+        return cs.parse_pixel_size(f"{self.fwhm.value()!r}nm")[0]
 
     def start(self) -> Any:
         """Run the comparison in a worker thread; the worker."""
@@ -195,16 +253,47 @@ class CompareWidget(QWidget):
         self.status.setText("imaging the simulated maps, registering, scoring…")
         # Errors go to _fail (one line), never re-raised from the thread as a traceback.
         worker = create_worker(compare, *args, _start_thread=False, _connect={
-            "returned": self.show, "errored": self._fail, "finished": self._done})
+            "returned": lambda outcome: self._shown(args, outcome), "errored": self._fail,
+            "finished": self._done})
         self._worker = worker
         worker.start()
         return worker
 
     def run_now(self) -> Dict[str, Any]:
         """The same comparison in this thread (scripts and tests): the outcome, shown."""
-        outcome = compare(*self._arguments())
-        self.show(outcome)
+        args = self._arguments()
+        outcome = compare(*args)
+        self._shown(args, outcome)
         return outcome
+
+    def _shown(self, args: tuple, outcome: Dict[str, Any]) -> None:
+        self.show(outcome)
+        self._compared = args
+        self.export_button.setEnabled(True)
+
+    def export_now(self, parent: str) -> List[str]:
+        """Write the command line's ``compare`` folder of each model compared last, as
+        ``<parent>/compare-<folder name>``, in this thread (scripts and tests); the folders."""
+        if self._compared is None:
+            raise cs.InputError("compare before exporting")
+        return export(*self._compared, parent)
+
+    def _export_clicked(self) -> None:
+        from napari.qt.threading import create_worker
+
+        parent = QFileDialog.getExistingDirectory(
+            self, "Where to write compare-<model> folders (the command line's compare --out)")
+        if not parent or self._compared is None:
+            return
+        self.export_button.setEnabled(False)
+        self.status.setText("writing the compare folders…")
+        worker = create_worker(export, *self._compared, parent, _start_thread=False, _connect={
+            "returned": lambda folders: self.status.setText(
+                "written: " + ", ".join(os.path.basename(f) for f in folders)),
+            "errored": self._fail,
+            "finished": lambda: self.export_button.setEnabled(True)})
+        self._worker = worker
+        worker.start()
 
     def _done(self) -> None:
         self.run_button.setEnabled(True)
