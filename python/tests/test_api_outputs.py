@@ -78,3 +78,30 @@ def test_compare_images_are_what_the_scores_count(series_tif, tmp_path):
         # The imaged map is NaN only outside the simulated region, where no contact is counted.
         outside = np.isnan(r.simulated_images[i])
         assert not (b & outside).any()
+
+
+def test_compare_out_is_the_cli_folder(series_tif, tmp_path, cli):
+    """compare(out=) writes the command line's compare folder by its own writer: compare.csv
+    byte for byte, compare.json equal but for the command recorded, the panels."""
+    path, _ = series_tif
+    sim, topo = tmp_path / "sim", tmp_path / "t.npy"
+    cli("surface", "--size", 96, "--pixel-size", "200nm", "--rms-height", "100nm", "--seed", 5,
+        "--out", topo)
+    cli("simulate", "--topography", topo, "--pixel-size", "200nm", "--radius", "290um",
+        "--modulus", "2GPa", "--model", "hardening", "--hardening", "4MPa/nm",
+        "--forces", "2,4,8mN", "--out", sim, "-q")
+    cli("compare", "--micrographs", path, "--forces", "2,4,8mN", "--simulation", sim,
+        "--psf-fwhm", "450nm", "--out", tmp_path / "cli")
+    words = ["contactscope", "compare", "--micrographs", str(path), "--forces", "2,4,8mN",
+             "--simulation", str(sim), "--psf-fwhm", "450nm", "--out", str(tmp_path / "py")]
+    r = cs.compare(cs.read_series(path, forces=FORCES), None, None, sim, psf_fwhm=450e-9,
+                   out=tmp_path / "py", command_line=words)
+    assert {pathlib.Path(p).name for p in r["written"]} == \
+        {p.name for p in (tmp_path / "cli").iterdir() if p.name != ".contactscope-run.json"}
+    mine, theirs = tmp_path / "py", tmp_path / "cli"
+    assert (mine / "compare.csv").read_bytes() == (theirs / "compare.csv").read_bytes()
+    a = json.loads((mine / "compare.json").read_text())
+    b = json.loads((theirs / "compare.json").read_text())
+    assert a.pop("command_line") == words
+    assert b.pop("command_line")[1:-1] == words[1:-1]
+    assert a == b
