@@ -269,6 +269,27 @@ def test_a_sweep_on_the_gpu_equals_the_cpu_or_says_why_not(client):
         dd.sweep(LOADS, 2e-7, 1e9, device="gpu", **kwargs)
 
 
+def test_serial_sweeps_and_fits_report_each_ramp(capsys):
+    """progress=True in this process (client="serial", or client=None with one task or one
+    core): a line per ramp done, with the count where it is known; nothing without it."""
+    h = cs.surface(seed=1, **SPEC)
+    kwargs = dict(values=[1e15, 4e15, 16e15], heights=h, radius=RADIUS, client="serial")
+    dd.sweep(LOADS, 2e-7, 1e9, progress=True, **kwargs)
+    assert capsys.readouterr().err.splitlines() == [
+        f"contactscope: ramp {i} of 3 done" for i in (1, 2, 3)]
+    dd.sweep(LOADS, 2e-7, 1e9, **kwargs)
+    assert capsys.readouterr().err == ""
+    truth = cs.ramp(h, 2e-7, 1e9, "hardening", 4e15, LOADS, radius=RADIUS).areas_m2
+    dd.fit_hardening(LOADS, truth, h, 2e-7, 1e9, radius=RADIUS, grid=3, ln_tolerance=0.5,
+                     client="serial", progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[:4] == ["contactscope: hardening fit: 3 ramps over the search grid"] + [
+        f"contactscope: ramp {i} of 3 done" for i in (1, 2, 3)]
+    assert lines[4] == "contactscope: ramp 1 done" and lines[5].startswith(
+        "contactscope: Brent step: k_MPa_per_nm = ")
+    assert lines[-3:] == [f"contactscope: ramp {i} of 3 done" for i in (1, 2, 3)]
+
+
 def test_a_sweep_writes_its_folder_whole(client, tmp_path):
 
     h = cs.surface(seed=1, **SPEC)

@@ -248,14 +248,25 @@ def _close_quietly(client: Any, cluster: Any) -> None:
 
 
 class _Serial:
-    """The same tasks in this process, in order: the reference for the Dask path."""
+    """The same tasks in this process, in order: the reference for the Dask path. With
+    ``report`` set (``progress=True``), each ramp done is a line on stderr."""
+
+    def __init__(self) -> None:
+        self.report = False
+        self.ramps = 0
+        self.expected: Optional[int] = None
 
     def scatter(self, value: Any, **_: Any) -> Any:
         return value
 
     def submit(self, fn: Callable, *args: Any, **_: Any) -> Any:
         # Results of earlier tasks stand for their values, as Dask futures do.
-        return _Done(fn(*(a.value if isinstance(a, _Done) else a for a in args)))
+        done = _Done(fn(*(a.value if isinstance(a, _Done) else a for a in args)))
+        if self.report and fn is _ramp_task:
+            self.ramps += 1
+            of = f" of {self.expected}" if self.expected else ""
+            print(f"contactscope: ramp {self.ramps}{of} done", file=sys.stderr, flush=True)
+        return done
 
     def gather(self, futures: Sequence[Any]) -> List[Any]:
         return [f.result() for f in futures]
@@ -294,19 +305,29 @@ def _pure(client: Any) -> Dict[str, Any]:
 
 
 class _Progress:
-    """Progress of a computation on Dask, when asked for: the dashboard's address once, then
-    Dask's own progress bar per batch of tasks (text in a terminal, a widget in a notebook)."""
+    """Progress, when asked for. On Dask: the dashboard's address once, then Dask's own progress
+    bar per batch of tasks (text in a terminal, a widget in a notebook). In this process: a line
+    per ramp done."""
 
     def __init__(self, ex: Any, on: bool) -> None:
         self.ex = ex
-        self.on = on and not isinstance(ex, _Serial)
-        if self.on:
+        self.serial = isinstance(ex, _Serial)
+        self.on = on
+        if on and self.serial:
+            ex.report = True
+        elif on:
             link = getattr(ex, "dashboard_link", None)
             if link:
                 print(f"contactscope: Dask dashboard at {link}", file=sys.stderr, flush=True)
 
+    def expect(self, ramps: Optional[int]) -> None:
+        """The number of ramps the next batch holds (``None``: one at a time)."""
+        if self.serial:
+            self.ex.expected = ramps
+            self.ex.ramps = 0
+
     def __call__(self, futures: Sequence[Any]) -> None:
-        if self.on and futures:
+        if self.on and not self.serial and futures:
             from dask.distributed import progress
 
             progress(list(futures))
@@ -377,6 +398,7 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
         tasks = []
         grid = list(itertools.product(range(len(futures)), values))
         plan = threads.plan(len(grid))
+        show.expect(len(grid))
         for surface, value in grid:
             tasks.append(ex.submit(_ramp_task, futures[surface], pixel_size, float(modulus),
                                    family, None if value is None else float(value), loads,
@@ -598,6 +620,7 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
         xs = [a + (b - a) * i / (grid - 1) for i in builtins.range(grid)]
         show.note(f"{family} fit: {grid} ramps over the search grid")
         plan = threads.plan(grid)
+        show.expect(grid)
         pending = [submit(math.exp(x), plan) for x in xs]
         show(pending)
         grid_out = ex.gather(pending)
@@ -611,6 +634,7 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
         x0, x1 = xs[max(best - 1, 0)], xs[min(best + 1, len(xs) - 1)]
         alone = threads.plan(1)
         unit, factor = _parameter_column(family)
+        show.expect(None)
 
         def cost(x: float) -> float:
             m = score(submit(math.exp(x), alone).result())
@@ -623,9 +647,10 @@ def fit_hardening(forces: Sequence[float], areas: Sequence[float], heights: Any,
         ln_best = brent_minimum(cost, x0, x1, ln_tolerance / 4.0)
         step = 0.05
         plan = threads.plan(3)
+        show.note("the best value and the two ramps of its standard error")
+        show.expect(3)
         pending = [submit(math.exp(ln_best), plan), submit(math.exp(ln_best - step), plan),
                    submit(math.exp(ln_best + step), plan)]
-        show.note("the best value and the two ramps of its standard error")
         show(pending)
         final, minus, plus = ex.gather(pending)
     if final["error"] is not None:
