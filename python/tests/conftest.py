@@ -64,3 +64,17 @@ def surface_npy(tmp_path_factory, cli):
     cli("surface", "--size", 128, "--pixel-size", "100nm", "--rms-height", "50nm", "--seed", 3,
         "--out", path)
     return path
+
+
+@pytest.fixture(scope="session")
+def hardening_sim(tmp_path_factory, cli):
+    """A `simulate` folder on the grid of `series_tif` (96² px of 200 nm, hardening k = 4
+    MPa/nm, 2/4/8 mN), written by the command line: what `compare` tests compare with."""
+    d = tmp_path_factory.mktemp("simulation")
+    sim, topo = d / "sim", d / "t.npy"
+    cli("surface", "--size", 96, "--pixel-size", "200nm", "--rms-height", "100nm", "--seed", 5,
+        "--out", topo)
+    cli("simulate", "--topography", topo, "--pixel-size", "200nm", "--radius", "290um",
+        "--modulus", "2GPa", "--model", "hardening", "--hardening", "4MPa/nm",
+        "--forces", "2,4,8mN", "--out", sim, "-q")
+    return sim

@@ -358,15 +358,9 @@ def test_simulate_maps_choice(surface_npy):
     assert stacks & set(gt) == {"contact"} and gt.contact.any()
 
 
-def test_compare_matches_cli(cli, series_tif, tmp_path):
+def test_compare_matches_cli(cli, series_tif, tmp_path, hardening_sim):
     path, s = series_tif
-    sim = tmp_path / "sim"
-    topo = tmp_path / "t.npy"
-    cli("surface", "--size", 96, "--pixel-size", "200nm", "--rms-height", "100nm", "--seed", 5,
-        "--out", topo)
-    cli("simulate", "--topography", topo, "--pixel-size", "200nm", "--radius", "290um",
-        "--modulus", "2GPa", "--model", "hardening", "--hardening", "4MPa/nm",
-        "--forces", "2,4,8mN", "--out", sim, "-q")
+    sim = hardening_sim
     cli("compare", "--micrographs", path, "--forces", "2,4,8mN", "--simulation", sim,
         "--psf-fwhm", "450nm", "--out", tmp_path / "cmp")
     theirs = read_csv(tmp_path / "cmp" / "compare.csv")

@@ -80,16 +80,11 @@ def test_compare_images_are_what_the_scores_count(series_tif, tmp_path):
         assert not (b & outside).any()
 
 
-def test_compare_out_is_the_cli_folder(series_tif, tmp_path, cli):
+def test_compare_out_is_the_cli_folder(series_tif, tmp_path, cli, hardening_sim):
     """compare(out=) writes the command line's compare folder by its own writer: compare.csv
     byte for byte, compare.json equal but for the command recorded, the panels."""
     path, _ = series_tif
-    sim, topo = tmp_path / "sim", tmp_path / "t.npy"
-    cli("surface", "--size", 96, "--pixel-size", "200nm", "--rms-height", "100nm", "--seed", 5,
-        "--out", topo)
-    cli("simulate", "--topography", topo, "--pixel-size", "200nm", "--radius", "290um",
-        "--modulus", "2GPa", "--model", "hardening", "--hardening", "4MPa/nm",
-        "--forces", "2,4,8mN", "--out", sim, "-q")
+    sim = hardening_sim
     cli("compare", "--micrographs", path, "--forces", "2,4,8mN", "--simulation", sim,
         "--psf-fwhm", "450nm", "--out", tmp_path / "cli")
     words = ["contactscope", "compare", "--micrographs", str(path), "--forces", "2,4,8mN",

@@ -425,16 +425,11 @@ def test_sample_and_widget_on_a_layer(viewer):
 
 @needs_napari
 @needs_display
-def test_compare_widget_layers_and_dice(viewer, series_tif, tmp_path, cli):
+def test_compare_widget_layers_and_dice(viewer, series_tif, tmp_path, cli, hardening_sim):
     from contactscope.napari.compare_widget import CompareWidget
 
     path, _ = series_tif
-    sim, topo = tmp_path / "sim", tmp_path / "t.npy"
-    cli("surface", "--size", 96, "--pixel-size", "200nm", "--rms-height", "100nm", "--seed", 5,
-        "--out", topo)
-    cli("simulate", "--topography", topo, "--pixel-size", "200nm", "--radius", "290um",
-        "--modulus", "2GPa", "--model", "hardening", "--hardening", "4MPa/nm",
-        "--forces", "2,4,8mN", "--out", sim, "-q")
+    sim = hardening_sim
     w = CompareWidget(viewer)
     viewer.window.add_dock_widget(w)
     w.simulation.setText(str(sim))

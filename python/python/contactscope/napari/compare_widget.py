@@ -24,9 +24,9 @@ from qtpy.QtWidgets import (QCheckBox, QComboBox, QDoubleSpinBox, QFileDialog, Q
 
 import contactscope as cs
 
-from ._common import ERRORS, META, notify_error, one_line, stem
-from .series_widget import (LOAD_AXES, SeriesRequest, _coloured, _green, selected,
-                            selection_boxes, selection_row)
+from ._common import ERRORS, META, notify_error, one_line
+from .series_widget import (LOAD_AXES, SeriesRequest, _coloured, _green, choose_micrographs,
+                            files_request, selection_boxes, selection_row)
 
 #: The experiment's layers; each simulation adds "<name>: imaged" and "<name>: contact edges".
 LAYERS = ("compared micrographs", "experiment contact edges")
@@ -54,15 +54,10 @@ def compare(request: SeriesRequest, simulation: Any, psf_fwhm_m: float,
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", cs.ContactscopeWarning)
         for name, folder in zip(names, folders):
-            if request.images is not None:
-                result = cs.compare(series, request.forces_n, request.pixel_size_m, folder,
-                                    psf_fwhm=psf_fwhm_m, dihedral=dihedral, images=True)
-                px = request.pixel_size_m
-            else:
-                result = cs.compare(series, None, None, folder, psf_fwhm=psf_fwhm_m,
-                                    dihedral=dihedral, images=True)
-                px = series["pixel_size_m"]
-            results.append((name, result))
+            results.append((name, cs.compare(*request.micrographs(series), folder,
+                                             psf_fwhm=psf_fwhm_m, dihedral=dihedral,
+                                             images=True)))
+    px = request.pixel_size_m if request.images is not None else series["pixel_size_m"]
     return {"results": results, "result": results[0][1], "pixel_size_m": px}
 
 
@@ -73,16 +68,8 @@ def command_line(request: SeriesRequest, simulation: str, psf_fwhm_m: float, dih
         words = ["contactscope-napari", "compare", "--micrographs", request.label]
     else:
         words = ["contactscope", "compare", "--micrographs", *request.inputs]
-    if request.forces_text and not (request.inputs
-                                    and request.inputs[0].lower().endswith(".csv")):
-        words += ["--forces", request.forces_text]
+    words += request.selection_flags()
     words += ["--simulation", simulation, "--psf-fwhm", f"{psf_fwhm_m * 1e9:g}nm"]
-    for flag, value in (("--series", request.series), ("--channel", request.channel),
-                        ("--z", request.z), ("--t", request.t)):
-        if value is not None:
-            words += [flag, str(value)]
-    if request.load_axis is not None:
-        words += ["--load-axis", request.load_axis]
     if dihedral:
         words.append("--dihedral")
     return words + ["--out", out]
@@ -102,13 +89,8 @@ def export(request: SeriesRequest, simulation: Any, psf_fwhm_m: float, dihedral:
         for folder in folders:
             out = os.path.join(parent, f"compare-{model_name(os.fspath(folder))}")
             words = command_line(request, os.fspath(folder), psf_fwhm_m, dihedral, out)
-            if request.images is not None:
-                cs.compare(series, request.forces_n, request.pixel_size_m, folder,
-                           psf_fwhm=psf_fwhm_m, dihedral=dihedral, out=out,
-                           command_line=words)
-            else:
-                cs.compare(series, None, None, folder, psf_fwhm=psf_fwhm_m, dihedral=dihedral,
-                           out=out, command_line=words)
+            cs.compare(*request.micrographs(series), folder, psf_fwhm=psf_fwhm_m,
+                       dihedral=dihedral, out=out, command_line=words)
             written.append(out)
     return written
 
@@ -204,26 +186,17 @@ class CompareWidget(QWidget):
             self.simulation.setText(";".join(known + [name]))
 
     def _browse_files(self) -> None:
-        names, _ = QFileDialog.getOpenFileNames(
-            self, "Micrographs or a manifest", "",
-            "Micrographs (*.tif *.tiff *.czi *.nd2 *.lif);;Manifest (*.csv);;All files (*)")
-        if names:
-            self.paths.setText(";".join(names))
+        choose_micrographs(self, self.paths)
 
     def current_request(self) -> SeriesRequest:
         """The micrograph series the fields describe."""
-        text = self.forces.text().strip()
-        inputs = [p.strip() for p in self.paths.text().split(";") if p.strip()]
-        if not inputs:
-            raise cs.InputError("choose the micrographs: files, a folder or a manifest")
+        request = files_request(self.paths.text(), self.forces.text(),
+                                self.load_axis.currentText(), self.selection,
+                                "choose the micrographs: files, a folder or a manifest")
         if not self.simulations():
             raise cs.InputError("choose the simulation: a folder written by contactscope "
                                 "simulate (or several, one per model)")
-        axis = self.load_axis.currentText()
-        return SeriesRequest(inputs=inputs, forces_text=text,
-                             forces_n=cs.parse_forces(text) if text else None,
-                             load_axis=None if axis == LOAD_AXES[0] else axis,
-                             label=stem(inputs[0]), **selected(self.selection))
+        return request
 
     def simulations(self) -> List[str]:
         """The simulation folders typed or chosen, in order."""

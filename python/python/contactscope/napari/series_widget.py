@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 from qtpy.QtCore import QObject, Signal
@@ -69,11 +69,27 @@ class SeriesRequest:
         """The command line's ``analyze`` with the same selection, writing to ``out``."""
         if self.images is not None:
             words = ["contactscope-napari", "analyze", self.label]
-        elif len(self.inputs) == 1 and self.inputs[0].lower().endswith(".csv"):
+        elif self.is_manifest():
             words = ["contactscope", "analyze", "--manifest", self.inputs[0]]
         else:
             words = ["contactscope", "analyze", *self.inputs]
-        if self.forces_text and not (self.inputs and self.inputs[0].lower().endswith(".csv")):
+        words += self.selection_flags()
+        if self.threshold_text:
+            words += ["--threshold", self.threshold_text]
+        if self.pixel_size_text and self.images is None:
+            words += ["--pixel-size", self.pixel_size_text]
+        return words + ["--out", out]
+
+    def is_manifest(self) -> bool:
+        """Whether the files are one manifest (which gives the forces itself)."""
+        return len(self.inputs) == 1 and self.inputs[0].lower().endswith(".csv")
+
+    def selection_flags(self) -> List[str]:
+        """The command line's flags of this selection shared by its commands: ``--forces``
+        (unless a manifest gives them), ``--series``, ``--channel``, ``--z``, ``--t`` and
+        ``--load-axis``."""
+        words = []
+        if self.forces_text and not self.is_manifest():
             words += ["--forces", self.forces_text]
         for flag, value in (("--series", self.series), ("--channel", self.channel),
                             ("--z", self.z), ("--t", self.t)):
@@ -81,11 +97,14 @@ class SeriesRequest:
                 words += [flag, str(value)]
         if self.load_axis is not None:
             words += ["--load-axis", self.load_axis]
-        if self.threshold_text:
-            words += ["--threshold", self.threshold_text]
-        if self.pixel_size_text and self.images is None:
-            words += ["--pixel-size", self.pixel_size_text]
-        return words + ["--out", out]
+        return words
+
+    def micrographs(self, series: Any) -> Tuple[Any, Optional[List[float]], Optional[Any]]:
+        """``series`` (from :meth:`read`) as the micrographs, forces and pixel size arguments of
+        :func:`contactscope.compare`: a stack with its own, or files that carry theirs."""
+        if self.images is not None:
+            return series, self.forces_n, self.pixel_size_m
+        return series, None, None
 
     def options(self) -> Dict[str, Any]:
         """The analysis' keyword arguments beyond the series: the threshold rule, and the pixel
@@ -257,11 +276,7 @@ class LoadSeriesWidget(QWidget):
             self.selection["z"].setValue(int(round(here[axes.index("Z")])))
 
     def _browse_files(self) -> None:
-        names, _ = QFileDialog.getOpenFileNames(
-            self, "Micrographs or a manifest", "",
-            "Micrographs (*.tif *.tiff *.czi *.nd2 *.lif);;Manifest (*.csv);;All files (*)")
-        if names:
-            self.paths.setText(";".join(names))
+        if choose_micrographs(self, self.paths):
             self.source.setCurrentIndex(0)
 
     def _browse_folder(self) -> None:
@@ -315,11 +330,9 @@ class LoadSeriesWidget(QWidget):
             px = meta.get("pixel_size_m")
             return SeriesRequest(images=data, forces_text=text, forces_n=forces, label=name,
                                  pixel_size_m=None if px is None else tuple(px))
-        inputs = [p.strip() for p in self.paths.text().split(";") if p.strip()]
-        if not inputs:
-            raise cs.InputError("choose micrographs: files, a folder, a manifest or a layer")
-        return SeriesRequest(inputs=inputs, forces_text=text, forces_n=forces, channel=channel,
-                             load_axis=load_axis, label=stem(inputs[0]), **chosen)
+        return files_request(self.paths.text(), self.forces.text(), self.load_axis.currentText(),
+                             self.selection, "choose micrographs: files, a folder, a manifest "
+                             "or a layer")
 
     # Running ---------------------------------------------------------------------------------
 
@@ -525,6 +538,31 @@ def selection_row(boxes: Dict[str, QSpinBox]) -> QHBoxLayout:
 def selected(boxes: Dict[str, QSpinBox]) -> Dict[str, Optional[int]]:
     """The selection the boxes give (``None`` where unset)."""
     return {name: (None if box.value() < 0 else box.value()) for name, box in boxes.items()}
+
+
+def files_request(paths: str, forces: str, load_axis: str, selection: Dict[str, Any],
+                  missing: str) -> SeriesRequest:
+    """The series of files (``;``-separated), forces, load axis and plane typed in a widget;
+    ``missing``: the message when no file is given."""
+    inputs = [p.strip() for p in paths.split(";") if p.strip()]
+    if not inputs:
+        raise cs.InputError(missing)
+    forces = forces.strip()
+    return SeriesRequest(inputs=inputs, forces_text=forces,
+                         forces_n=cs.parse_forces(forces) if forces else None,
+                         load_axis=None if load_axis == LOAD_AXES[0] else load_axis,
+                         label=stem(inputs[0]), **selected(selection))
+
+
+def choose_micrographs(parent: Any, field: Any) -> bool:
+    """A file dialog for micrographs or a manifest; the names chosen go into ``field``
+    (``;``-separated). Whether any were chosen."""
+    names, _ = QFileDialog.getOpenFileNames(
+        parent, "Micrographs or a manifest", "",
+        "Micrographs (*.tif *.tiff *.czi *.nd2 *.lif);;Manifest (*.csv);;All files (*)")
+    if names:
+        field.setText(";".join(names))
+    return bool(names)
 
 
 def _grey_value(text: str) -> float:
