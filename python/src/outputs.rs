@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use pyo3::prelude::*;
 
 use crate::{bad, compute};
-use contactscope_jobs::staging::Staging;
+use contactscope_jobs::staging::{check_out_dir, Staging};
 
 /// Write `files` (pairs of a plain file name and its bytes) as the output folder `out`: all of
 /// them or none, replacing a folder an earlier contactscope run wrote as a whole and refusing any
@@ -38,7 +38,15 @@ fn write_folder(
     })
 }
 
+/// Refuse, before any work, an output folder `write_folder` would refuse (in the way, or
+/// holding files no contactscope run wrote): the command line's `--out` rules, checked early.
+#[pyfunction]
+fn check_out_folder(out: PathBuf) -> PyResult<()> {
+    check_out_dir(&out, &[]).map_err(crate::to_py)
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(write_folder, m)?)?;
+    m.add_function(wrap_pyfunction!(check_out_folder, m)?)?;
     Ok(())
 }

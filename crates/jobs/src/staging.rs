@@ -131,46 +131,62 @@ impl Staging {
     /// Whether the output folder exists and may be replaced (true), does not exist (false), or
     /// must not be touched (an error naming what is in the way).
     fn check_replaceable(&self) -> Result<bool> {
-        let refuse = |reason: String| Error::Output {
-            path: self.out_dir.clone(),
-            reason: format!(
-                "{reason}; nothing was written (choose another {} or remove it)",
-                contactscope_formats::param::Param::Out
-            ),
-        };
-        match fs::symlink_metadata(&self.out_dir) {
-            Err(_) => return Ok(false),
-            Ok(meta) if !meta.is_dir() => {
-                return Err(refuse("is in the way (not a folder)".into()));
-            }
-            Ok(_) => {}
-        }
-        let entries: Vec<(String, PathBuf)> = fs::read_dir(&self.out_dir)
-            .map_err(|e| output_error(&self.out_dir, e))?
-            .filter_map(|e| e.ok())
-            .map(|e| (e.file_name().to_string_lossy().into_owned(), e.path()))
-            .collect();
-        if entries.is_empty() {
-            return Ok(true);
-        }
-        let earlier = earlier_run_files(&self.out_dir).ok_or_else(|| {
-            refuse(format!(
-                "is not empty and was not written by contactscope (no {MARKER})"
-            ))
-        })?;
-        for (name, path) in &entries {
-            if is_input(path, &self.protected) {
-                return Err(input_refusal(path.clone()));
-            }
-            let is_file = fs::symlink_metadata(path).is_ok_and(|m| m.is_file());
-            if name != MARKER && !(is_file && earlier.contains(name)) {
-                return Err(refuse(format!(
-                    "holds '{name}', which no earlier contactscope run wrote there"
-                )));
-            }
-        }
-        Ok(true)
+        replaceable(&self.out_dir, &self.protected)
     }
+}
+
+/// Refuse, before any work, an output folder a run's commit would refuse (in the way, holding
+/// files no contactscope run wrote, or holding one of `inputs`); the commit checks again.
+pub fn check_out_dir(out_dir: &Path, inputs: &[PathBuf]) -> Result<()> {
+    let protected: Vec<PathBuf> = inputs
+        .iter()
+        .filter_map(|p| p.canonicalize().ok())
+        .collect();
+    replaceable(out_dir, &protected).map(|_| ())
+}
+
+/// Whether `out_dir` exists and may be replaced (true), does not exist (false), or must not be
+/// touched (an error naming what is in the way).
+fn replaceable(out_dir: &Path, protected: &[PathBuf]) -> Result<bool> {
+    let refuse = |reason: String| Error::Output {
+        path: out_dir.to_path_buf(),
+        reason: format!(
+            "{reason}; nothing was written (choose another {} or remove it)",
+            contactscope_formats::param::Param::Out
+        ),
+    };
+    match fs::symlink_metadata(out_dir) {
+        Err(_) => return Ok(false),
+        Ok(meta) if !meta.is_dir() => {
+            return Err(refuse("is in the way (not a folder)".into()));
+        }
+        Ok(_) => {}
+    }
+    let entries: Vec<(String, PathBuf)> = fs::read_dir(out_dir)
+        .map_err(|e| output_error(out_dir, e))?
+        .filter_map(|e| e.ok())
+        .map(|e| (e.file_name().to_string_lossy().into_owned(), e.path()))
+        .collect();
+    if entries.is_empty() {
+        return Ok(true);
+    }
+    let earlier = earlier_run_files(out_dir).ok_or_else(|| {
+        refuse(format!(
+            "is not empty and was not written by contactscope (no {MARKER})"
+        ))
+    })?;
+    for (name, path) in &entries {
+        if is_input(path, protected) {
+            return Err(input_refusal(path.clone()));
+        }
+        let is_file = fs::symlink_metadata(path).is_ok_and(|m| m.is_file());
+        if name != MARKER && !(is_file && earlier.contains(name)) {
+            return Err(refuse(format!(
+                "holds '{name}', which no earlier contactscope run wrote there"
+            )));
+        }
+    }
+    Ok(true)
 }
 
 /// The file a run leaves in its output folder: JSON with the names of the files it wrote, so
@@ -398,6 +414,31 @@ mod tests {
         assert_eq!(fs::read(out.join("areas.csv")).unwrap(), b"old");
         let left: Vec<_> = fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(left.len(), 1, "only the output folder, no staging folder");
+    }
+
+    #[test]
+    fn the_early_check_refuses_what_the_commit_would() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("results");
+        check_out_dir(&out, &[]).unwrap(); // new
+        fs::create_dir_all(&out).unwrap();
+        check_out_dir(&out, &[]).unwrap(); // empty
+        fs::write(out.join("notes.txt"), b"mine").unwrap();
+        let err = check_out_dir(&out, &[]).unwrap_err().to_string();
+        assert!(err.contains("not written by contactscope"), "{err}");
+        fs::write(out.join(MARKER), br#"{"files": ["notes.txt"]}"#).unwrap();
+        check_out_dir(&out, &[]).unwrap(); // an earlier run's
+        let input = out.join("notes.txt");
+        assert!(check_out_dir(&out, std::slice::from_ref(&input)).is_err());
+        fs::remove_dir_all(&out).unwrap();
+        fs::write(&out, b"a file").unwrap();
+        let err = check_out_dir(&out, &[]).unwrap_err().to_string();
+        assert!(err.contains("in the way"), "{err}");
+        assert_eq!(
+            fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "nothing written"
+        );
     }
 
     #[test]

@@ -384,8 +384,8 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
         raise _cs.InputError("give heights, surfaces or seeds with surface_spec")
     values = list(values)
     _check_device(device)
-    if out is not None:
-        _check_out(out)
+    if out is not None:  # refused before any ramp runs, as the final write would refuse it
+        _cs.check_out_folder(os.fspath(out))
     n_ramps = (len(maps) + len(seeds)) * len(values)
     with _executor(client, n_ramps, threads_per_task) as ex:
         threads = _Threads(ex, threads_per_task)
@@ -429,22 +429,6 @@ def _parameter_column(family: str) -> Tuple[Optional[str], float]:
 def _check_device(device: str) -> None:
     if device not in ("cpu", "cuda", "auto"):
         raise _cs.InputError(f"device '{device}' is not one of cpu, cuda, auto")
-
-
-def _check_out(out: Any) -> None:
-    """Refuse, before any ramp runs, an output folder the final write would refuse: one in the
-    way (a file) or holding files no contactscope run wrote (the command line's ``--out``
-    rules; the write itself checks again)."""
-    path = os.fspath(out)
-    if not os.path.lexists(path):
-        return
-    if not os.path.isdir(path):
-        raise _cs.FileError(f"cannot write {path}: is in the way (not a folder); nothing was "
-                            "written (choose another out= or remove it)")
-    if os.listdir(path) and not os.path.isfile(os.path.join(path, ".contactscope-run.json")):
-        raise _cs.FileError(f"cannot write {path}: is not empty and was not written by "
-                            "contactscope (no .contactscope-run.json); nothing was written "
-                            "(choose another out= or remove it)")
 
 
 def _write_sweep(out: Any, results: "_SweepResults", modulus: float,
