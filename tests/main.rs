@@ -4,6 +4,7 @@
 //!
 //! | module | what |
 //! |---|---|
+//! | [`batch`] | an archive in one command: folders equal to `analyze`'s, tables (Parquet, CSV), provenance, failures, kills and re-runs |
 //! | [`cli`] | usage, one-line errors, range checks, signals, the hostile-file corpus |
 //! | [`formats`] | every reader against trusted readers' numbers; `info`, `topography`; vendor files in the optics commands |
 //! | [`series`] | load series: the global Otsu threshold, areas, ground truth, vendor load axes, real TIFFs |
@@ -18,6 +19,7 @@
 
 mod common;
 
+mod batch;
 mod cli;
 mod demo;
 mod formats;

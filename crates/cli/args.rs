@@ -31,18 +31,19 @@ impl PixelSizeArg {
 }
 
 /// Normal forces as every command takes them (`--forces`), N: a list `4,10,40mN` or a
-/// log-spaced range `4mN..400mN:12` (`contactscope_formats::units`).
+/// log-spaced range `4mN..400mN:12` (`contactscope_formats::units`), with the text as given
+/// (which `batch` hands on to its samplesheet and its command lines).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Forces(pub Vec<f64>);
+pub struct Forces(pub Vec<f64>, pub String);
 
 /// Forces of micrographs: a 0 in a list is a reference frame (analysed, left out of fits).
 pub fn frame_forces(text: &str) -> std::result::Result<Forces, contactscope_formats::Error> {
-    units::parse_forces(text).map(Forces)
+    units::parse_forces(text).map(|f| Forces(f, text.trim().to_string()))
 }
 
 /// Forces of simulated loads and predictions: every value positive.
 pub fn load_forces(text: &str) -> std::result::Result<Forces, contactscope_formats::Error> {
-    units::parse_loads(text).map(Forces)
+    units::parse_loads(text).map(|f| Forces(f, text.trim().to_string()))
 }
 
 /// The default output folder of one command.

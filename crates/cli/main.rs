@@ -9,6 +9,7 @@ mod signals;
 
 mod analyze;
 mod autocorr;
+mod batch;
 mod compare;
 mod demo;
 mod fit_hardening;
@@ -32,7 +33,7 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 #[derive(Parser)]
 #[command(
     name = "contactscope",
-    version,
+    version = concat!(env!("CARGO_PKG_VERSION"), " (source ", env!("CONTACTSCOPE_SOURCE_REVISION"), ")"),
     about = "Real-contact-area microscopy: confocal load series → contact area versus load"
 )]
 struct Cli {
@@ -50,6 +51,12 @@ enum Command {
         after_help = "Examples:\n  contactscope analyze series.tif --forces 4,10,20,40mN --out results\n  contactscope analyze ramp.czi --load-axis t --forces 1mN..100mN:8 --overlays\n  contactscope analyze my-experiment/   (a folder holding manifest.csv: file,page,force_mN)"
     )]
     Analyze(analyze::Args),
+    /// A lab's archive in one command: every series of a samplesheet or a folder, one table.
+    #[command(
+        long_about = "A lab's archive in one command: every series of a samplesheet (id, input, per-series options, metadata columns) or of a folder walk is analysed as `analyze` would (series/ID), fitted with fit-hardening where a row names a height map (fit/ID), and tabulated: images.parquet/.csv (one row per image), series.parquet/.csv (one row per series), batch.json (provenance), index.html (QC page). A re-run redoes only the series whose inputs, options or outputs changed.\n\nExit status: 0 when every series succeeded, 3 when some failed (their rows in series.csv say why; the tables and the page are written), 1 when the batch could not run.",
+        after_help = "Examples:\n  contactscope batch archive/ --out results   (every folder with manifest.csv, every .czi/.nd2/.lif)\n  contactscope batch --samplesheet sheet.csv --out results --color-by lubricant\n  contactscope batch archive/ --pattern '*.czi' --load-axis t --forces 4mN..400mN:8 --out results"
+    )]
+    Batch(Box<batch::Args>),
     /// Print the global Otsu threshold of all pages of all inputs.
     #[command(
         after_help = "Examples:\n  contactscope threshold series.tif\n  contactscope threshold ramp.czi --channel 0"
@@ -156,8 +163,11 @@ fn main() -> ExitCode {
     // Messages name parameters as flags (`--pixel-size`).
     contactscope_formats::param::set_front_end(contactscope_formats::param::FrontEnd::CommandLine);
     signals::discard_on_interrupt();
+    contactscope_jobs::provenance::set_source_revision(env!("CONTACTSCOPE_SOURCE_REVISION"));
+    let mut some_failed = false;
     let result = match command {
         Command::Analyze(args) => analyze::run(args),
+        Command::Batch(args) => batch::run(*args).map(|all_ok| some_failed = !all_ok),
         Command::Threshold(args) => threshold::run(args),
         Command::Info(args) => info::run(args),
         Command::SynthSeries(args) => synth_series::run(args),
@@ -174,6 +184,8 @@ fn main() -> ExitCode {
         Command::Hertz(args) => hertz::run(args),
     };
     match result {
+        // A batch whose tables are written but some series failed (docs/errors.md).
+        Ok(()) if some_failed => ExitCode::from(3),
         Ok(()) => ExitCode::SUCCESS,
         Err(_) if signals::interrupted() => loop {
             // The signal handler reports and exits; the run's error is a consequence.

@@ -90,7 +90,7 @@ fn every_force_flag_takes_lists_and_ranges_in_one_syntax() {
         assert!(forces_of(&command, "400000mN").is_err(), "{name}: 400 N");
         // A 0 mN reference frame is a micrograph's force, never a simulated one.
         let zero = forces_of(&command, "0,4mN");
-        let micrographs = ["analyze", "compare"].contains(&name.as_str());
+        let micrographs = ["analyze", "batch", "compare"].contains(&name.as_str());
         assert_eq!(zero.is_ok(), micrographs, "{name}: {zero:?}");
         seen.push(name);
     }
@@ -99,6 +99,7 @@ fn every_force_flag_takes_lists_and_ranges_in_one_syntax() {
         seen,
         [
             "analyze",
+            "batch",
             "compare",
             "friction",
             "hertz",

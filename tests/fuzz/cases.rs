@@ -479,6 +479,33 @@ pub const TEMPLATES: &[Template] = &[
         ]
     ),
     t!(
+        "batch-sheet",
+        ["series", "sheet.csv", "t.npy"],
+        [
+            "sheet.csv",
+            "series/series.tif",
+            "series/manifest.csv",
+            "t.npy"
+        ],
+        ["batch", "--samplesheet", "sheet.csv", "--out", "OUT", "-q"]
+    ),
+    t!(
+        "batch-walk",
+        ["series"],
+        ["series/series.tif", "series/manifest.csv"],
+        [
+            "batch",
+            "series",
+            "--pixel-size",
+            "200nm",
+            "--threshold",
+            "1100",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
         "surface",
         [],
         [],

@@ -13,7 +13,8 @@
 //!
 //! Environment: `FUZZ_CASES`, `FUZZ_SEED`, `FUZZ_JOBS` (parallel cases, default 2),
 //! `FUZZ_TIMEOUT_S` (default 20), `FUZZ_MEMORY_MIB` (address-space limit, default 4096),
-//! `FUZZ_KEEP` (folder for failing cases, default `target/fuzz-failures`).
+//! `FUZZ_KEEP` (folder for failing cases, default `target/fuzz-failures`), `FUZZ_ONLY` (only the
+//! templates whose name starts with it, e.g. `batch`).
 
 mod cases;
 mod mutate;
@@ -132,6 +133,7 @@ fn campaign(cases: usize, seed: u64) {
         .iter()
         .chain(vendor::TEMPLATES)
         .filter(|t| t.copies.iter().all(|c| seeds_dir.join(c).exists()))
+        .filter(|t| std::env::var("FUZZ_ONLY").map_or(true, |p| t.name.starts_with(&p)))
         .collect();
 
     let next = AtomicUsize::new(0);

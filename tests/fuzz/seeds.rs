@@ -254,4 +254,13 @@ pub fn build(dir: &Path) {
     };
     fs::write(dir.join("trace.csv"), trace_csv(&trace, &layout)).unwrap();
     squeeze(dir);
+    // A samplesheet of two series (the manifest folder, its TIFF with forces), metadata and a
+    // fit row on the 6.4 µm map.
+    fs::write(
+        dir.join("sheet.csv"),
+        "id,input,forces,pixel_size_nm,topography,topography_pixel_size,radius,modulus,models,sample\n\
+         s1,series,,,,,,,,glass\n\
+         s2,series/series.tif,\"1,2,4mN\",40,t.npy,200nm,20um,3.7GPa,hardening,steel\n",
+    )
+    .unwrap();
 }

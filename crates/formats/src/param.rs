@@ -6,7 +6,7 @@
 //! every name is a flag (or keyword) its front-end really has.
 
 use std::fmt;
-use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::atomic::{AtomicU8, AtomicUsize, Ordering};
 
 /// Who is asking: decides how a [`Param`] is written in messages.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -26,8 +26,36 @@ pub fn set_front_end(front_end: FrontEnd) {
     FRONT_END.store(front_end as u8, Ordering::Relaxed);
 }
 
-/// The front-end set by [`set_front_end`] ([`FrontEnd::Library`] by default).
+/// Sections of work (anywhere in the process) that must be worded as the command line words
+/// them, whatever the front-end: a batch's series, whose folders are exactly what
+/// `contactscope analyze` writes, in every front-end.
+static COMMAND_LINE_SECTIONS: AtomicUsize = AtomicUsize::new(0);
+
+/// While alive, messages name parameters as the command line does ([`FrontEnd::CommandLine`]).
+/// Counted, so that overlapping sections on several threads end only when the last does.
+#[must_use = "the wording holds while the guard lives"]
+pub struct CommandLineWords(());
+
+impl CommandLineWords {
+    /// Start a section worded as the command line.
+    pub fn begin() -> Self {
+        COMMAND_LINE_SECTIONS.fetch_add(1, Ordering::SeqCst);
+        CommandLineWords(())
+    }
+}
+
+impl Drop for CommandLineWords {
+    fn drop(&mut self) {
+        COMMAND_LINE_SECTIONS.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// The front-end set by [`set_front_end`] ([`FrontEnd::Library`] by default), or the command
+/// line inside a [`CommandLineWords`] section.
 pub fn front_end() -> FrontEnd {
+    if COMMAND_LINE_SECTIONS.load(Ordering::SeqCst) > 0 {
+        return FrontEnd::CommandLine;
+    }
     match FRONT_END.load(Ordering::Relaxed) {
         1 => FrontEnd::CommandLine,
         2 => FrontEnd::Python,

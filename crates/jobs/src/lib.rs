@@ -12,6 +12,7 @@
 //! | [`series`] | files, folders and manifests (TIFF, CZI, ND2, LIF) → which page or plane is which load; the file-backed plane source of the series analysis |
 //! | [`heights`] | a height-map file read, filled and detrended as every command takes it |
 //! | [`images`] | a micrograph file or planes in memory, as the optics commands take them |
+//! | [`provenance`] | version, source revision, machine, times, SHA-256 of input files: what `batch.json` records |
 //! | [`staging`] | output folders written to a staging folder and renamed into place atomically; inputs never overwritten |
 //! | [`table`] | small CSV tables whose column names carry the unit (`force_mN`) |
 //! | [`results`] | one command's outputs read by another: `areas.csv`, a `simulate` folder, `psf.json` |
@@ -27,6 +28,7 @@ pub mod lab;
 pub mod mechanics_csv;
 #[cfg(feature = "plots")]
 pub mod plot;
+pub mod provenance;
 pub mod results;
 pub mod series;
 pub mod staging;
@@ -35,6 +37,7 @@ pub mod table;
 
 pub mod analyze;
 pub mod autocorr;
+pub mod batch;
 pub mod compare;
 // The demo writes an HTML report with figures: it needs the `plots` feature.
 #[cfg(feature = "plots")]

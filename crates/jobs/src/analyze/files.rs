@@ -38,6 +38,28 @@ pub fn run_to_folder(
 ) -> Result<(AnalyzeOutcome, Vec<PathBuf>)> {
     request.check()?;
     let open = request.micrographs.open()?;
+    run_open_to_folder(
+        request,
+        &open,
+        out_dir,
+        command_line,
+        images,
+        progress,
+        &|_, _, _| Ok(()),
+    )
+}
+
+/// [`run_to_folder`] on a series already opened, with `observer` also told of every image's
+/// plane and mask as it is measured (the batch's thumbnails and edge checks).
+pub fn run_open_to_folder(
+    request: &AnalyzeRequest,
+    open: &OpenSeries,
+    out_dir: &Path,
+    command_line: &[String],
+    images: ImageOutputs,
+    progress: Progress,
+    observer: ImageSink,
+) -> Result<(AnalyzeOutcome, Vec<PathBuf>)> {
     let inputs: Vec<PathBuf> = open
         .series
         .files
@@ -47,12 +69,11 @@ pub fn run_to_folder(
         .collect();
     let staging = Staging::new(out_dir, &inputs)?;
     let sink = |i: usize, plane: &Plane, mask: &Mask| -> contactscope::Result<()> {
-        Ok(write_image_outputs(
-            &staging, request, &open, images, i, plane, mask,
-        )?)
+        write_image_outputs(&staging, request, open, images, i, plane, mask)?;
+        observer(i, plane, mask)
     };
     let sink: ImageSink = &sink;
-    let outcome = run_open(request, &open, progress, sink)?;
+    let outcome = run_open(request, open, progress, sink)?;
     staging.write("areas.csv", &areas_csv(&outcome)?)?;
     #[cfg(feature = "plots")]
     if outcome.rows.rows.iter().any(super::Row::on_log_axes) {
@@ -203,5 +224,6 @@ pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
             xy: measured,
         }],
         curves,
+        ..Chart::default()
     }
 }

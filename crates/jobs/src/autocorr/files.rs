@@ -85,6 +85,7 @@ pub fn acf_chart(curves: &[AcfCurve], title: &str) -> Chart {
         legend: Legend::UpperRight,
         points: Vec::new(),
         curves: lines,
+        ..Chart::default()
     }
 }
 

@@ -167,6 +167,7 @@ pub fn fit_chart(measured: &Measured, fits: &[ModelFit]) -> Chart {
                     .collect(),
             })
             .collect(),
+        ..Chart::default()
     }
 }
 
@@ -191,6 +192,7 @@ fn misfit_chart(fits: &[ModelFit]) -> Option<Chart> {
                 .collect(),
         }],
         curves: Vec::new(),
+        ..Chart::default()
     })
 }
 
@@ -226,5 +228,6 @@ fn sweep_chart(family: Family, measured: &Measured, rows: &[SweepRow]) -> Chart 
         legend: Legend::UpperLeft,
         points: vec![measured_points(measured)],
         curves,
+        ..Chart::default()
     }
 }

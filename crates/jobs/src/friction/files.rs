@@ -147,6 +147,7 @@ mod plots {
                 .map(|fit| tau_area_curve(traces, fit))
                 .into_iter()
                 .collect(),
+            ..Chart::default()
         }
     }
 
@@ -190,6 +191,7 @@ mod plots {
                 },
             ],
             curves: Vec::new(),
+            ..Chart::default()
         }
     }
 
@@ -218,6 +220,7 @@ mod plots {
                 label: format!("F = τ·A, τ = {tau_mpa:.1} MPa"),
                 xy: vec![(0.0, 0.0), (a_max, tau_mpa * a_max * 1e-3)],
             }],
+            ..Chart::default()
         }
     }
 }

@@ -87,5 +87,6 @@ fn fit_chart(outcome: &HertzOutcome) -> crate::plot::Chart {
             ),
             xy: curve,
         }],
+        ..Chart::default()
     }
 }

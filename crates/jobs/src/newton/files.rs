@@ -110,5 +110,6 @@ fn gap_chart(outcome: &NewtonOutcome) -> crate::plot::Chart {
                 xy: vec![(edge_um, 0.0), (edge_um, top)],
             },
         ],
+        ..Chart::default()
     }
 }

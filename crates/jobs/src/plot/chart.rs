@@ -97,6 +97,9 @@ pub struct Chart {
     pub points: Vec<PointSet>,
     /// Curves, drawn as 2 px solid lines.
     pub curves: Vec<Curve>,
+    /// Curve `j` takes the colour of point set `j` (a fit drawn in its data's colour) instead
+    /// of colours after the point sets'.
+    pub curves_follow_points: bool,
 }
 
 /// What is left of a [`Chart`] after dropping points that log axes cannot show.
@@ -245,7 +248,11 @@ impl Chart {
             }
         }
         for (j, (curve, runs)) in self.curves.iter().zip(&data.curves).enumerate() {
-            let style = series_colour(self.points.len() + j).stroke_width(2);
+            let colour = match self.curves_follow_points {
+                true => series_colour(j),
+                false => series_colour(self.points.len() + j),
+            };
+            let style = colour.stroke_width(2);
             let series = chart
                 .draw_series(runs.iter().map(|run| PathElement::new(run.clone(), style)))
                 .map_err(plot_err)?;
@@ -494,6 +501,7 @@ mod tests {
                     .map(|f| (f, 120.0 * f.powf(0.9)))
                     .collect(),
             }],
+            ..Chart::default()
         }
     }
 

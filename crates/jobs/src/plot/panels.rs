@@ -95,6 +95,57 @@ pub fn edge_panels_png(
     encode_png(&rgb, dim(total_w)?, dim(out_h)?)
 }
 
+/// A small overlay for pages that show many series (the batch's QC page): the micrograph
+/// reduced by whole-pixel boxes to at most `max_side` pixels a side (each thumbnail pixel the
+/// mean of the finite values in its box), grey levels stretched as in [`overlay_png`], and a
+/// thumbnail pixel pure green where its box holds a contact edge pixel (a contact pixel with a
+/// non-contact 4-neighbour inside the image). `contact` is row-major, non-zero for contact.
+///
+/// Errors as [`overlay_png`] on zero or mismatched sizes, and on `max_side` 0.
+pub fn thumbnail_png(
+    values: &[f64],
+    width: usize,
+    height: usize,
+    contact: &[u8],
+    max_side: usize,
+) -> Result<Vec<u8>> {
+    overlay_size(values.len(), width, height, contact.len(), 1)?;
+    if max_side == 0 {
+        return Err(Error::Plot(
+            "a thumbnail needs a size of at least 1 pixel".into(),
+        ));
+    }
+    let factor = width.max(height).div_ceil(max_side).max(1);
+    let (tw, th) = (width.div_ceil(factor), height.div_ceil(factor));
+    let mut sums = vec![(0.0f64, 0u32); tw * th];
+    let mut edges = vec![false; tw * th];
+    let mask: Vec<bool> = contact.iter().map(|&c| c != 0).collect();
+    for y in 0..height {
+        for x in 0..width {
+            let t = (y / factor) * tw + x / factor;
+            let v = values[y * width + x];
+            if v.is_finite() {
+                sums[t].0 += v;
+                sums[t].1 += 1;
+            }
+            if !edges[t] && is_edge(&mask, width, height, x, y) {
+                edges[t] = true;
+            }
+        }
+    }
+    let means: Vec<f64> = sums
+        .iter()
+        .map(|&(s, n)| if n > 0 { s / f64::from(n) } else { f64::NAN })
+        .collect();
+    let grey = grey_levels(&means, stretch_range(&means));
+    let mut rgb = Vec::with_capacity(tw * th * 3);
+    for (g, edge) in grey.iter().zip(&edges) {
+        rgb.extend_from_slice(&if *edge { EDGE_GREEN } else { [*g; 3] });
+    }
+    let dim = |n: usize| u32::try_from(n).map_err(|_| Error::Plot("thumbnail too large".into()));
+    encode_png(&rgb, dim(tw)?, dim(th)?)
+}
+
 /// Checks the overlay inputs; returns the output size in pixels.
 fn overlay_size(
     n_values: usize,
@@ -192,6 +243,26 @@ mod tests {
         }
         values[0] = f64::NAN;
         (values, mask)
+    }
+
+    #[test]
+    fn thumbnails_shrink_by_whole_boxes_and_keep_every_edge() {
+        let (values, mask) = rectangle_scene();
+        let contact: Vec<u8> = mask.iter().map(|&m| u8::from(m)).collect();
+        // 20×10 into at most 5 pixels a side: boxes of 4, a 5×3 thumbnail.
+        let png = thumbnail_png(&values, 20, 10, &contact, 5).unwrap();
+        let img = image::load_from_memory(&png).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (5, 3));
+        for (x, y, p) in img.enumerate_pixels() {
+            // The rectangle x 5..11, y 3..7 has edge pixels in boxes x 1..=2, y 0..=1.
+            let green = (1..=2).contains(&x) && (0..=1).contains(&y);
+            assert_eq!(p.0 == EDGE_GREEN, green, "({x}, {y})");
+        }
+        // No shrinking needed: one box per pixel, the overlay itself.
+        let same = thumbnail_png(&values, 20, 10, &contact, 64).unwrap();
+        assert_eq!(same, overlay_png(&values, 20, 10, &mask, 1).unwrap());
+        assert!(thumbnail_png(&values, 20, 10, &contact, 0).is_err());
+        assert!(thumbnail_png(&values, 20, 9, &contact, 5).is_err());
     }
 
     #[test]

@@ -204,5 +204,6 @@ fn area_plot(outcome: &SimulateOutcome) -> crate::plot::Chart {
             xy,
         }],
         curves,
+        ..Chart::default()
     }
 }

@@ -1,0 +1,506 @@
+//! The record of one series (`records/ID.json` in the batch's folder): what it was made from
+//! (every input file with size, modification time and SHA-256; the options in SI units; the
+//! version), what became of it (status, error, times, the command lines of its folders) and its
+//! numbers (one row per image, the series' fits), from which the batch's tables are built. A
+//! record is written, atomically, after the series' folders: a batch killed at any moment keeps
+//! every series it finished, and the next run redoes only what has no record or a stale one.
+//!
+//! A re-run compares a series with its record ([`Record::staleness`]): options, version, the
+//! input's listing, then each file's size and modification time, and a file's hash only when
+//! those differ. An unchanged archive is re-used without reading a byte of image data.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+use super::options::OutputSettings;
+use crate::error::{Error, Result};
+use crate::provenance::{sha256_file, Stat};
+
+/// How a series ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// Every stage succeeded.
+    Ok,
+    /// A stage failed: the record says which and why.
+    Failed,
+}
+
+impl Status {
+    /// `ok` or `failed`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Failed => "failed",
+        }
+    }
+}
+
+/// One input file as a series used it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileRecord {
+    /// As the batch named it.
+    pub path: String,
+    /// `image`, `manifest` or `topography`; `seen` for a file of a series that failed before
+    /// reading it (size and time only, no hash).
+    pub role: String,
+    /// Canonical path.
+    pub canonical: PathBuf,
+    /// Size, bytes.
+    pub size_bytes: u64,
+    /// Modification time, ns since the Unix epoch.
+    pub modified_ns: u64,
+    /// SHA-256 of the bytes, hex.
+    pub sha256: String,
+}
+
+impl FileRecord {
+    /// Stat and hash a file; also the number of bytes read.
+    pub fn of(path: &Path, role: &str) -> Result<(FileRecord, u64)> {
+        let stat = Stat::of(path)?;
+        let (sha256, bytes) = sha256_file(path)?;
+        let canonical = path.canonicalize().map_err(|e| Error::io(path, e))?;
+        Ok((
+            FileRecord {
+                path: path.display().to_string(),
+                role: role.to_string(),
+                canonical,
+                size_bytes: stat.size_bytes,
+                modified_ns: u64::try_from(stat.modified_ns).unwrap_or(u64::MAX),
+                sha256,
+            },
+            bytes,
+        ))
+    }
+}
+
+impl FileRecord {
+    /// Size and time of a file, without its hash (`sha256` empty); `None` if it cannot be seen.
+    pub fn stat_only(path: &Path, role: &str) -> Option<FileRecord> {
+        let stat = Stat::of(path).ok()?;
+        Some(FileRecord {
+            path: path.display().to_string(),
+            role: role.to_string(),
+            canonical: path.canonicalize().ok()?,
+            size_bytes: stat.size_bytes,
+            modified_ns: u64::try_from(stat.modified_ns).unwrap_or(u64::MAX),
+            sha256: String::new(),
+        })
+    }
+}
+
+/// The input path itself: a folder's listing of image files and manifest (what a folder input
+/// reads), or a file's canonical path.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub struct InputState {
+    /// Canonical path of the input, `None` when it does not exist.
+    pub canonical: Option<PathBuf>,
+    /// For a folder: the names of its TIFF, CZI, ND2, LIF files and `manifest.csv`, sorted.
+    pub listing: Option<Vec<String>>,
+}
+
+impl InputState {
+    /// The state of `input` now.
+    pub fn of(input: &Path) -> InputState {
+        let canonical = input.canonicalize().ok();
+        let listing = input.is_dir().then(|| {
+            let mut names: Vec<String> = std::fs::read_dir(input)
+                .map(|entries| {
+                    entries
+                        .filter_map(|e| e.ok())
+                        .map(|e| e.file_name().to_string_lossy().into_owned())
+                        .filter(|n| {
+                            let l = n.to_ascii_lowercase();
+                            l == "manifest.csv"
+                                || [".tif", ".tiff", ".czi", ".nd2", ".lif"]
+                                    .iter()
+                                    .any(|x| l.ends_with(x))
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            names.sort();
+            names
+        });
+        InputState { canonical, listing }
+    }
+}
+
+/// The command lines that make a series' folders on their own.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub struct CommandLines {
+    /// `contactscope analyze …` (`series/ID`).
+    pub analyze: Vec<String>,
+    /// `contactscope fit-hardening …` (`fit/ID`), for a series with a height map.
+    pub fit_hardening: Option<Vec<String>>,
+}
+
+/// One image's numbers: the columns of `areas.csv`, plus whether its contact touches the
+/// image border.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImageResult {
+    /// The image file relative to the series' input (its folder, or the file's name).
+    pub image: String,
+    /// Page (TIFF) or position along the load axis.
+    pub page: usize,
+    /// Normal force, mN.
+    pub force_mn: Option<f64>,
+    /// Threshold applied.
+    pub threshold: f64,
+    /// Contact pixels.
+    pub contact_pixels: u64,
+    /// Contact area in the series' area unit.
+    pub area: f64,
+    /// Mean intensity over contact pixels.
+    pub mean_intensity: Option<f64>,
+    /// Sum of intensities over contact pixels.
+    pub integrated_intensity: f64,
+    /// Mean intensity elsewhere.
+    pub background_mean: Option<f64>,
+    /// 8-connected patches.
+    pub patches: u64,
+    /// Largest patch, area unit.
+    pub largest_patch: f64,
+    /// Mean pressure, MPa.
+    pub mean_pressure_mpa: Option<f64>,
+    /// √(A/π), length unit of the area unit.
+    pub equivalent_radius: f64,
+    /// Friction force, mN.
+    pub friction_mn: Option<f64>,
+    /// Hertz radius, µm.
+    pub hertz_radius_um: Option<f64>,
+    /// Hertz area, µm².
+    pub hertz_area_um2: Option<f64>,
+    /// A contact pixel lies on the image's border.
+    pub edge_contact: bool,
+}
+
+/// The power law A = c·N^β of a series (N in mN, A in the area unit).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PowerLaw {
+    /// c.
+    pub prefactor: f64,
+    /// β.
+    pub exponent: f64,
+    /// Standard error of β (none for two points).
+    pub exponent_se: Option<f64>,
+    /// R² in log–log.
+    pub r_squared: f64,
+    /// Points fitted.
+    pub points: usize,
+}
+
+/// A series' numbers (what `analyze` gave).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SeriesResult {
+    /// `um2` or `px`.
+    pub area_unit: String,
+    /// Sample type of the images (`uint16`, …).
+    pub sample_type: String,
+    /// Image size, pixels.
+    pub width_px: usize,
+    /// Image size, pixels.
+    pub height_px: usize,
+    /// Threshold method (`otsu-global`, `otsu-per-image`, `manual`).
+    pub threshold_method: String,
+    /// The one threshold of the series (none per image).
+    pub threshold: Option<f64>,
+    /// Pixel size used, µm (x, y).
+    pub pixel_size_um: Option<(f64, f64)>,
+    /// Where it came from (metadata field, or given).
+    pub pixel_size_source: Option<String>,
+    /// The pixel size was given (a samplesheet cell or the batch's default), not read.
+    pub pixel_size_given: bool,
+    /// The batch's own default gave the pixel size (no cell of the row, no file metadata used).
+    pub pixel_size_from_default: bool,
+    /// The first file's metadata pixel size, µm (x, y), when it has one.
+    pub metadata_pixel_size_um: Option<(f64, f64)>,
+    /// The power-law fit.
+    pub power_law: Option<PowerLaw>,
+    /// p of A = N/p, MPa, and its points.
+    pub proportional_mpa: Option<(f64, usize)>,
+    /// Smallest and largest mean pressure, MPa.
+    pub mean_pressure_range_mpa: Option<(f64, f64)>,
+    /// `analyze`'s warnings.
+    pub warnings: Vec<String>,
+    /// One row per image, in load order.
+    pub images: Vec<ImageResult>,
+}
+
+/// What `fit-hardening` gave a series.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct FitSummary {
+    /// k, Pa/m.
+    pub k_pa_per_m: Option<f64>,
+    /// Its standard error.
+    pub k_se_pa_per_m: Option<f64>,
+    /// Misfit (RMS of ln A_sim/A_exp) of the hardening model.
+    pub k_misfit: Option<f64>,
+    /// Penetration hardness p_Y, Pa.
+    pub hardness_pa: Option<f64>,
+    /// Its standard error.
+    pub hardness_se_pa: Option<f64>,
+    /// Misfit of the hardness model.
+    pub hardness_misfit: Option<f64>,
+    /// Misfit of the elastic model.
+    pub elastic_misfit: Option<f64>,
+    /// Misfit of Greenwood–Tripp.
+    pub gt_misfit: Option<f64>,
+    /// The model with the lowest misfit.
+    pub best_model: Option<String>,
+    /// `fit-hardening`'s warnings.
+    pub warnings: Vec<String>,
+}
+
+/// The record of one series.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Record {
+    /// The series id.
+    pub id: String,
+    /// How it ended.
+    pub status: Status,
+    /// The one-line error of a failed series.
+    pub error: Option<String>,
+    /// The stage that failed: `inputs`, `analyze`, `fit-hardening` or `qc`.
+    pub failed_stage: Option<String>,
+    /// contactscope's version.
+    pub contactscope_version: String,
+    /// The source revision it was built from.
+    pub source_revision: String,
+    /// The options, in SI units.
+    pub options: Value,
+    /// The batch-wide output settings.
+    pub settings: OutputSettings,
+    /// The input path's state.
+    pub input: InputState,
+    /// Every input file read.
+    pub files: Vec<FileRecord>,
+    /// Bytes read to hash the inputs.
+    pub bytes_hashed: u64,
+    /// The command lines of its folders.
+    pub command_lines: CommandLines,
+    /// When the series started (RFC 3339).
+    pub started: String,
+    /// When it ended.
+    pub finished: String,
+    /// Wall time, s.
+    pub seconds: f64,
+    /// `analyze`'s numbers (also kept when a later stage failed).
+    pub result: Option<SeriesResult>,
+    /// `fit-hardening`'s numbers.
+    pub fit: Option<FitSummary>,
+}
+
+/// Why a series is analysed again (or `None`: its record still holds).
+pub type Staleness = Option<String>;
+
+impl Record {
+    /// The record's file in the batch folder.
+    pub fn path(out: &Path, id: &str) -> PathBuf {
+        out.join("records").join(format!("{id}.json"))
+    }
+
+    /// Read a record; `None` when there is none, or it cannot be read (then the series is
+    /// done again).
+    pub fn read(out: &Path, id: &str) -> Option<Record> {
+        let bytes = std::fs::read(Record::path(out, id)).ok()?;
+        serde_json::from_slice(&bytes).ok()
+    }
+
+    /// Write the record atomically.
+    pub fn write(&self, out: &Path) -> Result<()> {
+        let bytes = serde_json::to_vec_pretty(self)
+            .map_err(|e| Error::InvalidArgument(format!("record of {}: {e}", self.id)))?;
+        crate::staging::write_atomic(&Record::path(out, &self.id), &bytes)
+    }
+
+    /// Whether the record still describes the series made from `options` on `input` now;
+    /// `Some(reason)` when it must be done again. Hashes a file only when its size or time
+    /// changed, and reports the bytes so read in `hashed`. A file whose time changed but whose
+    /// bytes did not gets its new time in `touched` (the caller re-writes the record).
+    pub fn staleness(
+        &self,
+        options: &Value,
+        settings: &OutputSettings,
+        input: &Path,
+        hashed: &mut u64,
+        touched: &mut bool,
+    ) -> Staleness {
+        if self.contactscope_version != crate::provenance::version() {
+            return Some(format!(
+                "made by contactscope {} (this is {})",
+                self.contactscope_version,
+                crate::provenance::version()
+            ));
+        }
+        if &self.options != options {
+            return Some(changed_options(&self.options, options));
+        }
+        if &self.settings != settings {
+            return Some("the batch's output settings changed".into());
+        }
+        if InputState::of(input) != self.input {
+            return Some(format!("{} changed (its listing or path)", input.display()));
+        }
+        for file in &self.files {
+            let path = Path::new(&file.path);
+            let Ok(stat) = Stat::of(path) else {
+                return Some(format!("{} is gone", file.path));
+            };
+            if stat.size_bytes != file.size_bytes {
+                return Some(format!("{} changed (size)", file.path));
+            }
+            if u64::try_from(stat.modified_ns).ok() != Some(file.modified_ns) {
+                if file.sha256.is_empty() {
+                    // Seen, never hashed (its series failed before reading it): a new time is
+                    // a change.
+                    return Some(format!("{} changed (time)", file.path));
+                }
+                match sha256_file(path) {
+                    Ok((sha, n)) => {
+                        *hashed += n;
+                        if sha != file.sha256 {
+                            return Some(format!("{} changed (content)", file.path));
+                        }
+                        *touched = true;
+                    }
+                    Err(_) => return Some(format!("{} cannot be read", file.path)),
+                }
+            }
+        }
+        None
+    }
+
+    /// The record with the files' current modification times (their bytes are unchanged).
+    pub fn retouched(mut self) -> Record {
+        for file in &mut self.files {
+            if let Ok(stat) = Stat::of(Path::new(&file.path)) {
+                file.modified_ns = u64::try_from(stat.modified_ns).unwrap_or(u64::MAX);
+            }
+        }
+        self
+    }
+}
+
+/// Which options differ, in words.
+fn changed_options(old: &Value, new: &Value) -> String {
+    let keys = |v: &Value| -> Vec<String> {
+        v.as_object()
+            .map(|m| m.keys().cloned().collect())
+            .unwrap_or_default()
+    };
+    let mut names: Vec<String> = keys(old).into_iter().chain(keys(new)).collect();
+    names.sort();
+    names.dedup();
+    let changed: Vec<String> = names
+        .into_iter()
+        .filter(|k| old.get(k) != new.get(k))
+        .collect();
+    format!("options changed: {}", changed.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn record(dir: &Path) -> (Record, PathBuf) {
+        let file = dir.join("a.tif");
+        std::fs::write(&file, b"0123456789").unwrap();
+        let (f, n) = FileRecord::of(&file, "image").unwrap();
+        assert_eq!(n, 10);
+        let record = Record {
+            id: "s1".into(),
+            status: Status::Ok,
+            error: None,
+            failed_stage: None,
+            contactscope_version: crate::provenance::version().into(),
+            source_revision: "unknown".into(),
+            options: json!({"pixel_size": [2e-7, 2e-7]}),
+            settings: OutputSettings::default(),
+            input: InputState::of(&file),
+            files: vec![f],
+            bytes_hashed: n,
+            command_lines: CommandLines::default(),
+            started: String::new(),
+            finished: String::new(),
+            seconds: 0.0,
+            result: None,
+            fit: None,
+        };
+        (record, file)
+    }
+
+    #[test]
+    fn unchanged_inputs_are_not_read_and_changes_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let (record, file) = record(dir.path());
+        let options = record.options.clone();
+        let settings = OutputSettings::default();
+        let (mut hashed, mut touched) = (0, false);
+        let check = |r: &Record, o: &Value, h: &mut u64, t: &mut bool| {
+            r.staleness(o, &settings, &file, h, t)
+        };
+        assert_eq!(check(&record, &options, &mut hashed, &mut touched), None);
+        assert_eq!(
+            (hashed, touched),
+            (0, false),
+            "size and time agree: nothing read"
+        );
+        // New bytes of the same size, the old time put back: not seen, by design.
+        let time = std::fs::metadata(&file).unwrap().modified().unwrap();
+        std::fs::write(&file, b"abcdefghij").unwrap();
+        std::fs::File::options()
+            .write(true)
+            .open(&file)
+            .unwrap()
+            .set_modified(time)
+            .unwrap();
+        assert_eq!(check(&record, &options, &mut hashed, &mut touched), None);
+        // A new time: hashed, and the change found.
+        std::fs::File::options()
+            .write(true)
+            .open(&file)
+            .unwrap()
+            .set_modified(time + std::time::Duration::from_secs(5))
+            .unwrap();
+        let why = check(&record, &options, &mut hashed, &mut touched).unwrap();
+        assert!(why.ends_with("changed (content)"), "{why}");
+        assert_eq!(hashed, 10);
+        // Only touched: same bytes, a new time.
+        std::fs::write(&file, b"0123456789").unwrap();
+        let (mut hashed, mut touched) = (0, false);
+        assert_eq!(check(&record, &options, &mut hashed, &mut touched), None);
+        assert!(touched);
+        let retouched = record.clone().retouched();
+        let (mut hashed, mut touched) = (0, false);
+        assert_eq!(check(&retouched, &options, &mut hashed, &mut touched), None);
+        assert_eq!((hashed, touched), (0, false));
+        // Options, size, a missing file.
+        let why = check(
+            &record,
+            &json!({"pixel_size": [1e-7, 1e-7]}),
+            &mut 0,
+            &mut false,
+        );
+        assert_eq!(why.as_deref(), Some("options changed: pixel_size"));
+        std::fs::write(&file, b"0123").unwrap();
+        assert!(check(&record, &options, &mut 0, &mut false)
+            .unwrap()
+            .ends_with("(size)"));
+        std::fs::remove_file(&file).unwrap();
+        assert!(check(&record, &options, &mut 0, &mut false).is_some());
+    }
+
+    #[test]
+    fn records_round_trip_exactly() {
+        let dir = tempfile::tempdir().unwrap();
+        let (mut record, _) = record(dir.path());
+        record.seconds = 0.1 + 0.2;
+        record.write(dir.path()).unwrap();
+        assert_eq!(Record::read(dir.path(), "s1"), Some(record));
+        assert_eq!(Record::read(dir.path(), "s2"), None);
+    }
+}

@@ -1,0 +1,8 @@
+//! Build script of the Python package: records the source revision
+//! (`crates/jobs/build/revision.rs`).
+
+include!("../crates/jobs/build/revision.rs");
+
+fn main() {
+    emit_source_revision("..");
+}

@@ -1,0 +1,98 @@
+//! The folder walk: manifest folders (nested) and files matching a pattern become series with
+//! the batch's defaults; the walk writes the samplesheet it used, which repeats the run exactly
+//! (every series re-used), and a hand-edited samplesheet is never overwritten by a new walk.
+
+use super::{batch, batch_ok, cells, counts, csv, synth};
+use crate::common::stderr;
+
+#[test]
+fn a_walk_writes_the_samplesheet_it_used() {
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let archive = dir.join("archive");
+    synth(&archive.join("glass"), "run2", 1, &[]);
+    synth(&archive.join("glass"), "run10", 2, &[]);
+    let loose = synth(&archive, "loose", 3, &[]);
+    std::fs::remove_file(loose.join("manifest.csv")).unwrap();
+    std::fs::rename(loose.join("series.tif"), archive.join("steel-ramp.tif")).unwrap();
+    std::fs::remove_dir_all(&loose).unwrap();
+    // The output folder inside the archive is not walked into.
+    let args = [
+        "archive",
+        "--pattern",
+        "*.tif",
+        "--forces",
+        "1,2,4,8mN",
+        "--pixel-size",
+        "200nm",
+        "--out",
+        "archive/results",
+    ];
+    let stdout = batch_ok(dir, &args);
+    assert_eq!(counts(&stdout), (3, 0), "{stdout}");
+    let sheet = std::fs::read_to_string(archive.join("results/samplesheet.csv")).unwrap();
+    assert_eq!(
+        sheet,
+        "id,input,forces,pixel_size\n\
+         glass-run2,../glass/run2,,200nm\n\
+         glass-run10,../glass/run10,,200nm\n\
+         steel-ramp,../steel-ramp.tif,\"1,2,4,8mN\",200nm\n"
+    );
+    let series = csv(&archive.join("results/series.csv"));
+    assert_eq!(
+        cells(&series, "series_id"),
+        ["glass-run2", "glass-run10", "steel-ramp"]
+    );
+    // The manifests give their own forces; the default applies to the loose file only.
+    let images = csv(&archive.join("results/images.csv"));
+    assert_eq!(images.1.len(), 12);
+    // The pixel size came from the batch's default: flagged.
+    assert!(cells(&series, "flags")
+        .iter()
+        .all(|f| f.contains("pixel_size_default")));
+    assert_eq!(
+        cells(&series, "pixel_size_source")[0],
+        "batch default (pixel_size)"
+    );
+
+    // The samplesheet repeats the run: everything re-used, the same tables.
+    let before = std::fs::read(archive.join("results/series.parquet")).unwrap();
+    let stdout = batch_ok(
+        dir,
+        &[
+            "--samplesheet",
+            "archive/results/samplesheet.csv",
+            "--out",
+            "archive/results",
+        ],
+    );
+    assert_eq!(counts(&stdout), (0, 3), "{stdout}");
+    let after = std::fs::read(archive.join("results/series.parquet")).unwrap();
+    assert_eq!(
+        super::parquet(&archive.join("results/series.parquet"))
+            .1
+            .len(),
+        3
+    );
+    // The input column says how the series were named (the walk's paths, then the sheet's).
+    assert_ne!(before, after);
+
+    // Edited by hand, the samplesheet is not overwritten by another walk.
+    std::fs::write(
+        archive.join("results/samplesheet.csv"),
+        sheet
+            .replace(
+                "id,input,forces,pixel_size",
+                "id,input,forces,pixel_size,sample",
+            )
+            .replace("200nm\n", "200nm,x\n"),
+    )
+    .unwrap();
+    let o = batch(dir, &args);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("edited since the last walk"),
+        "{}",
+        stderr(&o)
+    );
+}
