@@ -204,8 +204,8 @@ pub fn run(args: Args) -> Result<bool> {
         ..BatchRequest::new(source, args.out.clone())
     };
     let plan = batch::plan(request)?;
-    let todo: Vec<_> = plan.to_run().cloned().collect();
-    let bar = progress_bar(todo.len(), 1, args.quiet.quiet);
+    let todo = plan.to_run().count();
+    let bar = progress_bar(todo, 1, args.quiet.quiet);
     bar.set_style(
         ProgressStyle::with_template(
             "[{bar:40}] {pos}/{len} series ({elapsed}, about {eta} left) {msg}",
@@ -217,20 +217,18 @@ pub fn run(args: Args) -> Result<bool> {
         eprintln!(
             "batch: {} series, {} to analyse, {} unchanged",
             plan.tasks.len(),
-            todo.len(),
-            plan.tasks.len() - todo.len()
+            todo,
+            plan.tasks.len() - todo
         );
     }
-    let mut fresh = Vec::with_capacity(todo.len());
-    for task in &todo {
-        bar.set_message(task.id.clone());
-        let record = batch::run_series(task);
+    let report = |record: &batch::Record, _: usize, _: usize| {
         if let Some(e) = &record.error {
             bar.suspend(|| eprintln!("contactscope: series {} failed: {e}", record.id));
         }
+        bar.set_message(record.id.clone());
         bar.inc(1);
-        fresh.push(record);
-    }
+    };
+    let fresh = batch::run_planned(&plan, &report);
     bar.finish_and_clear();
     let outcome = batch::finish(plan, fresh)?;
     print_warnings(&outcome.warnings);

@@ -17,6 +17,7 @@ use pyo3::prelude::*;
 
 use contactscope_jobs::Error;
 
+mod batch;
 mod compare;
 mod convert;
 mod fit;
@@ -206,15 +207,18 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     // Messages name parameters as keywords (`pixel_size=`).
     contactscope_formats::param::set_front_end(contactscope_formats::param::FrontEnd::Python);
+    contactscope_jobs::provenance::set_source_revision(env!("CONTACTSCOPE_SOURCE_REVISION"));
     m.add_function(wrap_pyfunction!(_params, m)?)?;
     m.add("InputError", py.get_type::<InputError>())?;
     m.add("FileError", py.get_type::<FileError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add("InternalError", py.get_type::<InternalError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("__source_revision__", env!("CONTACTSCOPE_SOURCE_REVISION"))?;
     m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
     images::register(m)?;
+    batch::register(m)?;
     compare::register(m)?;
     fit::register(m)?;
     info::register(m)?;

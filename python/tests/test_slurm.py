@@ -138,3 +138,25 @@ def test_a_job_cancelled_mid_sweep_loses_nothing(slurm):
     for a, b in zip(on_slurm.rows, serial.rows):
         assert a["error"] is None and a["parameter"] == b["parameter"]
         np.testing.assert_array_equal(a["areas_m2"], b["areas_m2"])
+
+
+def test_a_batch_on_slurm_equals_the_command_line(slurm, cli, tmp_path):
+    """The same samplesheet as a batch on the command line and as Dask tasks in Slurm jobs:
+    the same tables, byte for byte; every series' folder and record written by the workers."""
+    _, client = slurm
+    for i in range(4):
+        folder = tmp_path / f"s{i}"
+        folder.mkdir()
+        s = cs.synth_series(128, 128, 200e-9, [1e-3, 2e-3, 4e-3], seed=20 + i)
+        cs.write_tiff(folder / "series.tif", s.images, 200e-9)
+    (tmp_path / "sheet.csv").write_text(
+        "id,input,forces,sample\n" + "".join(
+            f's{i},s{i}/series.tif,"1,2,4mN",{"ab"[i % 2]}\n' for i in range(4)))
+    cli("batch", "--samplesheet", tmp_path / "sheet.csv", "--out", tmp_path / "cli", "-q")
+    result = dd.batch(tmp_path / "sheet.csv", tmp_path / "slurm", client=client)
+    assert result.outcome["analysed"] == 4 and result.outcome["failed"] == 0
+    for name in ["images.csv", "series.csv", "images.parquet", "series.parquet"]:
+        assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "slurm" / name).read_bytes()
+    for i in range(4):
+        assert (tmp_path / "slurm" / "series" / f"s{i}" / "areas.csv").is_file()
+        assert (tmp_path / "slurm" / "records" / f"s{i}.json").is_file()

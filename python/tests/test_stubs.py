@@ -72,6 +72,8 @@ def results(tmp_path, friction_inputs):  # noqa: F811
     np.save(npy, heights)
     sim = cs.simulate(heights, 1e-7, 1e9, [2e-5, 4e-5], "hardening", k=4e15, radius=2e-5)
     traces, areas = friction_inputs
+    sheet = tmp_path / "sheet.csv"
+    sheet.write_text(f'id,input,forces\ns1,{tif},"2,4,8mN"\n')
     spec = {"inputs": [str(tif)], "manifest": None, "series": None, "channel": None, "z": None,
             "t": None, "axes": None, "load_axis": None, "forces": forces}
     return {
@@ -93,6 +95,7 @@ def results(tmp_path, friction_inputs):  # noqa: F811
         "hertz": cs.hertz(squeeze_csv(tmp_path / "sq.csv"), 290e-6),
         "info": cs.info(tif, stats=True),
         "synth_series": cs.synth_series(96, 96, 2e-7, forces),
+        "batch": ext.batch("file", str(sheet), str(tmp_path / "batch")),
     }
 
 

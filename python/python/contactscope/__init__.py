@@ -815,3 +815,7 @@ def write_tiff(path: PathLike, stack: Any, pixel_size: Optional[PixelSize] = Non
 
 
 __all__ += ["synth_series", "synth_beads", "synth_newton", "write_tiff"]
+
+from .archive import BatchResult, batch  # noqa: E402  (uses the names above)
+
+__all__ += ["batch", "BatchResult"]

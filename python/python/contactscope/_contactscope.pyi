@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+__source_revision__: str
 
 PixelSize = Union[float, Tuple[float, float], Sequence[float]]
 Path = Union[str, PathLike[str]]
@@ -684,4 +685,47 @@ def write_tiff(
     pixel_size: Optional[PixelSize] = None,
 ) -> None: ...
 def write_folder(out: Path, files: Sequence[Tuple[str, bytes]]) -> List[Path]: ...
+
+# The batch (contactscope.batch, contactscope.distributed.batch): a table as its columns, each
+# (name, kind: "float" | "int" | "text" | "bool", values with None for nulls).
+TableColumns = List[Tuple[str, str, List[Any]]]
+
+class BatchOutcome(TypedDict):
+    series: int
+    ok: int
+    failed: int
+    analysed: int
+    reused: int
+    image_rows: int
+    written: List[str]
+    tables_seconds: float
+    warnings: List[str]
+    failures: List[List[str]]
+    bytes_hashed: int
+    images_table: TableColumns
+    series_table: TableColumns
+
+def batch(
+    kind: str, source: str, out: Path, base: Optional[Path] = None,
+    patterns: Sequence[str] = ..., tiff_folders: bool = False,
+    options: Dict[str, str] = ..., overlays: bool = False, save_masks: bool = False,
+    memory_mib: int = 128, device: str = "cpu", rerun: str = "changed",
+    color_by: Optional[str] = None, command_line: Sequence[str] = ...,
+    progress: Optional[Callable[[str, int, int], None]] = None,
+) -> BatchOutcome: ...
+
+class BatchPlan:
+    def tasks(self) -> List[str]: ...
+    def counts(self) -> Tuple[int, int]: ...
+    def finish(self, records: Sequence[str]) -> BatchOutcome: ...
+
+def batch_plan(
+    kind: str, source: str, out: Path, base: Optional[Path] = None,
+    patterns: Sequence[str] = ..., tiff_folders: bool = False,
+    options: Dict[str, str] = ..., overlays: bool = False, save_masks: bool = False,
+    memory_mib: int = 128, device: str = "cpu", rerun: str = "changed",
+    color_by: Optional[str] = None, command_line: Sequence[str] = ...,
+) -> BatchPlan: ...
+
+def batch_series(task: str) -> str: ...
 def check_out_folder(out: Path) -> None: ...

@@ -40,7 +40,7 @@ import numpy as np
 
 from . import FitResults, Results, _cs, _f64
 
-__all__ = ["local_client", "sweep", "fit_hardening", "brent_minimum", "thread_plan"]
+__all__ = ["local_client", "sweep", "fit_hardening", "batch", "brent_minimum", "thread_plan"]
 
 #: A misfit standing for an infeasible parameter in the Brent search (misfits are RMS log
 #: ratios, of order 1), as in the library's own fit.
@@ -262,10 +262,11 @@ class _Serial:
     def submit(self, fn: Callable, *args: Any, **_: Any) -> Any:
         # Results of earlier tasks stand for their values, as Dask futures do.
         done = _Done(fn(*(a.value if isinstance(a, _Done) else a for a in args)))
-        if self.report and fn is _ramp_task:
+        if self.report and fn in (_ramp_task, _batch_task):
             self.ramps += 1
             of = f" of {self.expected}" if self.expected else ""
-            print(f"contactscope: ramp {self.ramps}{of} done", file=sys.stderr, flush=True)
+            what = "ramp" if fn is _ramp_task else "series"
+            print(f"contactscope: {what} {self.ramps}{of} done", file=sys.stderr, flush=True)
         return done
 
     def gather(self, futures: Sequence[Any]) -> List[Any]:
@@ -415,6 +416,59 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
     if out is not None:
         _write_sweep(out, results, modulus=float(modulus), radius=radius, device=device)
     return results
+
+
+def _batch_task(task: str, threads: Plan) -> str:
+    """One series of a batch on a worker: its folders, thumbnail and record written into the
+    batch's folder (which the workers share), the record returned as JSON."""
+    _threads(threads)
+    return _cs.batch_series(task)
+
+
+def batch(samplesheet: Any, out: Any, *, client: Any = None, base: Any = None,
+          patterns: Optional[Sequence[str]] = None, tiff_folders: bool = False,
+          rerun: str = "changed", color_by: Optional[str] = None, overlays: bool = False,
+          save_masks: bool = False, memory_mib: int = 128, device: str = "cpu",
+          threads_per_task: Optional[int] = None, progress: bool = False,
+          **options: Any) -> "BatchResult":
+    """:func:`contactscope.batch` with one Dask task per series: the same folder, and the same
+    tables byte for byte as the command line's ``contactscope batch`` over the same
+    samplesheet. The plan (the samplesheet checked, the folder taken, which series changed) and
+    the tables are made here; each series to do runs on a worker, which writes its folders,
+    thumbnail and record into ``out`` — the workers must see the same file system (a local
+    cluster, or a Slurm cluster's shared disk). Paths are made absolute first, so that workers
+    started in another folder find the inputs; the ``input`` column keeps the samplesheet's own
+    text (a folder walk's ``input`` is then the absolute path).
+
+    ``client``, ``threads_per_task`` and ``progress`` as in :func:`sweep`; the other arguments
+    as :func:`contactscope.batch`. A worker lost in the middle of a series loses nothing: Dask
+    runs the task again, which rewrites the series' folders whole.
+    """
+    from .archive import BatchResult, _request
+
+    if not (hasattr(samplesheet, "to_csv") and hasattr(samplesheet, "columns")):
+        samplesheet = os.path.abspath(os.fspath(samplesheet))
+    if base is not None:
+        base = os.path.abspath(os.fspath(base))
+    elif hasattr(samplesheet, "to_csv"):
+        base = os.getcwd()
+    request = _request(samplesheet, os.path.abspath(os.fspath(out)), base, patterns,
+                       tiff_folders, rerun, color_by, overlays, save_masks, memory_mib, device,
+                       options, "contactscope.distributed.batch")
+    plan = _cs.batch_plan(**request)
+    tasks = plan.tasks()
+    with _executor(client, len(tasks), threads_per_task) as ex:
+        threads = _Threads(ex, threads_per_task)
+        show = _Progress(ex, progress)
+        total, reused = plan.counts()
+        show.note(f"batch: {total} series, {len(tasks)} to analyse, {reused} unchanged")
+        show.expect(len(tasks))
+        per_task = threads.plan(len(tasks))
+        # Not pure: a task writes files, and Dask must run each one (none is a duplicate).
+        futures = [ex.submit(_batch_task, task, per_task, pure=False) for task in tasks]
+        show(futures)
+        records = ex.gather(futures)
+    return BatchResult(plan.finish(records))
 
 
 def _parameter_column(family: str) -> Tuple[Optional[str], float]:

@@ -127,21 +127,43 @@ fn classify(plane: &Plane, rule: ContactRule, mask: &mut [u8]) -> (ClassSums, Cl
     }
 }
 
-/// Integer classification with exact integer sums (the hot loop of a series analysis).
+/// Pixels per block of [`classify_codes`] whose sums fit a `u32`: 4096 × 65 535 < 2³².
+const SUM_BLOCK: usize = 4096;
+
+/// Integer classification with exact integer sums (the hot loop of a series analysis). The sums
+/// run in `u32` over blocks of [`SUM_BLOCK`] pixels, added up in `u64`: exact, and a loop the
+/// compiler vectorises (0.54 → 0.33 ms per 1024² image on the 2-core development machine).
 fn classify_codes(
     codes: &[u16],
     offset: i32,
     code_threshold: i64,
     mask: &mut [u8],
 ) -> (ClassSums, ClassSums) {
-    let k = code_threshold.clamp(-1, i64::from(u16::MAX));
     let (mut n_contact, mut s_contact, mut s_all) = (0u64, 0u64, 0u64);
-    for (m, &c) in mask.iter_mut().zip(codes) {
-        let is_contact = i64::from(c) > k;
-        *m = u8::from(is_contact);
-        n_contact += u64::from(is_contact);
-        s_contact += u64::from(c) * u64::from(is_contact);
-        s_all += u64::from(c);
+    if code_threshold < 0 {
+        mask.fill(1);
+        n_contact = codes.len() as u64;
+        s_all = codes.iter().map(|&c| u64::from(c)).sum();
+        s_contact = s_all;
+    } else if code_threshold < i64::from(u16::MAX) {
+        let k = code_threshold as u16;
+        for (m, c) in mask.chunks_mut(SUM_BLOCK).zip(codes.chunks(SUM_BLOCK)) {
+            let (mut n, mut sc, mut sa) = (0u32, 0u32, 0u32);
+            for (m, &c) in m.iter_mut().zip(c) {
+                let is_contact = c > k;
+                *m = u8::from(is_contact);
+                n += u32::from(is_contact);
+                sc += if is_contact { u32::from(c) } else { 0 };
+                sa += u32::from(c);
+            }
+            n_contact += u64::from(n);
+            s_contact += u64::from(sc);
+            s_all += u64::from(sa);
+        }
+    } else {
+        // Nothing lies above the largest code.
+        mask.fill(0);
+        s_all = codes.iter().map(|&c| u64::from(c)).sum();
     }
     let n_background = codes.len() as u64 - n_contact;
     let with_offset = |sum: u64, n: u64| sum as f64 + f64::from(offset) * n as f64;
@@ -203,6 +225,37 @@ mod tests {
         assert_eq!(m.background_mean, Some(32.0 / 3.0));
         assert_eq!(m.patches, 1);
         assert_eq!(m.largest_patch_pixels, 3);
+    }
+
+    #[test]
+    fn block_sums_equal_the_plain_sums_at_every_threshold() {
+        // Three blocks and a remainder, codes over the whole u16 range.
+        let codes: Vec<u16> = (0..3 * SUM_BLOCK + 77)
+            .map(|i| ((i as u64 * 2_654_435_761) % 65_536) as u16)
+            .collect();
+        for k in [-5i64, -1, 0, 1, 1000, 32_767, 65_534, 65_535, 70_000] {
+            let mut mask = vec![7u8; codes.len()];
+            let (contact, background) = classify_codes(&codes, 0, k, &mut mask);
+            let above: Vec<bool> = codes.iter().map(|&c| i64::from(c) > k).collect();
+            let n = above.iter().filter(|&&a| a).count() as u64;
+            let s: u64 = codes
+                .iter()
+                .zip(&above)
+                .filter(|(_, &a)| a)
+                .map(|(&c, _)| u64::from(c))
+                .sum();
+            let all: u64 = codes.iter().map(|&c| u64::from(c)).sum();
+            assert_eq!((contact.count, contact.sum), (n, s as f64), "k = {k}");
+            assert_eq!(
+                (background.count, background.sum),
+                (codes.len() as u64 - n, (all - s) as f64),
+                "k = {k}"
+            );
+            assert!(
+                mask.iter().zip(&above).all(|(&m, &a)| m == u8::from(a)),
+                "k = {k}"
+            );
+        }
     }
 
     #[test]

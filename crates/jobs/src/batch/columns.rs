@@ -2,6 +2,9 @@
 //! the flags (`docs/outputs.md` describes every column). Both tables start with `series_id` and
 //! the metadata columns, so that either can be grouped and filtered by them alone.
 //!
+//! Every absent value is a null (an empty CSV cell), an empty list of flags or warnings too, so
+//! that the CSV and the Parquet file say the same.
+//!
 //! Area columns follow `areas.csv`: `_um2` (and `_um`) for series with a pixel size, `_px` for
 //! series without one; the `_px` columns exist only when some series is in pixels, and the
 //! `friction_mN` and Hertz columns only when some series has them.
@@ -269,9 +272,10 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
     }
     t.text(
         "flags",
-        entries
-            .iter()
-            .map(|e| Some(e.flags.iter().map(|f| f.code).collect::<Vec<_>>().join(","))),
+        entries.iter().map(|e| {
+            let codes: Vec<&str> = e.flags.iter().map(|f| f.code).collect();
+            (!codes.is_empty()).then(|| codes.join(","))
+        }),
     );
     t.text(
         "warnings",
@@ -288,7 +292,7 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
                     .iter()
                     .flat_map(|f| f.warnings.iter().map(|w| format!("fit-hardening: {w}"))),
             );
-            Some(all.join(" | "))
+            (!all.is_empty()).then(|| all.join(" | "))
         }),
     );
     t.text(

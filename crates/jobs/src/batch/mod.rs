@@ -513,6 +513,12 @@ pub struct BatchOutcome {
     pub failures: Vec<(String, String)>,
     /// Bytes of input files hashed (new series, and files whose time changed).
     pub bytes_hashed: u64,
+    /// The image table as written.
+    #[serde(skip)]
+    pub images: tables::Table,
+    /// The series table as written.
+    #[serde(skip)]
+    pub series_table: tables::Table,
 }
 
 /// Write the tables, the QC page and `batch.json` from every series' record (`fresh` holds
@@ -591,18 +597,21 @@ pub fn finish(plan: Plan, fresh: Vec<Record>) -> Result<BatchOutcome> {
             .filter(|(_, d)| d.run)
             .map(|(r, _)| r.bytes_hashed)
             .sum::<u64>();
+    let image_rows = images.rows;
     let outcome = BatchOutcome {
         series: records.len(),
         ok: records.len() - failures.len(),
         failed: failures.len(),
         analysed: plan.decisions.iter().filter(|d| d.run).count(),
         reused: plan.decisions.iter().filter(|d| !d.run).count(),
-        image_rows: images.rows,
+        image_rows,
         written,
         tables_seconds,
         warnings,
         failures,
         bytes_hashed,
+        images,
+        series_table: series,
     };
     let json = provenance_json(&plan, &records, &outcome, qc_seconds);
     let path = out.join("batch.json");
@@ -726,21 +735,33 @@ fn provenance_json(plan: &Plan, records: &[Record], outcome: &BatchOutcome, qc_s
     })
 }
 
-/// A batch in this process: [`plan`], every series to do in samplesheet order ([`run_series`];
-/// `progress` is told after each, with the record, its position among those run, and how
-/// many run), [`finish`].
-pub fn run(
-    request: BatchRequest,
-    progress: &dyn Fn(&Record, usize, usize),
-) -> Result<BatchOutcome> {
-    let plan = plan(request)?;
+/// Progress of a batch in this process: told after each series with its record, how many are
+/// done and how many run; called from the threads doing the work.
+pub type SeriesProgress<'a> = &'a (dyn Fn(&Record, usize, usize) + Sync);
+
+/// Every series of the plan that runs ([`run_series`]), on this process's thread pool: series
+/// run side by side (rayon's work stealing also shares each series' images and hashing among
+/// the threads), so that one series' serial work (opening files, plots, writing its folder)
+/// overlaps another's analysis. The records in samplesheet order.
+pub fn run_planned(plan: &Plan, progress: SeriesProgress) -> Vec<Record> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
     let todo: Vec<&SeriesTask> = plan.to_run().collect();
-    let mut fresh = Vec::with_capacity(todo.len());
-    for (i, task) in todo.iter().enumerate() {
-        let record = run_series(task);
-        progress(&record, i + 1, todo.len());
-        fresh.push(record);
-    }
+    let done = AtomicUsize::new(0);
+    todo.par_iter()
+        .with_max_len(1)
+        .map(|task| {
+            let record = run_series(task);
+            progress(&record, done.fetch_add(1, Ordering::SeqCst) + 1, todo.len());
+            record
+        })
+        .collect()
+}
+
+/// A batch in this process: [`plan`], [`run_planned`], [`finish`].
+pub fn run(request: BatchRequest, progress: SeriesProgress) -> Result<BatchOutcome> {
+    let plan = plan(request)?;
+    let fresh = run_planned(&plan, progress);
     finish(plan, fresh)
 }
 

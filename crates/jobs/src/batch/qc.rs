@@ -95,10 +95,23 @@ pub fn write_page(
     let combined = combined_plot(entries, &label);
     #[cfg(feature = "plots")]
     if let Some(chart) = &combined {
-        let png = out.join("qc").join("area_vs_load.png");
-        crate::staging::write_atomic(&png, &chart.to_png()?)?;
-        let svg = out.join("qc").join("area_vs_load.svg");
-        crate::staging::write_atomic(&svg, chart.to_svg()?.as_bytes())?;
+        let qc = out.join("qc");
+        let (png, svg, digest) = (
+            qc.join("area_vs_load.png"),
+            qc.join("area_vs_load.svg"),
+            qc.join("area_vs_load.sha256"),
+        );
+        // The plot of an unchanged archive is not drawn again (most of a re-run's time): its
+        // data's digest is kept beside it.
+        let data = crate::provenance::sha256_bytes(format!("{chart:?}").as_bytes());
+        let same = std::fs::read_to_string(&digest).is_ok_and(|d| d == data)
+            && png.is_file()
+            && svg.is_file();
+        if !same {
+            crate::staging::write_atomic(&png, &chart.to_png()?)?;
+            crate::staging::write_atomic(&svg, chart.to_svg()?.as_bytes())?;
+            crate::staging::write_atomic(&digest, data.as_bytes())?;
+        }
         written.extend([png, svg]);
     }
     let html = page(plan, entries, images, colour, combined.is_some(), warnings);
@@ -191,15 +204,18 @@ fn force_range(points: &[(f64, f64, bool)]) -> (f64, f64) {
     })
 }
 
-/// A small inline log–log plot of a series: its points, its power law, the extreme values.
+/// A small inline log–log plot of a series: its points, its power law, the extreme values
+/// (the column's header gives the units).
 fn mini_plot(r: &SeriesResult) -> String {
     let points = loaded_points(r);
     if points.is_empty() {
         return "<span class=\"none\">no loaded image with contact</span>".into();
     }
-    let (w, h, m) = (180.0, 120.0, 14.0);
-    let (x0, x1) = force_range(&points);
-    let (y0, y1) = points.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
+    // Plot area x0..x1 (right of the y labels), y0..y1 (above the x labels).
+    let (w, h) = (200.0, 118.0);
+    let (left, right, top, bottom) = (38.0, 194.0, 7.0, 100.0);
+    let (f0, f1) = force_range(&points);
+    let (a0, a1) = points.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
         (lo.min(p.1), hi.max(p.1))
     });
     let span = |lo: f64, hi: f64| {
@@ -209,25 +225,27 @@ fn mini_plot(r: &SeriesResult) -> String {
             (lo.ln() - 0.5, lo.ln() + 0.5)
         }
     };
-    let ((lx0, lx1), (ly0, ly1)) = (span(x0, x1), span(y0, y1));
-    let px = |x: f64| m + (x.ln() - lx0) / (lx1 - lx0) * (w - 2.0 * m);
-    let py = |y: f64| h - m - (y.ln() - ly0) / (ly1 - ly0) * (h - 2.0 * m);
+    let ((lx0, lx1), (ly0, ly1)) = (span(f0, f1), span(a0, a1));
+    let px = |x: f64| left + (x.ln() - lx0) / (lx1 - lx0) * (right - left);
+    let py = |y: f64| bottom - (y.ln() - ly0) / (ly1 - ly0) * (bottom - top);
     let mut svg = format!(
         "<svg class=\"mini\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\" role=\"img\" \
-         aria-label=\"area versus load, log-log\"><rect x=\"0.5\" y=\"0.5\" width=\"{}\" \
-         height=\"{}\" class=\"frame\"/>",
-        w - 1.0,
-        h - 1.0
+         aria-label=\"contact area versus normal force, log-log\"><rect x=\"{}\" y=\"{}\" \
+         width=\"{}\" height=\"{}\" class=\"frame\"/>",
+        left - 4.0,
+        top - 4.0,
+        right - left + 8.0,
+        bottom - top + 8.0
     );
     if let Some(law) = r.power_law {
         let f = |n: f64| law.prefactor * n.powf(law.exponent);
         let _ = write!(
             svg,
             "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" class=\"fit\"/>",
-            px(x0),
-            py(f(x0)).clamp(0.0, h),
-            px(x1),
-            py(f(x1)).clamp(0.0, h)
+            px(f0),
+            py(f(f0)).clamp(0.0, h),
+            px(f1),
+            py(f(f1)).clamp(0.0, h)
         );
     }
     for (x, y, edge) in &points {
@@ -239,32 +257,37 @@ fn mini_plot(r: &SeriesResult) -> String {
             if *edge { "edge" } else { "pt" }
         );
     }
-    let unit = if r.area_unit == "um2" { "µm²" } else { "px" };
     let _ = write!(
         svg,
-        "<text x=\"{m}\" y=\"{}\" class=\"lab\">{} mN</text>\
-         <text x=\"{}\" y=\"{}\" class=\"lab\" text-anchor=\"end\">{} mN</text>\
-         <text x=\"2\" y=\"10\" class=\"lab\">{} {unit}</text>\
-         <text x=\"2\" y=\"{}\" class=\"lab\">{} {unit}</text></svg>",
-        h - 2.0,
-        short(x0),
-        w - 2.0,
-        h - 2.0,
-        short(x1),
-        short(y1),
-        h - m - 2.0,
-        short(y0)
+        "<text x=\"{left}\" y=\"{}\" class=\"lab\">{}</text>\
+         <text x=\"{right}\" y=\"{}\" class=\"lab\" text-anchor=\"end\">{}</text>\
+         <text x=\"{}\" y=\"{}\" class=\"lab\" text-anchor=\"end\">{}</text>\
+         <text x=\"{}\" y=\"{bottom}\" class=\"lab\" text-anchor=\"end\">{}</text></svg>",
+        h - 3.0,
+        short(f0),
+        h - 3.0,
+        short(f1),
+        left - 7.0,
+        top + 6.0,
+        short(a1),
+        left - 7.0,
+        short(a0)
     );
     svg
 }
 
-/// A number in 3 significant digits.
+/// A number in at most 3 significant digits, without trailing zeros (`4`, `37.6`, `0.0123`).
 fn short(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
     }
     let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
-    format!("{v:.digits$}")
+    let text = format!("{v:.digits$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
 }
 
 fn pm(value: Option<f64>, se: Option<f64>, digits: usize) -> String {
@@ -284,7 +307,7 @@ image-rendering:pixelated}.flag{display:inline-block;margin:1px;padding:1px 5px;
 border-radius:8px;background:#f0ad4e;color:#fff;font-size:.8em}.flag.failed{background:#d9534f}\
 .none{color:#888}.mini .frame{fill:#fff;stroke:#bbb}.mini .pt{fill:#0072b2}\
 .mini .edge{fill:#d55e00}.mini .fit{stroke:#009e73;stroke-width:1.5}.mini .lab{font-size:9px;\
-fill:#555}.controls{margin:.6em 0}.combined{max-width:900px;width:100%;border:1px solid #ddd}\
+fill:#555}.controls{margin:.6em 0}.combined{max-width:720px;width:100%;border:1px solid #ddd}\
 details{max-width:28em}.num{text-align:right;white-space:nowrap}";
 
 const SCRIPT: &str = "(function(){\
@@ -299,7 +322,9 @@ var heads=table.tHead.rows[0].cells;\
 for(var c=0;c<heads.length;c++){(function(col){heads[col].addEventListener('click',function(){\
 var rows=Array.prototype.slice.call(body.rows);var dir=heads[col].dataset.dir==='asc'?-1:1;\
 heads[col].dataset.dir=dir===1?'asc':'desc';rows.sort(function(a,b){\
-var x=a.cells[col].dataset.v||a.cells[col].textContent,y=b.cells[col].dataset.v||b.cells[col].textContent;\
+var x=(a.cells[col].dataset.v||a.cells[col].textContent).trim(),\
+y=(b.cells[col].dataset.v||b.cells[col].textContent).trim();\
+if(x===''||y==='')return (x==='')-(y==='');\
 var nx=parseFloat(x),ny=parseFloat(y);if(!isNaN(nx)&&!isNaN(ny))return dir*(nx-ny);\
 return dir*x.localeCompare(y);});rows.forEach(function(r){body.appendChild(r);});});})(c);}\
 })();";
@@ -380,7 +405,8 @@ fn page(
         let _ = write!(html, "<th>{}</th>", esc(&m.name));
     }
     html.push_str(
-        "<th>status</th><th>highest load</th><th>area vs load</th><th>β (A ∝ N^β)</th>\
+        "<th>status</th><th>highest load</th><th>area A vs load N<br><span class=\"meta\">\
+         (log–log; µm² or px, mN)</span></th><th>β (A ∝ N^β)</th>\
          <th>R²</th><th>p (MPa)</th>",
     );
     if fits {
@@ -560,7 +586,8 @@ mod tests {
         );
         assert_eq!(url("s 1/é"), "s%201/%C3%A9");
         assert_eq!(short(123.456), "123");
-        assert_eq!(short(4.0), "4.00");
+        assert_eq!(short(4.0), "4");
+        assert_eq!(short(37.6), "37.6");
         assert_eq!(short(0.01234), "0.0123");
         assert_eq!(pm(Some(0.87), Some(0.004), 3), "0.870 ± 0.004");
         assert_eq!(pm(None, None, 3), "—");

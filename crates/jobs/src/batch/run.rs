@@ -275,8 +275,14 @@ fn touches_border(mask: &Mask) -> bool {
 
 #[cfg(feature = "plots")]
 fn draw_thumbnail(plane: &Plane, mask: &Mask) -> Result<Vec<u8>> {
-    crate::plot::thumbnail_png(
-        &plane.to_f64(),
+    use crate::plot::{thumbnail_png, Pixels};
+    use contactscope::image::Samples;
+    let pixels = match &plane.samples {
+        Samples::Int { codes, offset } => Pixels::Codes(codes, *offset),
+        Samples::Float(values) => Pixels::Floats(values),
+    };
+    thumbnail_png(
+        pixels,
         plane.width,
         plane.height,
         &mask.data,

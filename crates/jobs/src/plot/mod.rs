@@ -21,7 +21,7 @@ use image::{ExtendedColorType, ImageEncoder};
 use crate::error::{Error, Result};
 
 pub use chart::{Axes, Chart, Curve, Legend, PointSet};
-pub use panels::{edge_panels_png, overlay_png, thumbnail_png};
+pub use panels::{edge_panels_png, overlay_png, thumbnail_png, Pixels};
 
 fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
     let mut png = Vec::new();

@@ -95,6 +95,40 @@ pub fn edge_panels_png(
     encode_png(&rgb, dim(total_w)?, dim(out_h)?)
 }
 
+/// The pixel values of a thumbnail's micrograph, row-major: integer codes with their offset
+/// (value = code + offset) or floats.
+#[derive(Debug, Clone, Copy)]
+pub enum Pixels<'a> {
+    /// Integer codes and the offset of their values.
+    Codes(&'a [u16], i32),
+    /// Float values (non-finite ones are left out of a box's mean).
+    Floats(&'a [f32]),
+}
+
+impl Pixels<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Pixels::Codes(c, _) => c.len(),
+            Pixels::Floats(v) => v.len(),
+        }
+    }
+
+    /// Sum and count of the finite values in `range`.
+    fn sum(&self, range: std::ops::Range<usize>) -> (f64, u32) {
+        match *self {
+            Pixels::Codes(codes, offset) => {
+                let n = range.len() as u32;
+                let sum: u64 = codes[range].iter().map(|&c| u64::from(c)).sum();
+                (sum as f64 + f64::from(offset) * f64::from(n), n)
+            }
+            Pixels::Floats(values) => values[range]
+                .iter()
+                .filter(|v| v.is_finite())
+                .fold((0.0, 0), |(s, n), &v| (s + f64::from(v), n + 1)),
+        }
+    }
+}
+
 /// A small overlay for pages that show many series (the batch's QC page): the micrograph
 /// reduced by whole-pixel boxes to at most `max_side` pixels a side (each thumbnail pixel the
 /// mean of the finite values in its box), grey levels stretched as in [`overlay_png`], and a
@@ -103,13 +137,13 @@ pub fn edge_panels_png(
 ///
 /// Errors as [`overlay_png`] on zero or mismatched sizes, and on `max_side` 0.
 pub fn thumbnail_png(
-    values: &[f64],
+    pixels: Pixels,
     width: usize,
     height: usize,
     contact: &[u8],
     max_side: usize,
 ) -> Result<Vec<u8>> {
-    overlay_size(values.len(), width, height, contact.len(), 1)?;
+    overlay_size(pixels.len(), width, height, contact.len(), 1)?;
     if max_side == 0 {
         return Err(Error::Plot(
             "a thumbnail needs a size of at least 1 pixel".into(),
@@ -119,18 +153,26 @@ pub fn thumbnail_png(
     let (tw, th) = (width.div_ceil(factor), height.div_ceil(factor));
     let mut sums = vec![(0.0f64, 0u32); tw * th];
     let mut edges = vec![false; tw * th];
-    let mask: Vec<bool> = contact.iter().map(|&c| c != 0).collect();
+    let is_contact = |x: usize, y: usize| contact[y * width + x] != 0;
     for y in 0..height {
-        for x in 0..width {
-            let t = (y / factor) * tw + x / factor;
-            let v = values[y * width + x];
-            if v.is_finite() {
-                sums[t].0 += v;
-                sums[t].1 += 1;
+        let row = (y / factor) * tw;
+        let line = &contact[y * width..(y + 1) * width];
+        for (bx, cell) in sums[row..row + tw].iter_mut().enumerate() {
+            let (x0, x1) = (bx * factor, ((bx + 1) * factor).min(width));
+            let (s, n) = pixels.sum(y * width + x0..y * width + x1);
+            cell.0 += s;
+            cell.1 += n;
+            // Contact is sparse: most boxes have none on this line.
+            if edges[row + bx] || line[x0..x1].iter().all(|&c| c == 0) {
+                continue;
             }
-            if !edges[t] && is_edge(&mask, width, height, x, y) {
-                edges[t] = true;
-            }
+            edges[row + bx] = (x0..x1).any(|x| {
+                is_contact(x, y)
+                    && ((x > 0 && !is_contact(x - 1, y))
+                        || (x + 1 < width && !is_contact(x + 1, y))
+                        || (y > 0 && !is_contact(x, y - 1))
+                        || (y + 1 < height && !is_contact(x, y + 1)))
+            });
         }
     }
     let means: Vec<f64> = sums
@@ -250,7 +292,9 @@ mod tests {
         let (values, mask) = rectangle_scene();
         let contact: Vec<u8> = mask.iter().map(|&m| u8::from(m)).collect();
         // 20×10 into at most 5 pixels a side: boxes of 4, a 5×3 thumbnail.
-        let png = thumbnail_png(&values, 20, 10, &contact, 5).unwrap();
+        let floats: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+        let value = Pixels::Floats(&floats);
+        let png = thumbnail_png(value, 20, 10, &contact, 5).unwrap();
         let img = image::load_from_memory(&png).unwrap().to_rgb8();
         assert_eq!(img.dimensions(), (5, 3));
         for (x, y, p) in img.enumerate_pixels() {
@@ -259,10 +303,23 @@ mod tests {
             assert_eq!(p.0 == EDGE_GREEN, green, "({x}, {y})");
         }
         // No shrinking needed: one box per pixel, the overlay itself.
-        let same = thumbnail_png(&values, 20, 10, &contact, 64).unwrap();
+        let same = thumbnail_png(value, 20, 10, &contact, 64).unwrap();
         assert_eq!(same, overlay_png(&values, 20, 10, &mask, 1).unwrap());
-        assert!(thumbnail_png(&values, 20, 10, &contact, 0).is_err());
-        assert!(thumbnail_png(&values, 20, 9, &contact, 5).is_err());
+        assert!(thumbnail_png(value, 20, 10, &contact, 0).is_err());
+        assert!(thumbnail_png(value, 20, 9, &contact, 5).is_err());
+        // Integer codes with an offset give the same picture as their values.
+        let codes: Vec<u16> = values
+            .iter()
+            .map(|&v| if v.is_finite() { v as u16 + 100 } else { 0 })
+            .collect();
+        let mut no_nan = values.clone();
+        no_nan[0] = -100.0;
+        let from_codes = thumbnail_png(Pixels::Codes(&codes, -100), 20, 10, &contact, 5).unwrap();
+        let floats: Vec<f32> = no_nan.iter().map(|&v| v as f32).collect();
+        assert_eq!(
+            from_codes,
+            thumbnail_png(Pixels::Floats(&floats), 20, 10, &contact, 5).unwrap()
+        );
     }
 
     #[test]
