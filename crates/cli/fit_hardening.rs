@@ -9,7 +9,8 @@ use contactscope::model_fit::{Family, Imaging, ProgressHook, RampEvent, Search};
 use contactscope_formats::units::{self, Dimension};
 use contactscope_jobs::fit_hardening::files::run_to_folder;
 use contactscope_jobs::fit_hardening::{
-    BodyRequest, FitRequest, MeasuredInput, Sweep, SweepMicrographs,
+    self, families_from_text, parse_hardness_range, parse_k_range, BodyRequest, FitRequest,
+    MeasuredInput, Sweep, SweepMicrographs,
 };
 use contactscope_jobs::heights::HeightInput;
 use contactscope_jobs::results::fwhm_from_psf_json;
@@ -88,30 +89,10 @@ fn ramp_label(event: &RampEvent) -> String {
 }
 
 fn searches(args: &Args) -> Result<Vec<(Family, Search)>> {
-    let k = units::parse_range(&args.k_range, &|t| {
-        units::parse_ratio(t, Dimension::Pressure, Dimension::Length)
-    })
-    .context("--k-range")?;
-    let p = units::parse_range(&args.hardness_range, &|t| {
-        units::parse_positive(t, Dimension::Pressure)
-    })
-    .context("--hardness-range")?;
-    Ok(vec![
-        (
-            Family::Hardening,
-            Search {
-                range: k,
-                ..Search::default_for(Family::Hardening)
-            },
-        ),
-        (
-            Family::Hardness,
-            Search {
-                range: p,
-                ..Search::default_for(Family::Hardness)
-            },
-        ),
-    ])
+    let k = parse_k_range(&args.k_range).map_err(|e| anyhow::anyhow!("--k-range: {e}"))?;
+    let p = parse_hardness_range(&args.hardness_range)
+        .map_err(|e| anyhow::anyhow!("--hardness-range: {e}"))?;
+    Ok(fit_hardening::searches(k, p))
 }
 
 fn sweep_micrographs(args: &Args) -> Result<Option<SweepMicrographs>> {
@@ -154,12 +135,8 @@ fn imaging(args: &Args) -> Result<Option<Imaging>> {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let families = args
-        .models
-        .split(',')
-        .map(Family::parse)
-        .collect::<std::result::Result<Vec<_>, _>>()
-        .context("--models")?;
+    let families =
+        families_from_text(&args.models).map_err(|e| anyhow::anyhow!("--models: {e}"))?;
     let sweep = args
         .sweep
         .as_deref()

@@ -1,7 +1,7 @@
-//! The batch (`contactscope_jobs::batch`) from Python: [`batch`] runs a whole archive in this
-//! process, as the command line's `batch` does; [`batch_plan`], [`batch_series`] and
-//! [`BatchPlan::finish`] are its three steps, which `contactscope.distributed.batch` spreads
-//! over Dask (one series per task; tasks and records travel as JSON).
+//! The batch (`contactscope_jobs::batch`) from Python: [`batch_plan`], then either
+//! [`BatchPlan::run`] (every series in this process, as the command line's `batch` does) or
+//! [`batch_series`] per task and [`BatchPlan::finish`], which `contactscope.distributed.batch`
+//! spreads over Dask (one series per task; tasks and records travel as JSON).
 //!
 //! Options for every series come as text, the samplesheet's own vocabulary (`"200nm"`,
 //! `"4,10,40mN"`); the Python package turns SI numbers into such text.
@@ -115,67 +115,6 @@ fn outcome_to_py<'py>(py: Python<'py>, outcome: &BatchOutcome) -> PyResult<Bound
     Ok(dict)
 }
 
-/// Run a whole batch in this process (the command line's `batch`): plan, every series to do,
-/// the tables, page and provenance. `progress(id, done, total)` is called after each series.
-#[pyfunction]
-#[pyo3(signature = (kind, source, out, base=None, patterns=Vec::new(), tiff_folders=false,
-    options=HashMap::new(), overlays=false, save_masks=false, memory_mib=128, device="cpu",
-    rerun="changed", color_by=None, command_line=Vec::new(), progress=None))]
-#[allow(clippy::too_many_arguments)]
-fn batch<'py>(
-    py: Python<'py>,
-    kind: &str,
-    source: String,
-    out: PathBuf,
-    base: Option<PathBuf>,
-    patterns: Vec<String>,
-    tiff_folders: bool,
-    options: HashMap<String, String>,
-    overlays: bool,
-    save_masks: bool,
-    memory_mib: usize,
-    device: &str,
-    rerun: &str,
-    color_by: Option<String>,
-    command_line: Vec<String>,
-    progress: Option<Py<PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let request = request(
-        kind,
-        source,
-        out,
-        base,
-        patterns,
-        tiff_folders,
-        options,
-        overlays,
-        save_masks,
-        memory_mib,
-        device,
-        rerun,
-        color_by,
-        command_line,
-    )?;
-    let callback_error: Arc<Mutex<Option<PyErr>>> = Arc::new(Mutex::new(None));
-    let error = callback_error.clone();
-    let outcome = compute(py, move || {
-        let report = move |record: &Record, done: usize, total: usize| {
-            if let Some(f) = &progress {
-                Python::attach(|py| {
-                    if let Err(e) = f.call1(py, (record.id.as_str(), done, total)) {
-                        error.lock().expect("lock").get_or_insert(e);
-                    }
-                });
-            }
-        };
-        jobs::run(request, &report)
-    })?;
-    if let Some(e) = callback_error.lock().expect("lock").take() {
-        return Err(e);
-    }
-    outcome_to_py(py, &outcome)
-}
-
 /// A planned batch: the tasks to run (JSON), and [`BatchPlan::finish`] once their records are
 /// back. The batch's folder stays locked until then.
 #[pyclass(module = "contactscope._contactscope")]
@@ -204,6 +143,42 @@ impl BatchPlan {
             .ok_or_else(|| bad("batch: this plan is finished"))?;
         let reused = plan.decisions.iter().filter(|d| !d.run).count();
         Ok((plan.tasks.len(), reused))
+    }
+
+    /// Run every series of the plan in this process (side by side on its thread pool), then
+    /// [`BatchPlan::finish`]: the command line's `batch`. `progress(id, done, total)` is
+    /// called after each series, from the threads doing the work.
+    #[pyo3(signature = (progress=None))]
+    fn run<'py>(
+        &self,
+        py: Python<'py>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let plan = self
+            .plan
+            .lock()
+            .expect("lock")
+            .take()
+            .ok_or_else(|| bad("batch: this plan is finished"))?;
+        let callback_error: Arc<Mutex<Option<PyErr>>> = Arc::new(Mutex::new(None));
+        let error = callback_error.clone();
+        let outcome = compute(py, move || {
+            let report = move |record: &Record, done: usize, total: usize| {
+                if let Some(f) = &progress {
+                    Python::attach(|py| {
+                        if let Err(e) = f.call1(py, (record.id.as_str(), done, total)) {
+                            error.lock().expect("lock").get_or_insert(e);
+                        }
+                    });
+                }
+            };
+            let fresh = jobs::run_planned(&plan, &report);
+            jobs::finish(plan, fresh)
+        })?;
+        if let Some(e) = callback_error.lock().expect("lock").take() {
+            return Err(e);
+        }
+        outcome_to_py(py, &outcome)
     }
 
     /// Write the tables, page and provenance from the records (JSON, one per task, in order).
@@ -282,7 +257,6 @@ fn batch_series(py: Python<'_>, task: String) -> PyResult<String> {
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch_plan, m)?)?;
     m.add_function(wrap_pyfunction!(batch_series, m)?)?;
     m.add_class::<BatchPlan>()?;

@@ -705,16 +705,10 @@ class BatchOutcome(TypedDict):
     images_table: TableColumns
     series_table: TableColumns
 
-def batch(
-    kind: str, source: str, out: Path, base: Optional[Path] = None,
-    patterns: Sequence[str] = ..., tiff_folders: bool = False,
-    options: Dict[str, str] = ..., overlays: bool = False, save_masks: bool = False,
-    memory_mib: int = 128, device: str = "cpu", rerun: str = "changed",
-    color_by: Optional[str] = None, command_line: Sequence[str] = ...,
-    progress: Optional[Callable[[str, int, int], None]] = None,
-) -> BatchOutcome: ...
-
 class BatchPlan:
+    def run(
+        self, progress: Optional[Callable[[str, int, int], None]] = None
+    ) -> BatchOutcome: ...
     def tasks(self) -> List[str]: ...
     def counts(self) -> Tuple[int, int]: ...
     def finish(self, records: Sequence[str]) -> BatchOutcome: ...

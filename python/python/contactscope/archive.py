@@ -195,4 +195,4 @@ def batch(samplesheet: Any, out: Union[str, "os.PathLike[str]"], *, base: Any = 
     request = _request(samplesheet, out, base, patterns, tiff_folders, rerun, color_by,
                        overlays, save_masks, memory_mib, device, options, "contactscope.batch")
     report = _print_progress if progress is True else (progress or None)
-    return BatchResult(_cs.batch(**request, progress=report))
+    return BatchResult(_cs.batch_plan(**request).run(report))

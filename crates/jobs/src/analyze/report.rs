@@ -27,8 +27,10 @@ pub struct HertzParams {
     pub modulus_pa: f64,
 }
 
-/// One row of `areas.csv`, in µm² where a pixel size is known (pixels otherwise).
-#[derive(Debug, Clone, PartialEq)]
+/// One row of `areas.csv`, in µm² where a pixel size is known (pixels otherwise). Its own
+/// serialisation (field names as here) is the batch's record of an image; `areas.csv` and the
+/// outcome name the columns with their units ([`AreaTable`]).
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct Row {
     /// Image file.
     pub image: String,

@@ -14,7 +14,6 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
-use contactscope::model_fit::{Family, Search};
 use contactscope::solver::gpu::DeviceChoice;
 use contactscope::surface::fill::FillInvalid;
 use contactscope::surface::Detrend;
@@ -24,7 +23,10 @@ use contactscope_formats::ranges::Quantity;
 use contactscope_formats::units::{self, Dimension};
 
 use crate::analyze::{AnalyzeRequest, HertzParams};
-use crate::fit_hardening::{BodyRequest, FitRequest, MeasuredInput};
+use crate::fit_hardening::{
+    families_from_text, parse_hardness_range, parse_k_range, searches, BodyRequest, FitRequest,
+    MeasuredInput,
+};
 use crate::heights::{HeightInput, TopographySource};
 use crate::series::{Micrographs, SeriesSpec};
 
@@ -209,9 +211,12 @@ impl Opt {
             Opt::FillInvalid => json!(FillInvalid::from_name(text.trim())
                 .ok_or_else(|| format!("'{text}' is not mean or nearest"))?
                 .name()),
-            Opt::Models => json!(families(text)?.iter().map(|f| f.name()).collect::<Vec<_>>()),
-            Opt::KRange => json!(k_range(text)?),
-            Opt::HardnessRange => json!(hardness_range(text)?),
+            Opt::Models => json!(families_from_text(text)?
+                .iter()
+                .map(|f| f.name())
+                .collect::<Vec<_>>()),
+            Opt::KRange => json!(parse_k_range(text)?),
+            Opt::HardnessRange => json!(parse_hardness_range(text)?),
         })
     }
 }
@@ -254,24 +259,6 @@ fn parse_axes(text: &str) -> Result<BTreeMap<String, usize>, String> {
         };
     }
     Ok(axes)
-}
-
-fn families(text: &str) -> Result<Vec<Family>, String> {
-    text.split(',')
-        .map(|t| Family::parse(t).map_err(|e| e.to_string()))
-        .collect()
-}
-
-fn k_range(text: &str) -> Result<(f64, f64), String> {
-    units::parse_range(text, &|t| {
-        units::parse_ratio(t, Dimension::Pressure, Dimension::Length)
-    })
-    .map_err(|e| e.to_string())
-}
-
-fn hardness_range(text: &str) -> Result<(f64, f64), String> {
-    units::parse_range(text, &|t| units::parse_positive(t, Dimension::Pressure))
-        .map_err(|e| e.to_string())
 }
 
 /// A series' options as text, the way the flags take them (units applied, defaults merged).
@@ -526,25 +513,11 @@ impl SeriesOptions {
         let modulus = self
             .value(Opt::Modulus)
             .ok_or("a fit needs the contact modulus E* (modulus column)")?;
-        let families = families(self.fit_value(Opt::Models).unwrap_or_default())?;
-        let k = k_range(self.fit_value(Opt::KRange).unwrap_or_default())?;
-        let p = hardness_range(self.fit_value(Opt::HardnessRange).unwrap_or_default())?;
-        let searches = vec![
-            (
-                Family::Hardening,
-                Search {
-                    range: k,
-                    ..Search::default_for(Family::Hardening)
-                },
-            ),
-            (
-                Family::Hardness,
-                Search {
-                    range: p,
-                    ..Search::default_for(Family::Hardness)
-                },
-            ),
-        ];
+        let families = families_from_text(self.fit_value(Opt::Models).unwrap_or_default())?;
+        let searches = searches(
+            parse_k_range(self.fit_value(Opt::KRange).unwrap_or_default())?,
+            parse_hardness_range(self.fit_value(Opt::HardnessRange).unwrap_or_default())?,
+        );
         Ok(FitRequest {
             families,
             searches,

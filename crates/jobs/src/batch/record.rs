@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use super::options::OutputSettings;
+use crate::analyze::Row;
 use crate::error::{Error, Result};
 use crate::provenance::{sha256_file, Stat};
 
@@ -137,44 +138,22 @@ pub struct CommandLines {
     pub fit_hardening: Option<Vec<String>>,
 }
 
-/// One image's numbers: the columns of `areas.csv`, plus whether its contact touches the
-/// image border.
+/// One image's numbers: the row of `areas.csv` (its `image` relative to the series' input: its
+/// folder, or the file's name), and whether its contact touches the image border.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ImageResult {
-    /// The image file relative to the series' input (its folder, or the file's name).
-    pub image: String,
-    /// Page (TIFF) or position along the load axis.
-    pub page: usize,
-    /// Normal force, mN.
-    pub force_mn: Option<f64>,
-    /// Threshold applied.
-    pub threshold: f64,
-    /// Contact pixels.
-    pub contact_pixels: u64,
-    /// Contact area in the series' area unit.
-    pub area: f64,
-    /// Mean intensity over contact pixels.
-    pub mean_intensity: Option<f64>,
-    /// Sum of intensities over contact pixels.
-    pub integrated_intensity: f64,
-    /// Mean intensity elsewhere.
-    pub background_mean: Option<f64>,
-    /// 8-connected patches.
-    pub patches: u64,
-    /// Largest patch, area unit.
-    pub largest_patch: f64,
-    /// Mean pressure, MPa.
-    pub mean_pressure_mpa: Option<f64>,
-    /// √(A/π), length unit of the area unit.
-    pub equivalent_radius: f64,
-    /// Friction force, mN.
-    pub friction_mn: Option<f64>,
-    /// Hertz radius, µm.
-    pub hertz_radius_um: Option<f64>,
-    /// Hertz area, µm².
-    pub hertz_area_um2: Option<f64>,
+    /// The row as `analyze` has it.
+    pub row: Row,
     /// A contact pixel lies on the image's border.
     pub edge_contact: bool,
+}
+
+impl std::ops::Deref for ImageResult {
+    type Target = Row;
+
+    fn deref(&self) -> &Row {
+        &self.row
+    }
 }
 
 /// The power law A = c·N^β of a series (N in mN, A in the area unit).

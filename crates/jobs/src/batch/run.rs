@@ -21,7 +21,7 @@ use super::record::{
     Status,
 };
 use crate::analyze::files::{run_open_to_folder, ImageOutputs};
-use crate::analyze::{AnalyzeOutcome, AreaUnit};
+use crate::analyze::{AnalyzeOutcome, AreaUnit, Row};
 use crate::error::{Error, Result};
 use crate::fit_hardening::FitOutcome;
 use crate::provenance;
@@ -352,27 +352,15 @@ fn series_result(
         .zip(&open.series.images)
         .zip(edges)
         .map(|((row, image), &edge_contact)| ImageResult {
-            image: image
-                .path
-                .strip_prefix(&base)
-                .unwrap_or(&image.path)
-                .display()
-                .to_string(),
-            page: row.page,
-            force_mn: row.force_mn,
-            threshold: row.threshold,
-            contact_pixels: row.contact_pixels,
-            area: row.area,
-            mean_intensity: row.mean_intensity,
-            integrated_intensity: row.integrated_intensity,
-            background_mean: row.background_mean,
-            patches: row.patches,
-            largest_patch: row.largest_patch,
-            mean_pressure_mpa: row.mean_pressure_mpa,
-            equivalent_radius: row.equivalent_radius,
-            friction_mn: row.friction_mn,
-            hertz_radius_um: row.hertz_radius_um,
-            hertz_area_um2: row.hertz_area_um2,
+            row: Row {
+                image: image
+                    .path
+                    .strip_prefix(&base)
+                    .unwrap_or(&image.path)
+                    .display()
+                    .to_string(),
+                ..row.clone()
+            },
             edge_contact,
         })
         .collect();

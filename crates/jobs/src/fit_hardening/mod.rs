@@ -227,6 +227,50 @@ impl FitRequest {
     }
 }
 
+/// The search range of k (Pa/m) from the text of `--k-range`: `0.1..100MPa/nm`.
+pub fn parse_k_range(text: &str) -> std::result::Result<(f64, f64), String> {
+    use contactscope_formats::units::{self, Dimension};
+    units::parse_range(text, &|t| {
+        units::parse_ratio(t, Dimension::Pressure, Dimension::Length)
+    })
+    .map_err(|e| e.to_string())
+}
+
+/// The search range of the hardness p_Y (Pa) from the text of `--hardness-range`:
+/// `10MPa..10GPa`.
+pub fn parse_hardness_range(text: &str) -> std::result::Result<(f64, f64), String> {
+    use contactscope_formats::units::{self, Dimension};
+    units::parse_range(text, &|t| units::parse_positive(t, Dimension::Pressure))
+        .map_err(|e| e.to_string())
+}
+
+/// The searches of a fit over the ranges of k (Pa/m) and p_Y (Pa), the other settings the
+/// families' defaults.
+pub fn searches(k_range: (f64, f64), hardness_range: (f64, f64)) -> Vec<(Family, Search)> {
+    [
+        (Family::Hardening, k_range),
+        (Family::Hardness, hardness_range),
+    ]
+    .into_iter()
+    .map(|(family, range)| {
+        (
+            family,
+            Search {
+                range,
+                ..Search::default_for(family)
+            },
+        )
+    })
+    .collect()
+}
+
+/// The families of `--models` (`gt,elastic,hardness,hardening`), in order.
+pub fn families_from_text(text: &str) -> std::result::Result<Vec<Family>, String> {
+    text.split(',')
+        .map(|t| Family::parse(t).map_err(|e| e.to_string()))
+        .collect()
+}
+
 /// The range and the parameter name of a family's parameter.
 fn parameter_quantity(family: Family) -> (Quantity, Param) {
     match family {
