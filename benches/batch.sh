@@ -45,7 +45,7 @@ for _ in 1 2 3; do
   cat_s+=("$(echo "$t1 - $t0" | bc -l)")
 done
 
-loop_s=(); batch_s=(); batch_kb=()
+loop_s=(); batch_s=(); batch_kb=(); batch_cpu=()
 for r in $(seq 1 "$REPEAT"); do
   fresh
   mkdir "run-loop-$r"
@@ -55,10 +55,12 @@ for r in $(seq 1 "$REPEAT"); do
   loop_s+=("$(echo "$t1 - $t0" | bc -l)")
   fresh
   t0=$(now)
-  "$TIME" -f %M -o mem.txt "$BIN" batch archive --out "run-batch-$r" -q >/dev/null
+  "$TIME" -f "%M %U %S" -o mem.txt "$BIN" batch archive --out "run-batch-$r" -q >/dev/null
   t1=$(now)
   batch_s+=("$(echo "$t1 - $t0" | bc -l)")
-  batch_kb+=("$(cat mem.txt)")
+  read -r kb user sys < mem.txt
+  batch_kb+=("$kb")
+  batch_cpu+=("$(echo "$user + $sys" | bc -l)")
   echo "run $r: loop ${loop_s[-1]} s, batch ${batch_s[-1]} s, ${batch_kb[-1]} kB" >&2
 done
 last="run-batch-$REPEAT"
@@ -85,7 +87,7 @@ rm -rf changed
 
 m() { printf '%s\n' "$@" | median; }
 loop=$(m "${loop_s[@]}"); batch=$(m "${batch_s[@]}"); catm=$(m "${cat_s[@]}")
-rerun=$(m "${rerun_s[@]}"); kb=$(m "${batch_kb[@]}")
+rerun=$(m "${rerun_s[@]}"); kb=$(m "${batch_kb[@]}"); cpu=$(m "${batch_cpu[@]}")
 gb=$(echo "$bytes / 1000000000" | bc -l)
 cat <<EOF
 
@@ -95,6 +97,7 @@ cat <<EOF
 | \`cat\` of every TIFF to /dev/null | $(printf '%.2f' "$catm") s ($(printf '%.1f' "$(echo "$gb / $catm" | bc -l)") GB/s) |
 | shell loop of \`analyze\` | $(printf '%.2f' "$loop") s |
 | \`batch\` | $(printf '%.2f' "$batch") s ($(printf '%.2f' "$(echo "$gb / $batch" | bc -l)") GB/s of image data, hashing included) |
+| \`batch\` CPU time (user + system) | $(printf '%.2f' "$cpu") s on $(nproc) cores |
 | loop / batch | $(printf '%.2f' "$(echo "$loop / $batch" | bc -l)")× |
 | peak memory: batch / one \`analyze\` | $kb kB / $one_kb kB ($(printf '%.2f' "$(echo "$kb / $one_kb" | bc -l)")×) |
 | tables written (1,600 image rows) | $(printf '%.4f' "$tables_s") s |

@@ -221,8 +221,9 @@ pub fn run(args: Args) -> Result<bool> {
             plan.tasks.len() - todo
         );
     }
+    let quiet = args.quiet.quiet;
     let report = |record: &batch::Record, _: usize, _: usize| {
-        if let Some(e) = &record.error {
+        if let (Some(e), false) = (&record.error, quiet) {
             bar.suspend(|| eprintln!("contactscope: series {} failed: {e}", record.id));
         }
         bar.set_message(record.id.clone());
@@ -248,13 +249,6 @@ pub fn run(args: Args) -> Result<bool> {
     for path in &outcome.written {
         println!("  {}", path.display());
     }
-    println!(
-        "  and series/ID (as analyze writes it){} for every series",
-        if outcome.written.is_empty() {
-            ""
-        } else {
-            ", records/ID.json, qc/ID.png"
-        }
-    );
+    println!("  and per series: series/ID/ (as analyze writes it), records/ID.json, qc/ID.png");
     Ok(outcome.failed == 0)
 }

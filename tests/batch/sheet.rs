@@ -219,6 +219,20 @@ fn a_bad_samplesheet_is_refused_whole_with_its_line_and_column() {
     );
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(!dir.join("results").exists(), "nothing written");
+    // Forces for a manifest, which gives its own: one of the two would be ignored.
+    std::fs::write(
+        dir.join("both.csv"),
+        sheet.replace("a,archive/manifest-a,,", "a,archive/manifest-a,\"1,2\","),
+    )
+    .unwrap();
+    let o = super::batch(dir, &["--samplesheet", "both.csv", "--out", "results"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("line 2, column forces: the input archive/manifest-a is a manifest"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.join("results").exists(), "nothing written");
     // A folder of one's own is never taken.
     std::fs::create_dir(dir.join("mine")).unwrap();
     std::fs::write(dir.join("mine/notes.txt"), "mine").unwrap();
