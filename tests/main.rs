@@ -13,6 +13,7 @@
 //! | [`demo`] | the whole method on a generated experiment |
 //! | [`fuzz`] | the mutation fuzzer over every command (a short campaign; the long one is `--ignored`) |
 //! | [`layers`] | the workspace's layering: no crate imports a layer above it |
+//! | [`release`] | one version everywhere, licence files, the crates' registry metadata |
 //!
 //! Real files come from `../shared/data` (tests skip with a message when it is absent).
 //! Run one folder with `cargo test --release --test integration optics::`.
@@ -27,4 +28,5 @@ mod fuzz;
 mod layers;
 mod mechanics;
 mod optics;
+mod release;
 mod series;

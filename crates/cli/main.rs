@@ -33,7 +33,7 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 #[derive(Parser)]
 #[command(
     name = "contactscope",
-    version = concat!(env!("CARGO_PKG_VERSION"), " (source ", env!("CONTACTSCOPE_SOURCE_REVISION"), ")"),
+    version = env!("CONTACTSCOPE_LONG_VERSION"),
     about = "Real-contact-area microscopy: confocal load series → contact area versus load"
 )]
 struct Cli {

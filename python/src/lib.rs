@@ -214,7 +214,12 @@ fn _contactscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add("InternalError", py.get_type::<InternalError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    m.add("__source_revision__", env!("CONTACTSCOPE_SOURCE_REVISION"))?;
+    // The git commit the extension was built from, None outside a checkout (as summary.json's
+    // `source_revision`).
+    m.add(
+        "__source_revision__",
+        contactscope_jobs::provenance::source_revision(),
+    )?;
     m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
     images::register(m)?;

@@ -20,14 +20,19 @@ use crate::error::{Error, Result};
 static SOURCE_REVISION: OnceLock<&'static str> = OnceLock::new();
 
 /// Record the source revision the running front-end was built from (the git commit, with
-/// ` (modified)` for uncommitted changes, or `unknown`). Called once at start-up.
+/// ` (modified)` for uncommitted changes, or `unknown` when it was not built from a checkout).
+/// Called once at start-up.
 pub fn set_source_revision(revision: &'static str) {
     let _ = SOURCE_REVISION.set(revision);
 }
 
-/// The source revision set by the front-end, `unknown` if none was.
-pub fn source_revision() -> &'static str {
-    SOURCE_REVISION.get().copied().unwrap_or("unknown")
+/// The source revision set by the front-end; `None` when it is unknown (built from a source
+/// archive or a registry's crate) or none was set. Written as JSON `null`.
+pub fn source_revision() -> Option<&'static str> {
+    SOURCE_REVISION
+        .get()
+        .copied()
+        .filter(|revision| *revision != "unknown")
 }
 
 /// The version of contactscope.

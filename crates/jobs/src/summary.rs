@@ -6,7 +6,9 @@ use serde_json::{Map, Value};
 
 use crate::error::{Error, Result};
 
-/// The outcome as pretty JSON bytes, with `contactscope_version` and `command_line` first.
+/// The outcome as pretty JSON bytes, with `contactscope_version`, `source_revision` (the git
+/// commit the program was built from, `null` when unknown: [`crate::provenance`]) and
+/// `command_line` first.
 pub fn summary_json<T: Serialize>(command_line: &[String], outcome: &T) -> Result<Vec<u8>> {
     summary_json_without(command_line, outcome, &[])
 }
@@ -28,6 +30,10 @@ pub fn summary_json_without<T: Serialize>(
     map.insert(
         "contactscope_version".into(),
         Value::from(env!("CARGO_PKG_VERSION")),
+    );
+    map.insert(
+        "source_revision".into(),
+        Value::from(crate::provenance::source_revision()),
     );
     map.insert("command_line".into(), Value::from(command_line.to_vec()));
     match body {

@@ -33,6 +33,8 @@ from ._contactscope import (  # noqa: F401  (re-exported)
 )
 
 __version__ = _cs.__version__
+#: The git commit this build came from (``None`` when built outside a checkout, e.g. from the sdist).
+__source_revision__ = _cs.__source_revision__
 
 PathLike = Union[str, "os.PathLike[str]"]
 PixelSize = Union[float, "tuple[float, float]"]

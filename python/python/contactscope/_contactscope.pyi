@@ -10,7 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
-__source_revision__: str
+__source_revision__: Optional[str]
 
 PixelSize = Union[float, Tuple[float, float], Sequence[float]]
 Path = Union[str, PathLike[str]]

@@ -358,7 +358,7 @@ fn page(
          <title>contactscope batch: {} series</title><style>{STYLE}</style></head><body>\
          <h1>contactscope batch: {} series, {} images</h1>\
          <p class=\"meta\">{} ok, {failed} failed, {flagged} flagged. contactscope {} \
-         (source {}), finished {}. Tables: <a href=\"series.csv\">series.csv</a> \
+         {}, finished {}. Tables: <a href=\"series.csv\">series.csv</a> \
          (<a href=\"series.parquet\">Parquet</a>), <a href=\"images.csv\">images.csv</a> \
          (<a href=\"images.parquet\">Parquet</a>); provenance: <a href=\"batch.json\">batch.json</a>.\
          </p>",
@@ -367,7 +367,8 @@ fn page(
         images.rows,
         entries.len() - failed,
         esc(provenance::version()),
-        esc(provenance::source_revision()),
+        provenance::source_revision()
+            .map_or_else(|| "(source revision unknown)".to_string(), |r| format!("(source {})", esc(r))),
         esc(&provenance::rfc3339(std::time::SystemTime::now())),
     );
     if !counts.is_empty() {

@@ -246,8 +246,8 @@ pub struct Record {
     pub failed_stage: Option<String>,
     /// contactscope's version.
     pub contactscope_version: String,
-    /// The source revision it was built from.
-    pub source_revision: String,
+    /// The source revision it was built from (`None`: unknown).
+    pub source_revision: Option<String>,
     /// The options, in SI units.
     pub options: Value,
     /// The batch-wide output settings.
@@ -396,7 +396,7 @@ mod tests {
             error: None,
             failed_stage: None,
             contactscope_version: crate::provenance::version().into(),
-            source_revision: "unknown".into(),
+            source_revision: None,
             options: json!({"pixel_size": [2e-7, 2e-7]}),
             settings: OutputSettings::default(),
             input: InputState::of(&file),

@@ -141,7 +141,7 @@ pub fn run_series(task: &SeriesTask) -> Record {
         error,
         failed_stage,
         contactscope_version: provenance::version().to_string(),
-        source_revision: provenance::source_revision().to_string(),
+        source_revision: provenance::source_revision().map(str::to_string),
         options: task.options.fingerprint(),
         settings: task.settings,
         input: InputState::of(&task.input),

@@ -27,7 +27,7 @@ pub(super) struct Facts<'a> {
 }
 
 /// contactscope's own methods (`docs/methods.md`), written beside the report it cites them in.
-const METHODS: &str = include_str!("../../../../docs/methods.md");
+const METHODS: &str = include_str!("../../assets/methods.md");
 
 pub(super) fn write_report(dir: &Path, facts: &Facts) -> Result<()> {
     let panels = write_panels(dir, facts)?;
