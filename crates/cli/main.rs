@@ -144,6 +144,7 @@ fn grammar() -> clap::Command {
 }
 
 fn main() -> ExitCode {
+    signals::end_quietly_on_closed_output();
     let parsed = grammar()
         .try_get_matches()
         .and_then(|m| Cli::from_arg_matches(&m));
@@ -187,6 +188,7 @@ fn main() -> ExitCode {
         // A batch whose tables are written but some series failed (docs/errors.md).
         Ok(()) if some_failed => ExitCode::from(3),
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if signals::closed_output(&e) => signals::end_by_sigpipe(),
         Err(_) if signals::interrupted() => loop {
             // The signal handler reports and exits; the run's error is a consequence.
             std::thread::park();

@@ -1,5 +1,6 @@
 //! SIGINT and SIGTERM in the middle of a long `simulate`: exit 130 / 143, a message saying what was
-//! discarded, and nothing left behind (no staging folder, no output folder). Unix only.
+//! discarded, and nothing left behind (no staging folder, no output folder, no folder above it
+//! that the run created). Unix only.
 #![cfg(unix)]
 
 use std::path::Path;
@@ -8,10 +9,10 @@ use std::time::{Duration, Instant};
 
 use crate::common::rough_surface;
 
-/// Start a `simulate` of many loads, wait until its staging folder holds a file (it is inside
-/// the load ramp), send `signal`, and return (exit code, stderr).
-fn interrupt(dir: &Path, surface: &Path, signal: &str) -> (Option<i32>, String) {
-    let out = dir.join("sim");
+/// Start a `simulate` of many loads into `dir/out`, wait until its staging folder holds a file
+/// (it is inside the load ramp), send `signal`, and return (exit code, stderr).
+fn interrupt(dir: &Path, out: &str, surface: &Path, signal: &str) -> (Option<i32>, String) {
+    let out = dir.join(out);
     let child = Command::new(env!("CARGO_BIN_EXE_contactscope"))
         .args([
             "simulate",
@@ -37,7 +38,10 @@ fn interrupt(dir: &Path, surface: &Path, signal: &str) -> (Option<i32>, String) 
         .stderr(Stdio::piped())
         .spawn()
         .expect("binary starts");
-    let staging = dir.join(format!(".sim.staging-{}", child.id()));
+    let staging = out
+        .parent()
+        .expect("a parent")
+        .join(format!(".sim.staging-{}", child.id()));
     let start = Instant::now();
     while !staging.join("load_001_contact.tif").exists() {
         assert!(
@@ -65,8 +69,13 @@ fn interrupted_simulations_leave_nothing_behind() {
     let dir = tempfile::tempdir().unwrap();
     let surface = dir.path().join("surface.npy");
     rough_surface(&surface, 256, "128nm", 3, &[]);
-    for (signal, code, name) in [("-INT", 130, "SIGINT"), ("-TERM", 143, "SIGTERM")] {
-        let (status, err) = interrupt(dir.path(), &surface, signal);
+    // The second run's `--out` names two folders that do not exist yet: it creates them, and
+    // must remove them again (as `demo` once left an empty `contactscope-out/`).
+    for (signal, code, name, out) in [
+        ("-INT", 130, "SIGINT", "sim"),
+        ("-TERM", 143, "SIGTERM", "new/deeper/sim"),
+    ] {
+        let (status, err) = interrupt(dir.path(), out, &surface, signal);
         assert_eq!(status, Some(code), "{name}: {err}");
         assert!(
             err.contains(&format!("interrupted by {name}")) && err.contains("discarded"),
@@ -79,4 +88,43 @@ fn interrupted_simulations_leave_nothing_behind() {
         .map(|e| e.unwrap().file_name())
         .collect();
     assert_eq!(left, vec![std::ffi::OsString::from("surface.npy")]);
+}
+
+#[test]
+fn an_interrupted_demo_leaves_no_folder_it_created() {
+    // `demo` writes into ./contactscope-out/demo by default: interrupted, it must not leave an
+    // empty contactscope-out/ behind.
+    let dir = tempfile::tempdir().unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_contactscope"))
+        .args(["demo", "--small", "--quiet"])
+        .current_dir(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary starts");
+    let work = dir
+        .path()
+        .join("contactscope-out")
+        .join(format!(".demo.demo-{}", child.id()));
+    let start = Instant::now();
+    while !work.join("data").exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the demo never began"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(status.success());
+    let output = child.wait_with_output().expect("the child ends");
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(130), "{err}");
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}; {err}");
 }

@@ -18,6 +18,7 @@
 
 mod cases;
 mod mutate;
+mod pipes;
 mod run;
 mod seeds;
 mod vendor;

@@ -25,6 +25,9 @@ use crate::error::{Error, Result};
 pub struct Staging {
     out_dir: PathBuf,
     staging_dir: PathBuf,
+    /// Folders above `out_dir` this run created: removed again, when empty, if the run does
+    /// not commit (dropped after `staging_dir` is removed).
+    created_parents: Option<CreatedFolders>,
     files: std::sync::Mutex<Vec<String>>,
     protected: Vec<PathBuf>,
     committed: bool,
@@ -41,13 +44,14 @@ impl Staging {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        fs::create_dir_all(&parent).map_err(|e| output_error(&parent, e))?;
+        let created_parents = CreatedFolders::create(&parent)?;
         let staging_dir = parent.join(format!(".{name}.staging-{}", std::process::id()));
         fs::create_dir_all(&staging_dir).map_err(|e| output_error(&staging_dir, e))?;
         register(&staging_dir);
         Ok(Staging {
             out_dir: out_dir.to_path_buf(),
             staging_dir,
+            created_parents: Some(created_parents),
             files: std::sync::Mutex::new(Vec::new()),
             protected: inputs
                 .iter()
@@ -118,6 +122,9 @@ impl Staging {
         }
         self.committed = true;
         unfinished.retain(|d| d != &self.staging_dir);
+        if let Some(created) = self.created_parents.take() {
+            created.keep();
+        }
         // The earlier run's folder, set aside, goes too if a signal comes while it is removed.
         unfinished.extend(aside.clone());
         drop(unfinished);
@@ -260,16 +267,91 @@ fn open_gate(path: &Path) -> Result<std::sync::RwLockReadGuard<'static, bool>> {
 }
 
 /// Remove every registered unfinished folder (for a signal handler: the process is about to
-/// exit); returns the folders removed. Writes through [`Staging::write`] and [`write_atomic`]
-/// are refused from now on.
+/// exit), then the folders above them that this process created and that are now empty (`--out
+/// new/deeper/run` interrupted leaves no `new/`); returns the folders removed. Writes through
+/// [`Staging::write`] and [`write_atomic`] are refused from now on.
 pub fn discard_unfinished() -> Vec<PathBuf> {
     *WRITE_GATE.write().unwrap_or_else(|e| e.into_inner()) = true;
     let dirs = match UNFINISHED.lock() {
         Ok(mut list) => std::mem::take(&mut *list),
         Err(_) => return Vec::new(),
     };
-    dirs.into_iter()
+    let mut removed: Vec<PathBuf> = dirs
+        .into_iter()
         .filter(|d| fs::remove_dir_all(d).is_ok())
+        .collect();
+    let mut parents = match CREATED_PARENTS.lock() {
+        Ok(mut list) => std::mem::take(&mut *list),
+        Err(_) => Vec::new(),
+    };
+    // Deepest first, so that a folder is empty once its own created children are gone.
+    parents.sort_by_key(|p| std::cmp::Reverse(p.components().count()));
+    parents.dedup();
+    removed.extend(remove_empty(&parents));
+    removed
+}
+
+/// Folders above an output folder that runs of this process created and have not committed into.
+static CREATED_PARENTS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn register_parents(dirs: &[PathBuf]) {
+    if let Ok(mut list) = CREATED_PARENTS.lock() {
+        list.extend(dirs.iter().cloned());
+    }
+}
+
+fn unregister_parents(dirs: &[PathBuf]) {
+    if let Ok(mut list) = CREATED_PARENTS.lock() {
+        list.retain(|d| !dirs.contains(d));
+    }
+}
+
+/// The folders a run created to hold its output folder (`--out new/deeper/run` creates `new` and
+/// `new/deeper`): unless [`kept`](Self::keep), they are removed again when empty, on drop and
+/// by [`discard_unfinished`] — a run that ends without output leaves no folder it created.
+#[derive(Debug)]
+pub struct CreatedFolders {
+    /// Deepest first.
+    dirs: Vec<PathBuf>,
+    kept: bool,
+}
+
+impl CreatedFolders {
+    /// Create `dir` and its missing ancestors, remembering those created.
+    pub fn create(dir: &Path) -> Result<Self> {
+        let mut dirs = Vec::new();
+        let mut at = Some(dir);
+        while let Some(d) = at.filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
+            dirs.push(d.to_path_buf());
+            at = d.parent();
+        }
+        let created = CreatedFolders { dirs, kept: false };
+        fs::create_dir_all(dir).map_err(|e| output_error(dir, e))?;
+        register_parents(&created.dirs);
+        Ok(created)
+    }
+
+    /// The output was committed into them: they stay.
+    pub fn keep(mut self) {
+        unregister_parents(&self.dirs);
+        self.kept = true;
+    }
+}
+
+impl Drop for CreatedFolders {
+    fn drop(&mut self) {
+        if !self.kept {
+            unregister_parents(&self.dirs);
+            remove_empty(&self.dirs);
+        }
+    }
+}
+
+/// Remove each folder of `dirs` (deepest first) that is empty; returns those removed.
+fn remove_empty(dirs: &[PathBuf]) -> Vec<PathBuf> {
+    dirs.iter()
+        .filter(|d| fs::remove_dir(d).is_ok())
+        .cloned()
         .collect()
 }
 
@@ -341,6 +423,28 @@ mod tests {
         }
         assert!(!out.exists());
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn folders_created_above_the_output_go_unless_committed_into() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("new/deeper/results");
+        drop(Staging::new(&out, &[]).unwrap());
+        assert_eq!(
+            fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "new/ left behind"
+        );
+        // Committed: the folders hold the output and stay.
+        let staging = Staging::new(&out, &[]).unwrap();
+        staging.write("a.csv", b"x").unwrap();
+        staging.commit().unwrap();
+        assert!(out.join("a.csv").exists());
+        // A folder that existed before is never removed, even when empty.
+        let kept = dir.path().join("kept");
+        fs::create_dir(&kept).unwrap();
+        drop(Staging::new(&kept.join("run"), &[]).unwrap());
+        assert!(kept.exists());
     }
 
     #[test]

@@ -184,12 +184,13 @@ pub type DemoProgress<'a> = &'a dyn Fn(&str);
 /// Run the demo into `out_dir` (created; a previous demo report there is replaced, any other
 /// non-empty folder is refused).
 pub fn run_demo(out_dir: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutcome> {
-    let work = prepare_folder(out_dir)?;
+    let (work, created) = prepare_folder(out_dir)?;
     let result = build(&work, p, progress);
     crate::staging::unregister(&work);
     match result {
         Ok(mut outcome) => {
             replace_folder(&work, out_dir)?;
+            created.keep();
             outcome.out_dir = out_dir.to_path_buf();
             outcome.index = out_dir.join("index.html");
             Ok(outcome)
@@ -202,7 +203,7 @@ pub fn run_demo(out_dir: &Path, p: &DemoParams, progress: DemoProgress) -> Resul
 }
 
 /// A fresh work folder beside `out_dir`; checks that `out_dir` may be replaced.
-fn prepare_folder(out_dir: &Path) -> Result<PathBuf> {
+fn prepare_folder(out_dir: &Path) -> Result<(PathBuf, crate::staging::CreatedFolders)> {
     if out_dir.exists() {
         let previous_demo = out_dir.join("demo.json").is_file();
         let empty = std::fs::read_dir(out_dir)
@@ -222,12 +223,15 @@ fn prepare_folder(out_dir: &Path) -> Result<PathBuf> {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    // `contactscope-out/` and any other folder created here go again if the demo ends without
+    // a report (an error, Ctrl-C).
+    let created = crate::staging::CreatedFolders::create(&parent)?;
     let work = parent.join(format!(".{name}.demo-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&work);
     std::fs::create_dir_all(&work).map_err(|e| Error::io(&work, e))?;
     // Removed by the command line's signal handler if the demo is interrupted.
     crate::staging::register(&work);
-    Ok(work)
+    Ok((work, created))
 }
 
 fn replace_folder(work: &Path, out_dir: &Path) -> Result<()> {
