@@ -193,6 +193,13 @@ impl PixelArg {
                 "pixel size ({x:e}, {y:e}) m must be positive and finite (metres: 200 nm is 2e-7)"
             )));
         }
+        // The plausible range, for every function taking a pixel size (the jobs check it again
+        // where they use it; measure and write_tiff have no job of their own).
+        for v in [x, y] {
+            contactscope_formats::ranges::Quantity::PixelSize
+                .check(v, contactscope_formats::param::Param::PixelSize)
+                .map_err(to_py)?;
+        }
         Ok((x, y))
     }
 }

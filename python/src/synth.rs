@@ -116,6 +116,8 @@ fn synth_newton<'py>(
     detection_gap: f64,
     seed: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
+    // The checks every pixel size gets (positive, finite, plausible).
+    let (pixel_size, _) = crate::PixelArg::Square(pixel_size).xy()?;
     let params = NewtonSynthParams {
         width,
         height,

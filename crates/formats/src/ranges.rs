@@ -148,18 +148,34 @@ impl Quantity {
 }
 
 /// `x` with 7 significant digits and no rounding noise (`0.000001`, not `1.0000000000000002e-6`).
+/// `x` to 7 significant digits, in exponent notation beyond 10⁶ or below 10⁻⁴ (`2e11`, not
+/// `199999999999.99997`).
 fn short(x: f64) -> String {
-    let magnitude = x.abs().log10().floor();
-    if x == 0.0 || !x.is_finite() || magnitude.abs() > 12.0 {
-        return format!("{x:e}");
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
     }
-    let p = 10f64.powi(6 - magnitude as i32);
-    format!("{}", (x * p).round() / p)
+    let rounded: f64 = format!("{x:.6e}").parse().unwrap_or(x);
+    let magnitude = rounded.abs().log10().floor();
+    if !(-4.0..=6.0).contains(&magnitude) {
+        format!("{rounded:e}")
+    } else {
+        format!("{rounded}")
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_in_refusals_are_short() {
+        assert_eq!(short(199999999999.99997), "2e11");
+        assert_eq!(short(0.1), "0.1");
+        assert_eq!(short(1e6), "1000000");
+        assert_eq!(short(-3.7), "-3.7");
+        assert_eq!(short(1.23456789e-5), "1.234568e-5");
+        assert_eq!(short(2.5e-3), "0.0025");
+    }
 
     #[test]
     fn ranges_refuse_absurd_and_non_finite_values() {

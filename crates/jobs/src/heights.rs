@@ -65,7 +65,8 @@ impl HeightInput {
         match self {
             HeightInput::File(s) => s.check(),
             HeightInput::Memory { topography, .. } => {
-                check_pixel_size((topography.dx_m, topography.dy_m))
+                check_pixel_size((topography.dx_m, topography.dy_m))?;
+                check_memory_heights(&topography.heights)
             }
         }
     }
@@ -259,6 +260,28 @@ impl TopographySource {
 }
 
 /// A pixel size (x, y), m, within the plausible range.
+/// Heights given in memory (a Python array) are held to the bound of heights read from a file,
+/// ±[`MAX_FILE_HEIGHT_M`](contactscope_formats::topography::MAX_FILE_HEIGHT_M): beyond it they
+/// were almost always given in another unit than metres (a scan in nanometres gave 1-pixel
+/// contacts at 650 GPa without a word).
+fn check_memory_heights(heights: &ndarray::Array2<f64>) -> Result<()> {
+    let max = contactscope_formats::topography::MAX_FILE_HEIGHT_M;
+    match heights.iter().position(|h| h.is_nan() || h.abs() > max) {
+        None => Ok(()),
+        Some(k) => {
+            let nx = heights.ncols().max(1);
+            let h = heights.iter().nth(k).copied().unwrap_or(f64::NAN);
+            Err(Error::InvalidArgument(format!(
+                "{}: the height at row {}, column {} is {h:.3e} m, beyond ±{max} m: heights are \
+                 in metres (from nanometres, multiply by 1e-9)",
+                Param::Topography,
+                k / nx,
+                k % nx
+            )))
+        }
+    }
+}
+
 fn check_pixel_size((x, y): (f64, f64)) -> Result<()> {
     Quantity::PixelSize.check(x, Param::PixelSize)?;
     Quantity::PixelSize.check(y, Param::PixelSize)?;
