@@ -142,10 +142,11 @@ def in_si(value, factor=1.0):
 
 
 def assert_same_outcome(mine, theirs_lab, rel=1e-12, ignore=()):
-    """Every entry of the command line's JSON (but its version, command line and ``ignore``)
-    is in the Python result, in SI units."""
+    """Every entry of the command line's JSON (but its version, source revision, command line and
+    ``ignore``) is in the Python result, in SI units."""
     theirs = in_si({k: v for k, v in theirs_lab.items()
-                    if k not in ("contactscope_version", "command_line", *ignore)})
+                    if k not in ("contactscope_version", "source_revision", "command_line",
+                                 *ignore)})
 
     def same(a, b, where):
         if isinstance(b, dict):

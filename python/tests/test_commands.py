@@ -69,8 +69,8 @@ def test_friction_matches_cli(cli, friction_inputs, tmp_path):
     # The same keys, in SI units.
     assert set(mine) == {"inputs", "method", "tau_pa", "tau_se_pa", "r2", "static_shear_fit",
                          "kinetic_shear_fit", "mu_static_vs_load", "traces", "warnings"}
-    assert set(theirs) - set(mine) == {"contactscope_version", "command_line", "tau_MPa",
-                                       "tau_se_MPa"}
+    assert set(theirs) - set(mine) == {"contactscope_version", "source_revision", "command_line",
+                                       "tau_MPa", "tau_se_MPa"}
     assert mine.tau_pa * 1e-6 == pytest.approx(theirs["tau_MPa"], rel=1e-12)
     assert mine.tau_pa == pytest.approx(TAU, rel=0.03)
     assert mine.tau_se_pa * 1e-6 == pytest.approx(theirs["tau_se_MPa"], rel=1e-12)

@@ -220,3 +220,41 @@ fn a_rerun_replaces_its_folder_and_a_foreign_folder_is_refused() {
         "nothing left beside"
     );
 }
+
+#[test]
+fn a_manifest_beside_forces_or_other_inputs_is_refused_in_one_line() {
+    // The folder's manifest lists its images and their forces: a second source of forces, or
+    // images read beside it, is refused before anything is written (it was once ignored).
+    let tmp = tempfile::tempdir().unwrap();
+    let folder = fixture_series();
+    let out = tmp.path().join("out");
+    let tif = folder.join("series.tif");
+    let manifest = folder.join("manifest.csv");
+    let cases: [(&[&str], &str, &str); 3] = [
+        (
+            &[s(&folder), "--forces", "1mN..8mN:8"],
+            s(&folder),
+            "--forces would give",
+        ),
+        (&[s(&folder), s(&tif)], s(&folder), "other inputs beside it"),
+        (
+            &[s(&manifest), "--forces", "1,2mN"],
+            s(&manifest),
+            "--forces would give",
+        ),
+    ];
+    for (inputs, named, says) in cases {
+        let mut args = vec!["analyze"];
+        args.extend_from_slice(inputs);
+        args.extend(["--out", s(&out)]);
+        let o = run(&args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(named) && err.contains(says), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(!out.exists(), "{args:?}: wrote {}", out.display());
+    }
+    // Alone, the folder is its manifest.
+    run_ok(&["analyze", s(&folder), "--out", s(&out), "-q"]);
+    assert!(out.join("areas.csv").exists());
+}

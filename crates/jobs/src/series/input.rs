@@ -83,7 +83,10 @@ impl Micrographs {
                         )))
                     }
                     (None, [only], None) if is_manifest(only) => Some(only),
-                    (None, _, _) => None,
+                    (None, inputs, forces) => {
+                        refuse_second_source(inputs, forces.is_some())?;
+                        None
+                    }
                 };
                 let mut series = match manifest {
                     Some(manifest) => from_manifest_selected(
@@ -104,6 +107,33 @@ impl Micrographs {
             Micrographs::Memory(m) => m.open(),
         }
     }
+}
+
+/// A manifest (a folder holding `manifest.csv`, or a CSV) among several inputs or beside forces
+/// is refused: it lists the images and their forces itself, and reading the folder's images with
+/// other forces, or ignoring the manifest, would be silently wrong (issue 31: `analyze folder/
+/// --forces 1mN..8mN:8` once analysed all 8 pages while the manifest listed 2).
+fn refuse_second_source(inputs: &[PathBuf], forces_given: bool) -> Result<()> {
+    let Some(manifest) = inputs.iter().find(|p| is_manifest(p)) else {
+        return Ok(());
+    };
+    let what = if manifest.is_dir() {
+        "holds manifest.csv, which lists the images and their forces"
+    } else {
+        "is a manifest (a CSV listing the images and their forces)"
+    };
+    let conflict = if forces_given {
+        format!("{} would give the forces a second time", Param::Forces)
+    } else {
+        "other inputs beside it would be read without it".to_string()
+    };
+    Err(Error::bad_input(
+        Location::file(manifest),
+        format!(
+            "{what}; {conflict}: give it alone (its forces are used), or the image files with {}",
+            Param::Forces
+        ),
+    ))
 }
 
 /// Whether an input path names a manifest: a `.csv` file or a folder holding `manifest.csv`.
