@@ -7,36 +7,13 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::process::Command;
-
-use serde_json::Value;
 
 use crate::common::root;
 
 /// Each workspace package's dependencies on other workspace packages, and all its dependency
 /// names with their `optional` flag and whether default features are on.
 fn workspace() -> BTreeMap<String, Vec<(String, bool, bool)>> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = Command::new(cargo)
-        .args([
-            "metadata",
-            "--format-version",
-            "1",
-            "--no-deps",
-            "--offline",
-        ])
-        .current_dir(root())
-        .output()
-        .expect("cargo metadata runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let meta: Value = serde_json::from_slice(&out.stdout).expect("JSON");
-    meta["packages"]
-        .as_array()
-        .expect("packages")
+    crate::common::workspace_packages()
         .iter()
         .map(|p| {
             let deps = p["dependencies"]

@@ -4,35 +4,15 @@
 //! themselves are checked by `scripts/test-install` (no Rust on PATH) and the licences of what
 //! they ship by `scripts/licence-audit`.
 
-use std::process::Command;
-
 use serde_json::Value;
 
 use crate::common::{root, run};
 
 const VERSION: &str = env!("CARGO_PKG_VERSION");
 
-/// `cargo metadata --no-deps`: the workspace's packages.
+/// The workspace's packages (`cargo metadata --no-deps`).
 fn packages() -> Vec<Value> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = Command::new(cargo)
-        .args([
-            "metadata",
-            "--format-version",
-            "1",
-            "--no-deps",
-            "--offline",
-        ])
-        .current_dir(root())
-        .output()
-        .expect("cargo metadata runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let meta: Value = serde_json::from_slice(&out.stdout).expect("cargo metadata is JSON");
-    meta["packages"].as_array().expect("packages").clone()
+    crate::common::workspace_packages()
 }
 
 fn read(path: &str) -> String {

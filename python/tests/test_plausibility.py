@@ -117,21 +117,26 @@ def refusal(call, value):
     return errors[0]
 
 
-@pytest.mark.parametrize("case", sorted(
-    [(f.__module__, f.__name__, k) for f, k in entry_points() if k in PIXEL_KEYWORDS]),
-    ids=lambda case: f"{case[1]}-{case[2]}-{case[0].split('.')[-1]}")
-def test_a_pixel_size_in_nanometres_given_as_metres_is_refused(files, case):
+def cases(keywords):
+    return pytest.mark.parametrize(
+        "case",
+        sorted((f.__module__, f.__name__, k) for f, k in entry_points() if k in keywords),
+        ids=lambda case: f"{case[1]}-{case[2]}-{case[0].split('.')[-1]}")
+
+
+def refusal_of(files, case, value):
     module, name, keyword = case
     f = getattr(cs if module == "contactscope" else dist, name)
-    message = refusal(calls(files)[(f, keyword)], NM_AS_METRES)
+    return refusal(calls(files)[(f, keyword)], value)
+
+
+@cases(PIXEL_KEYWORDS)
+def test_a_pixel_size_in_nanometres_given_as_metres_is_refused(files, case):
+    message = refusal_of(files, case, NM_AS_METRES)
     assert "plausible range" in message and "nm" in message, message
 
 
-@pytest.mark.parametrize("case", sorted(
-    [(f.__module__, f.__name__, k) for f, k in entry_points() if k in HEIGHT_KEYWORDS]),
-    ids=lambda case: f"{case[1]}-{case[2]}-{case[0].split('.')[-1]}")
+@cases(HEIGHT_KEYWORDS)
 def test_heights_in_nanometres_given_as_metres_are_refused(files, case):
-    module, name, keyword = case
-    f = getattr(cs if module == "contactscope" else dist, name)
-    message = refusal(calls(files)[(f, keyword)], HEIGHTS_NM)
+    message = refusal_of(files, case, HEIGHTS_NM)
     assert "heights=" in message and "beyond ±1 m" in message, message
