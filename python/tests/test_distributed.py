@@ -355,7 +355,12 @@ def test_an_interrupted_sweep_leaves_no_folder_and_no_workers(tmp_path):
     if not sys.platform.startswith("linux"):
         pytest.skip("reads /proc to find the worker processes")
     script = tmp_path / "interrupted.py"
+    # The script turns Ctrl-C into KeyboardInterrupt itself, as Python does for a user at a
+    # terminal: launched from a process that ignores SIGINT (a CI job started in the background),
+    # it would inherit the ignoring, and the signal would do nothing.
     script.write_text(
+        "import signal\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "import sys\n"
         "import numpy as np\n"
         "import contactscope as cs\n"
