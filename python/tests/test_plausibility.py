@@ -1,5 +1,5 @@
 """Every Python entry point that takes heights or a pixel size checks them as the command line
-does (issue 31: a scan in nanometres given as metres once gave a 1-pixel contact at 650 GPa and
+does (a scan in nanometres given as metres once gave a 1-pixel contact at 650 GPa and
 no warning). The table below must name every such function and keyword: a new one fails
 ``test_every_entry_point_is_in_the_table`` until it is added here."""
 

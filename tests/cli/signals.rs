@@ -9,6 +9,24 @@ use std::time::{Duration, Instant};
 
 use crate::common::rough_surface;
 
+/// Wait (at most a minute) until `path` exists, then send `signal` to `child`.
+fn signal_once_written(child: &std::process::Child, path: &Path, signal: &str) {
+    let start = Instant::now();
+    while !path.exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "{} never appeared",
+            path.display()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let status = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(status.success());
+}
+
 /// Start a `simulate` of many loads into `dir/out`, wait until its staging folder holds a file
 /// (it is inside the load ramp), send `signal`, and return (exit code, stderr).
 fn interrupt(dir: &Path, out: &str, surface: &Path, signal: &str) -> (Option<i32>, String) {
@@ -42,19 +60,7 @@ fn interrupt(dir: &Path, out: &str, surface: &Path, signal: &str) -> (Option<i32
         .parent()
         .expect("a parent")
         .join(format!(".sim.staging-{}", child.id()));
-    let start = Instant::now();
-    while !staging.join("load_001_contact.tif").exists() {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the first load was never written"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let status = Command::new("kill")
-        .args([signal, &child.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(status.success());
+    signal_once_written(&child, &staging.join("load_001_contact.tif"), signal);
     let output = child.wait_with_output().expect("the child ends");
     assert!(!staging.exists(), "{signal}: staging folder left behind");
     assert!(!out.exists(), "{signal}: partial output folder");
@@ -106,19 +112,7 @@ fn an_interrupted_demo_leaves_no_folder_it_created() {
         .path()
         .join("contactscope-out")
         .join(format!(".demo.demo-{}", child.id()));
-    let start = Instant::now();
-    while !work.join("data").exists() {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the demo never began"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .expect("kill runs");
-    assert!(status.success());
+    signal_once_written(&child, &work.join("data"), "-INT");
     let output = child.wait_with_output().expect("the child ends");
     let err = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(130), "{err}");

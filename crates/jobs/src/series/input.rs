@@ -111,7 +111,7 @@ impl Micrographs {
 
 /// A manifest (a folder holding `manifest.csv`, or a CSV) among several inputs or beside forces
 /// is refused: it lists the images and their forces itself, and reading the folder's images with
-/// other forces, or ignoring the manifest, would be silently wrong (issue 31: `analyze folder/
+/// other forces, or ignoring the manifest, would be silently wrong (`analyze folder/
 /// --forces 1mN..8mN:8` once analysed all 8 pages while the manifest listed 2).
 fn refuse_second_source(inputs: &[PathBuf], forces_given: bool) -> Result<()> {
     let Some(manifest) = inputs.iter().find(|p| is_manifest(p)) else {
