@@ -16,7 +16,7 @@ use super::args::{
     default_out, frame_forces, Forces, LoadAxisArg, OutputFolder, PixelSizeArg, Quiet,
     SelectionArgs,
 };
-use super::common::{command_line, progress_bar};
+use super::common::{command_line, progress_bar, Finished};
 
 default_out!(Out, "contactscope-out/analyze");
 
@@ -78,7 +78,7 @@ fn micrographs(args: &Args) -> Result<Micrographs> {
     }))
 }
 
-pub fn run(args: Args) -> Result<()> {
+pub fn run(args: Args) -> Result<Finished> {
     let hertz = match (&args.radius, &args.modulus) {
         (Some(r), Some(e)) => Some(HertzParams {
             radius_m: units::parse_positive(r, Dimension::Length).context("--radius")?,
@@ -117,7 +117,7 @@ pub fn run(args: Args) -> Result<()> {
     bar.finish_and_clear();
     let (outcome, written) = outcome?;
     print_outcome(&outcome, &written, &args.out.out);
-    Ok(())
+    Ok(Finished::unless_nothing_valid(outcome.nothing_valid()))
 }
 
 fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
@@ -168,7 +168,10 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
     }
     if let Some(fit) = outcome.fits.power_law {
         let beta = contactscope_jobs::table::value_pm_or(fit.exponent, fit.exponent_se, 3);
-        println!("power law: A ∝ N^β, β = {beta}, R² = {:.4}", fit.r_squared);
+        let r2 = fit
+            .r_squared
+            .map_or("— (fewer than 3 points)".into(), |r| format!("{r:.4}"));
+        println!("power law: A ∝ N^β, β = {beta}, R² = {r2}");
     }
     if let Some((p, _)) = outcome.fits.proportional_mpa {
         println!("proportional fit: A = N/p, p = {p:.1} MPa");

@@ -8,6 +8,28 @@ use std::path::Path;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+/// How a command that ran to its end finished: its exit status (`docs/errors.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Finished {
+    /// Everything asked for was done: 0.
+    Complete,
+    /// `batch`: the tables are written but some series failed: 3.
+    SomeFailed,
+    /// The outputs are written but no load is valid (edge contact or no contact in every
+    /// one), so no fit rests on anything: 4.
+    NothingValid,
+}
+
+impl Finished {
+    /// [`Finished::NothingValid`] when `nothing_valid`, else [`Finished::Complete`].
+    pub fn unless_nothing_valid(nothing_valid: bool) -> Self {
+        match nothing_valid {
+            true => Finished::NothingValid,
+            false => Finished::Complete,
+        }
+    }
+}
+
 /// A progress bar on stderr, hidden with --quiet, when stderr is not a terminal, or when there
 /// are fewer than `min_items` items (a short job needs none).
 pub fn progress_bar(items: usize, min_items: usize, quiet: bool) -> ProgressBar {

@@ -195,11 +195,13 @@ pub fn run(args: Args) -> Result<()> {
         let parameter = match (fit.family, fit.best.parameter) {
             (Family::Hardening, Some(k)) => match fit.parameter_se {
                 Some(s) => format!("k = {} MPa/nm", value_pm(k * 1e-15, s * 1e-15)),
-                None => format!("k = {:.3} ± ? MPa/nm", k * 1e-15),
+                None if fit.undetermined => "k undetermined".into(),
+                None => format!("k = {:.3} MPa/nm (no standard error)", k * 1e-15),
             },
             (Family::Hardness, Some(p)) => match fit.parameter_se {
                 Some(s) => format!("p_Y = {} MPa", value_pm(p * 1e-6, s * 1e-6)),
-                None => format!("p_Y = {:.1} ± ? MPa", p * 1e-6),
+                None if fit.undetermined => "p_Y undetermined".into(),
+                None => format!("p_Y = {:.1} MPa (no standard error)", p * 1e-6),
             },
             _ => "—".into(),
         };

@@ -71,6 +71,13 @@ pub fn run(args: Args) -> Result<()> {
         i.byte_order
     );
     println!("description:  {}", i.description_kind);
+    if let Some(q) = &i.quantity {
+        let unit = i
+            .value_unit
+            .as_deref()
+            .map_or(String::new(), |u| format!(" in {u}"));
+        println!("values:       {}{unit}", q.replace('_', " "));
+    }
     match i.pixel_size {
         Some(p) => println!(
             "pixel size:   {} × {} from {}",

@@ -30,6 +30,8 @@ use std::process::ExitCode;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
+use common::Finished;
+
 #[derive(Parser)]
 #[command(
     name = "contactscope",
@@ -165,29 +167,34 @@ fn main() -> ExitCode {
     contactscope_formats::param::set_front_end(contactscope_formats::param::FrontEnd::CommandLine);
     signals::discard_on_interrupt();
     contactscope_jobs::provenance::set_source_revision(env!("CONTACTSCOPE_SOURCE_REVISION"));
-    let mut some_failed = false;
+    let done = |r: anyhow::Result<()>| r.map(|()| Finished::Complete);
     let result = match command {
         Command::Analyze(args) => analyze::run(args),
-        Command::Batch(args) => batch::run(*args).map(|all_ok| some_failed = !all_ok),
-        Command::Threshold(args) => threshold::run(args),
-        Command::Info(args) => info::run(args),
-        Command::SynthSeries(args) => synth_series::run(args),
-        Command::Demo(args) => demo::run(args),
+        Command::Batch(args) => batch::run(*args).map(|all_ok| match all_ok {
+            true => Finished::Complete,
+            false => Finished::SomeFailed,
+        }),
+        Command::Threshold(args) => done(threshold::run(args)),
+        Command::Info(args) => done(info::run(args)),
+        Command::SynthSeries(args) => done(synth_series::run(args)),
+        Command::Demo(args) => done(demo::run(args)),
         Command::Simulate(args) => simulate::run(args),
-        Command::Surface(args) => surface::run(args),
-        Command::Topography(args) => topography::run(args),
-        Command::Autocorr(args) => autocorr::run(args),
-        Command::Compare(args) => compare::run(args),
-        Command::FitHardening(args) => fit_hardening::run(args),
-        Command::Newton(args) => newton::run(args),
-        Command::Psf(args) => psf::run(args),
-        Command::Friction(args) => friction::run(args),
-        Command::Hertz(args) => hertz::run(args),
+        Command::Surface(args) => done(surface::run(args)),
+        Command::Topography(args) => done(topography::run(args)),
+        Command::Autocorr(args) => done(autocorr::run(args)),
+        Command::Compare(args) => done(compare::run(args)),
+        Command::FitHardening(args) => done(fit_hardening::run(args)),
+        Command::Newton(args) => done(newton::run(args)),
+        Command::Psf(args) => done(psf::run(args)),
+        Command::Friction(args) => done(friction::run(args)),
+        Command::Hertz(args) => done(hertz::run(args)),
     };
     match result {
+        Ok(Finished::Complete) => ExitCode::SUCCESS,
         // A batch whose tables are written but some series failed (docs/errors.md).
-        Ok(()) if some_failed => ExitCode::from(3),
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(Finished::SomeFailed) => ExitCode::from(3),
+        // Outputs written, but no load valid (docs/errors.md).
+        Ok(Finished::NothingValid) => ExitCode::from(4),
         Err(e) if signals::closed_output(&e) => signals::end_by_sigpipe(),
         Err(_) if signals::interrupted() => loop {
             // The signal handler reports and exits; the run's error is a consequence.

@@ -11,7 +11,7 @@ use contactscope_jobs::simulate::files::run_to_folder;
 use contactscope_jobs::simulate::{MapChoice, ModelChoice, SimulateRequest};
 
 use super::args::{default_out, load_forces, BodyArgs, Forces, OutputFolder, Quiet, SolverArgs};
-use super::common::{command_line, print_warnings, print_written, progress_bar};
+use super::common::{command_line, print_warnings, print_written, progress_bar, Finished};
 
 default_out!(Out, "contactscope-out/simulate");
 
@@ -110,7 +110,7 @@ fn model_of(args: &Args) -> Result<ModelChoice> {
     })
 }
 
-pub fn run(args: Args) -> Result<()> {
+pub fn run(args: Args) -> Result<Finished> {
     let hardness_model = matches!(args.model, ModelArg::Hardness);
     let hardening_model = matches!(args.model, ModelArg::Hardening);
     if args.volume_conserving.is_some() && !hardness_model {
@@ -176,8 +176,12 @@ pub fn run(args: Args) -> Result<()> {
         } else {
             "—".to_string()
         };
+        let note = match l.load_point().excluded {
+            Some(why) => format!("  ({}: left out of the fit)", why.legend()),
+            None => String::new(),
+        };
         println!(
-            "{:>10.4} {:>12.4} {:>9.5} {:>10} {:>8} {:>6}",
+            "{:>10.4} {:>12.4} {:>9.5} {:>10} {:>8} {:>6}{note}",
             l.force_n * 1e3,
             l.area_m2 * 1e12,
             l.contact_fraction,
@@ -186,6 +190,16 @@ pub fn run(args: Args) -> Result<()> {
             l.iterations
         );
     }
+    if let Some(fit) = outcome.power_law {
+        let beta = contactscope_jobs::table::value_pm_or(fit.exponent, fit.exponent_se, 3);
+        let r2 = fit
+            .r_squared
+            .map_or("— (fewer than 3 loads)".into(), |r| format!("{r:.4}"));
+        println!(
+            "power law over {} loads: A ∝ N^β, β = {beta}, R² = {r2}",
+            fit.points
+        );
+    }
     print_written(written.len(), &args.out.out);
-    Ok(())
+    Ok(Finished::unless_nothing_valid(outcome.nothing_valid()))
 }

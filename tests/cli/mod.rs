@@ -2,6 +2,7 @@
 //! every physical value, signals, and the hostile-file corpus.
 
 mod hostile;
+mod plausible;
 mod ranges;
 mod signals;
 mod usage;

@@ -114,7 +114,8 @@ fn analyze_a_directory_with_forces() {
             "mean_pressure_MPa",
             "equivalent_radius_um",
             "hertz_radius_um",
-            "hertz_area_um2"
+            "hertz_area_um2",
+            "edge_contact"
         ]
     );
     assert_eq!(rows.len(), 4);
@@ -259,14 +260,14 @@ fn without_pixel_size_areas_are_in_pixels_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
     let tif = dir.path().join("plain.tif");
     let images = synth::generate(&SynthParams {
-        width: 64,
-        height: 64,
+        width: 128,
+        height: 128,
         forces_n: vec![4e-3, 8e-3],
         ..SynthParams::default()
     })
     .unwrap();
     let pages: Vec<&[u16]> = images.iter().map(|i| i.codes.as_slice()).collect();
-    fs::write(&tif, encode_u16_stack(&pages, 64, 64, None, "").unwrap()).unwrap();
+    fs::write(&tif, encode_u16_stack(&pages, 128, 128, None, "").unwrap()).unwrap();
     let out_dir = dir.path().join("out");
     let o = run(&[
         "analyze",

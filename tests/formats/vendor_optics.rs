@@ -245,7 +245,7 @@ fn compare_reads_a_czi_load_series_as_its_tiff_export() {
     let topo = tmp.path().join("rough.npy");
     crate::common::rough_surface(&topo, 128, "50nm", 4, &["--rolloff", "2um"]);
     let sim = tmp.path().join("sim");
-    run_ok(&[
+    crate::common::run_written(&[
         "simulate",
         "--topography",
         s(&topo),

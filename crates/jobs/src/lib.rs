@@ -22,6 +22,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod fits;
 pub mod heights;
 pub mod images;
 pub mod lab;

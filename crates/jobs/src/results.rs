@@ -13,6 +13,7 @@ use contactscope::compare::SimulatedMap;
 use contactscope::optics::blur::Grid;
 use contactscope_formats::ranges::Quantity;
 use contactscope_formats::tiff::read_image;
+use contactscope_formats::tiff::write::quantity;
 
 /// (force N, area m²) rows of an `analyze` areas.csv (columns `force_mN` or `force_N`, and
 /// `area_um2`); a table in pixels is refused with a hint, as is one without rows. Rows at 0 N
@@ -126,6 +127,21 @@ pub fn simulated_maps(dir: &Path) -> Result<Vec<SimulatedMap>> {
 }
 
 fn read_map(path: &Path, force_n: f64) -> Result<SimulatedMap> {
+    let info = contactscope_formats::tiff::TiffReader::open(path)?
+        .info()
+        .clone();
+    if let Some(q) = info.quantity.as_deref().filter(|q| *q != quantity::CONTACT) {
+        return Err(Error::bad_input(
+            Location::file(path),
+            format!(
+                "holds {}{}, not a contact map (1 in contact, 0 elsewhere)",
+                q.replace('_', " "),
+                info.value_unit
+                    .as_deref()
+                    .map_or(String::new(), |u| format!(" in {u}"))
+            ),
+        ));
+    }
     let image = read_image(path, None, None)?;
     let px = image.require_pixel_size()?;
     let at = Location::file(path);

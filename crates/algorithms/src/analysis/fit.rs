@@ -12,10 +12,13 @@ pub struct PowerLawFit {
     pub exponent: f64,
     /// Standard error of β (needs at least 3 points; `None` otherwise).
     pub exponent_se: Option<f64>,
-    /// Coefficient of determination of the log–log regression.
-    pub r_squared: f64,
+    /// Coefficient of determination of the log–log regression; `None` with fewer than three
+    /// points (two points always give 1) or when every area is the same (no variance to explain).
+    pub r_squared: Option<f64>,
     /// Points used (positive force and area).
     pub points: usize,
+    /// Distinct forces among them (repeated loads are replicates, not new points of the law).
+    pub distinct_forces: usize,
 }
 
 impl PowerLawFit {
@@ -52,7 +55,10 @@ pub fn fit_power_law(x: &[f64], y: &[f64]) -> Option<PowerLawFit> {
         .iter()
         .map(|p| (p.1 - intercept - beta * p.0).powi(2))
         .sum();
-    let r_squared = if syy > 0.0 { 1.0 - ss_res / syy } else { 1.0 };
+    let r_squared = (n > 2 && syy > 0.0).then(|| 1.0 - ss_res / syy);
+    let mut xs: Vec<f64> = pts.iter().map(|p| p.0).collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
     let exponent_se = (n > 2).then(|| (ss_res / (n - 2) as f64 / sxx).sqrt());
     Some(PowerLawFit {
         prefactor: intercept.exp(),
@@ -60,6 +66,7 @@ pub fn fit_power_law(x: &[f64], y: &[f64]) -> Option<PowerLawFit> {
         exponent_se,
         r_squared,
         points: n,
+        distinct_forces: xs.len(),
     })
 }
 
@@ -93,7 +100,8 @@ mod tests {
         let fit = fit_power_law(&forces, &areas).unwrap();
         assert!((fit.exponent - 2.0 / 3.0).abs() < 1e-12);
         assert!(fit.exponent_se.unwrap() < 1e-12);
-        assert!((fit.r_squared - 1.0).abs() < 1e-12);
+        assert!((fit.r_squared.unwrap() - 1.0).abs() < 1e-12);
+        assert_eq!(fit.distinct_forces, 12);
         assert!((fit.eval(50.0) / areas[0] - (50.0f64).powf(2.0 / 3.0)).abs() < 1e-9);
     }
 
@@ -109,7 +117,21 @@ mod tests {
         assert!((fit.exponent - 0.8).abs() < 0.03);
         let se = fit.exponent_se.unwrap();
         assert!(se > 1e-4 && se < 0.05, "se = {se}");
-        assert!(fit.r_squared > 0.99 && fit.r_squared < 1.0);
+        let r2 = fit.r_squared.unwrap();
+        assert!(r2 > 0.99 && r2 < 1.0);
+    }
+
+    #[test]
+    fn two_points_or_constant_areas_have_no_r_squared() {
+        let two = fit_power_law(&[1.0, 2.0], &[1.0, 3.0]).unwrap();
+        assert_eq!(
+            (two.r_squared, two.exponent_se, two.points),
+            (None, None, 2)
+        );
+        let flat = fit_power_law(&[1.0, 2.0, 4.0], &[5.0, 5.0, 5.0]).unwrap();
+        assert_eq!((flat.exponent, flat.r_squared), (0.0, None));
+        let repeated = fit_power_law(&[1.0, 1.0, 2.0, 2.0], &[1.0, 1.1, 2.0, 2.1]).unwrap();
+        assert_eq!((repeated.points, repeated.distinct_forces), (4, 2));
     }
 
     #[test]

@@ -30,6 +30,7 @@ use crate::spectral::register::{
     register_series, translate, Dihedral, LoadShift, Refinement, SeriesOptions,
 };
 use crate::threshold::otsu_of_values;
+use contactscope_formats::ranges::short;
 
 /// How simulated maps are imaged, registered and matched to micrographs.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -417,6 +418,22 @@ fn render(
     }
     let at = || Location::file(&sim.source);
     let raw_area_m2 = sim.map.integral();
+    // The rendered size is known before rendering: a simulation that would cover more than the
+    // micrograph is refused before its (possibly huge) image on micrograph pixels is allocated.
+    let (px, py) = micrographs.pixel_m;
+    let at_least = (
+        (sim.map.width as f64 * sim.map.dx_m / px).floor(),
+        (sim.map.height as f64 * sim.map.dy_m / py).floor(),
+    );
+    if at_least.0 > w as f64 || at_least.1 > h as f64 {
+        return Err(Error::bad_input(
+            at(),
+            format!(
+                "the simulated region ({}×{} micrograph pixels of {}×{} nm) is larger than the micrograph ({w}×{h}); crop the simulation, or check the micrographs' pixel size",
+                at_least.0, at_least.1, short(px * 1e9), short(py * 1e9)
+            ),
+        ));
+    }
     let rendered = microscope_image(&sim.map, settings.psf_fwhm_m, micrographs.pixel_m)
         .map_err(|e| Error::bad_input(at(), e.to_string()))?;
     if rendered.width > w || rendered.height > h {

@@ -25,6 +25,38 @@ pub struct Mask {
 }
 
 impl Mask {
+    /// Contact pixels on the border of the image (corners counted once).
+    pub fn border_contact_pixels(&self) -> u64 {
+        let (w, h) = (self.width, self.height);
+        if w == 0 || h == 0 || self.data.len() < w * h {
+            return 0;
+        }
+        let on = |i: usize| u64::from(self.data[i] != 0);
+        let mut n: u64 = (0..w).map(|x| on(x)).sum();
+        if h > 1 {
+            n += (0..w).map(|x| on((h - 1) * w + x)).sum::<u64>();
+        }
+        for y in 1..h.saturating_sub(1) {
+            n += on(y * w);
+            if w > 1 {
+                n += on(y * w + w - 1);
+            }
+        }
+        n
+    }
+
+    /// Whether the contact is cut off by the image border by more than a sliver: more than
+    /// [`EDGE_CHORD_PER_SQRT_AREA`]·√(contact pixels) contact pixels on the border. For a compact
+    /// contact of area A = πr² cut by the border along a chord c, the part beyond the border is
+    /// about c³/(12πr³) of A; c = 0.32·√A ≈ 0.57 r puts it at 0.5 %. A few asperity patches
+    /// touching the border of a large field stay below this; a contact wider than the field does
+    /// not.
+    pub fn edge_contact(&self) -> bool {
+        let contact = self.data.iter().filter(|&&m| m != 0).count() as f64;
+        let border = self.border_contact_pixels() as f64;
+        border > 0.0 && border > EDGE_CHORD_PER_SQRT_AREA * contact.sqrt()
+    }
+
     /// Contact flags as booleans.
     pub fn as_bools(&self) -> Vec<bool> {
         self.data.iter().map(|&m| m != 0).collect()
@@ -48,6 +80,8 @@ pub struct Measurement {
     pub patches: u64,
     /// Pixels in the largest patch.
     pub largest_patch_pixels: u64,
+    /// The contact is cut off by the image border ([`Mask::edge_contact`]).
+    pub edge_contact: bool,
 }
 
 /// Running sums over one class of pixels.
@@ -62,6 +96,10 @@ impl ClassSums {
         (self.count > 0).then(|| self.sum / self.count as f64)
     }
 }
+
+/// Border contact pixels per √(contact pixels) beyond which a contact counts as cut off by the
+/// image border ([`Mask::edge_contact`]).
+pub const EDGE_CHORD_PER_SQRT_AREA: f64 = 0.32;
 
 /// Classify every pixel and measure. Errors if the threshold's rule does not fit the data.
 pub fn measure(plane: &Plane, threshold: &Threshold) -> Result<(Measurement, Mask)> {
@@ -91,6 +129,7 @@ pub fn measure(plane: &Plane, threshold: &Threshold) -> Result<(Measurement, Mas
         background_mean: background.mean(),
         patches,
         largest_patch_pixels,
+        edge_contact: mask.edge_contact(),
     };
     Ok((measurement, mask))
 }
@@ -200,6 +239,63 @@ mod tests {
             height: rows.len(),
             data,
         }
+    }
+
+    #[test]
+    fn border_contact_is_counted_on_every_side() {
+        let mask = |on: &[usize]| {
+            let mut data = vec![0u8; 16];
+            for &i in on {
+                data[i] = 1;
+            }
+            Mask {
+                width: 4,
+                height: 4,
+                data,
+            }
+        };
+        assert_eq!(
+            mask(&[5, 6, 9, 10]).border_contact_pixels(),
+            0,
+            "interior only"
+        );
+        for side in [1, 4, 7, 14, 0, 15] {
+            assert_eq!(mask(&[5, side]).border_contact_pixels(), 1, "pixel {side}");
+        }
+        assert_eq!(
+            mask(&(0..16).collect::<Vec<_>>()).border_contact_pixels(),
+            12
+        );
+    }
+
+    #[test]
+    fn a_contact_is_cut_off_by_a_chord_not_by_a_speck() {
+        // A disk of radius 30 px centred `d` px from the left border of a 200² image.
+        let disk = |d: f64| {
+            let (w, h) = (200, 200);
+            let data = (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as f64, (i / w) as f64);
+                    u8::from((x - d).powi(2) + (y - 100.0).powi(2) <= 900.0)
+                })
+                .collect();
+            Mask {
+                width: w,
+                height: h,
+                data,
+            }
+        };
+        assert!(!disk(31.0).edge_contact(), "inside");
+        // Grazing the border (a few pixels on it): well under 0.5 % of the disk beyond it.
+        let grazing = disk(29.5);
+        assert!(grazing.border_contact_pixels() > 0);
+        assert!(!grazing.edge_contact());
+        // Cut by a chord of 2·√(30² − 20²) ≈ 45 px: 10 % of the disk beyond the border.
+        assert!(disk(20.0).edge_contact());
+        // One speck on the border beside a large interior contact.
+        let mut speck = disk(100.0);
+        speck.data[100 * 200] = 1;
+        assert!(!speck.edge_contact());
     }
 
     #[test]

@@ -110,6 +110,10 @@ pub struct ModelFit {
     pub trace: Vec<(f64, f64)>,
     /// The optimum lies at an end of the search range.
     pub at_range_edge: bool,
+    /// The simulated areas do not change when the parameter moves 5 % either way from its best
+    /// value (no pixel is near the yield condition, say): the misfit is flat there, the value is
+    /// not determined by the data and has no standard error.
+    pub undetermined: bool,
 }
 
 /// What [`ModelBody`] reports after each load of a ramp it runs.
@@ -493,13 +497,14 @@ pub fn fit_parameter(
     })?;
     let trace = trace.into_inner().expect("trace");
     let best_eval = body.score(family, Some(ln_best.exp()), measured, false)?;
-    let parameter_se = standard_error(body, family, measured, ln_best, &best_eval)?;
+    let (parameter_se, undetermined) = standard_error(body, family, measured, ln_best, &best_eval)?;
     Ok(ModelFit {
         family,
         best: best_eval,
         parameter_se,
         trace,
         at_range_edge,
+        undetermined,
     })
 }
 
@@ -537,18 +542,19 @@ fn brent_minimum(lo: f64, hi: f64, width: f64, f: &(dyn Fn(f64) -> f64 + Sync)) 
 /// log ratios, of order 1).
 const INFEASIBLE_MISFIT: f64 = 1e6;
 
-/// Gauss–Newton standard error of the parameter at `ln_best` (see the module docs); `None` with a
-/// single load or a flat response.
+/// Gauss–Newton standard error of the parameter at `ln_best` (see the module docs), and whether
+/// the response is flat there (the parameter undetermined). No standard error with a single load,
+/// next to an infeasible region or with a flat response.
 fn standard_error(
     body: &ModelBody,
     family: Family,
     measured: &Measured,
     ln_best: f64,
     best: &Evaluation,
-) -> Result<Option<f64>> {
+) -> Result<(Option<f64>, bool)> {
     let n = measured.areas_m2.len();
     if n < 2 {
-        return Ok(None);
+        return Ok((None, false));
     }
     let h = 0.05;
     let sides: Result<Vec<Vec<f64>>> = [ln_best - h, ln_best + h]
@@ -557,7 +563,7 @@ fn standard_error(
         .collect();
     // Next to an infeasible region there is no two-sided derivative.
     let Ok(sides) = sides else {
-        return Ok(None);
+        return Ok((None, false));
     };
     let jacobian: Vec<f64> = sides[0]
         .iter()
@@ -566,11 +572,12 @@ fn standard_error(
         .collect();
     let jtj: f64 = jacobian.iter().map(|j| j * j).sum();
     if jtj <= 0.0 {
-        return Ok(None);
+        // The areas are the same on both sides: the data do not fix the parameter.
+        return Ok((None, true));
     }
     let residuals = measured.log_residuals(&best.areas_m2);
     let s2 = residuals.iter().map(|r| r * r).sum::<f64>() / (n - 1) as f64;
-    Ok(Some(ln_best.exp() * (s2 / jtj).sqrt()))
+    Ok((Some(ln_best.exp() * (s2 / jtj).sqrt()), false))
 }
 
 #[cfg(test)]

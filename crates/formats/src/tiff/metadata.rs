@@ -20,6 +20,12 @@ pub struct ImageJDescription {
     pub slices: Option<usize>,
     /// `frames=`.
     pub frames: Option<usize>,
+    /// `quantity=`: what the values are (contactscope's maps: `height`, `pressure`, `gap`,
+    /// `plastic_displacement`, `contact`, `contact_mask`, `intensity`).
+    pub quantity: Option<String>,
+    /// `vunit=`: the unit of the values (ImageJ's calibration key; contactscope writes `um`,
+    /// `MPa`, or `1` for 0/1 maps).
+    pub value_unit: Option<String>,
 }
 
 /// Parse an ImageJ ImageDescription; `None` if the text is not one.
@@ -41,6 +47,8 @@ pub fn parse_imagej(description: &str) -> Option<ImageJDescription> {
             "channels" => meta.channels = value.trim().parse().ok(),
             "slices" => meta.slices = value.trim().parse().ok(),
             "frames" => meta.frames = value.trim().parse().ok(),
+            "quantity" => meta.quantity = Some(value.trim().to_string()),
+            "vunit" => meta.value_unit = Some(value.trim().to_string()),
             _ => {}
         }
     }

@@ -81,6 +81,11 @@ pub struct TiffInfo {
     pub pixel_size: Option<PixelSize>,
     /// What kind of ImageDescription the file has ("ImageJ", "OME-XML", "text" or "none").
     pub description_kind: String,
+    /// What the values are, where the ImageJ description says (`quantity=`; contactscope's maps
+    /// and micrographs say it, see [`super::write::values_description`]).
+    pub quantity: Option<String>,
+    /// The values' unit, where the ImageJ description says (`vunit=`).
+    pub value_unit: Option<String>,
     /// Notes about ignored or doubtful metadata.
     pub notes: Vec<String>,
 }
@@ -449,6 +454,8 @@ fn read_info<R: Read + Seek>(path: &Path, decoder: &mut Decoder<R>) -> Result<Ti
         byte_order: byte_order.into(),
         pixel_size,
         description_kind: description_kind.into(),
+        quantity: imagej.as_ref().and_then(|m| m.quantity.clone()),
+        value_unit: imagej.as_ref().and_then(|m| m.value_unit.clone()),
         notes,
     })
 }

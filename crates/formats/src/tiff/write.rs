@@ -34,6 +34,35 @@ fn imagej_description(pages: usize, pixel_size: Option<(f64, f64)>, extra: &str)
     d
 }
 
+/// What a written file's values are, for its ImageJ description: `quantity=` and, for values with
+/// a unit, `vunit=` (ImageJ's key for the unit of calibrated values). contactscope's readers
+/// honour both: `topography` reads a `height` map in its `vunit` and refuses other quantities,
+/// `compare` takes only `contact` maps, `analyze` only `intensity` images.
+pub fn values_description(quantity: &str, unit: Option<&str>) -> String {
+    match unit {
+        Some(u) => format!("quantity={quantity}\nvunit={u}\n"),
+        None => format!("quantity={quantity}\n"),
+    }
+}
+
+/// The quantities contactscope writes (`quantity=` of [`values_description`]).
+pub mod quantity {
+    /// Heights of a surface (the deformed topography of `simulate`).
+    pub const HEIGHT: &str = "height";
+    /// Contact pressure.
+    pub const PRESSURE: &str = "pressure";
+    /// Gap between the surfaces.
+    pub const GAP: &str = "gap";
+    /// Plastic displacement.
+    pub const PLASTIC: &str = "plastic_displacement";
+    /// Computed contact, 1 in contact and 0 elsewhere.
+    pub const CONTACT: &str = "contact";
+    /// A thresholded micrograph's contact mask, 255 in contact and 0 elsewhere.
+    pub const CONTACT_MASK: &str = "contact_mask";
+    /// Fluorescence intensity (camera counts): a micrograph.
+    pub const INTENSITY: &str = "intensity";
+}
+
 /// Compression of written TIFF pages.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Compression {
@@ -109,8 +138,8 @@ where
     Ok(bytes.into_inner())
 }
 
-/// Encode 16-bit grey pages as one uncompressed multi-page TIFF with ImageJ calibration (pixel
-/// size in m).
+/// Encode 16-bit grey pages (micrographs: described as `quantity=intensity`) as one
+/// uncompressed multi-page TIFF with ImageJ calibration (pixel size in m).
 pub fn encode_u16_stack(
     pages: &[&[u16]],
     width: usize,
@@ -137,24 +166,30 @@ pub fn encode_u16_stack_compressed(
     extra_description: &str,
     compression: Compression,
 ) -> Result<Vec<u8>> {
-    encode_stack::<colortype::Gray16>(
-        pages,
-        width,
-        height,
-        pixel_size,
-        extra_description,
-        compression,
-    )
+    let description = format!(
+        "{extra_description}{}",
+        values_description(quantity::INTENSITY, None)
+    );
+    encode_stack::<colortype::Gray16>(pages, width, height, pixel_size, &description, compression)
 }
 
-/// Encode 8-bit grey pages (masks: 0 or 255) as one multi-page TIFF with ImageJ calibration.
+/// Encode 8-bit grey pages (masks: 0 or 255) as one multi-page TIFF with ImageJ calibration,
+/// described as `quantity=contact_mask`.
 pub fn encode_u8_stack(
     pages: &[&[u8]],
     width: usize,
     height: usize,
     pixel_size: Option<(f64, f64)>,
 ) -> Result<Vec<u8>> {
-    encode_stack::<colortype::Gray8>(pages, width, height, pixel_size, "", Compression::Deflate)
+    let description = values_description(quantity::CONTACT_MASK, None);
+    encode_stack::<colortype::Gray8>(
+        pages,
+        width,
+        height,
+        pixel_size,
+        &description,
+        Compression::Deflate,
+    )
 }
 
 /// Encode 32-bit float grey pages (maps of the solver) as one TIFF with ImageJ calibration,

@@ -75,7 +75,7 @@ use crate::error::{Error, Location, Result};
 use crate::image::{SampleType, Samples};
 use crate::ranges::Quantity;
 use crate::tiff::metadata::length_unit_factor;
-use crate::tiff::TiffReader;
+use crate::tiff::{TiffInfo, TiffReader};
 
 pub use gsf::{encode_gsf, read_gsf};
 pub use nanoscope::read_nanoscope;
@@ -213,17 +213,56 @@ pub fn read_topography(
     }
 }
 
+/// The metres per stored value of a TIFF height map: the unit its ImageJ description states
+/// (`vunit=`, as contactscope's maps write it), else `height_unit_m`, else 1. A file that says
+/// its values are something other than heights (`quantity=pressure`, a contact map, a
+/// micrograph) is refused naming what it holds, and so is a `height_unit_m` beside a stated unit.
+fn tiff_height_scale(path: &Path, info: &TiffInfo, height_unit_m: Option<f64>) -> Result<f64> {
+    use crate::tiff::write::quantity;
+    if let Some(q) = info.quantity.as_deref().filter(|q| *q != quantity::HEIGHT) {
+        let unit = info
+            .value_unit
+            .as_deref()
+            .map_or(String::new(), |u| format!(" in {u}"));
+        let hint = match q {
+            quantity::INTENSITY => "a micrograph: analyse it with `contactscope analyze`",
+            quantity::CONTACT | quantity::CONTACT_MASK => {
+                "a contact map: compare it with micrographs through `contactscope compare`"
+            }
+            _ => "the deformed surface of a simulation is its load_NNN_deformed_um.tif",
+        };
+        return Err(bad(
+            path,
+            format!(
+                "the file holds {}{unit}, not heights ({hint})",
+                q.replace('_', " ")
+            ),
+        ));
+    }
+    let Some(unit) = info.value_unit.as_deref() else {
+        return unitless_scale(height_unit_m);
+    };
+    let Some(factor) = length_unit_factor(unit) else {
+        return Err(bad(
+            path,
+            format!("the file's values are in '{unit}', not a length: not a height map"),
+        ));
+    };
+    refuse_height_unit(path, height_unit_m, unit)?;
+    Ok(factor)
+}
+
 /// Read the first page of a float32/float64 TIFF. Pixel size: `pixel_size_m`, else the file's
-/// calibration (`docs/conventions.md`, "Pixel size"), else an error. Heights are multiplied by
-/// `height_unit_m` (default 1: the file holds metres).
+/// calibration (`docs/conventions.md`, "Pixel size"), else an error. Heights are in the unit the
+/// file states ([`tiff_height_scale`]), else multiplied by `height_unit_m` (default 1: metres).
 pub fn read_tiff(
     path: &Path,
     pixel_size_m: Option<(f64, f64)>,
     height_unit_m: Option<f64>,
 ) -> Result<HeightMap> {
-    let scale = unitless_scale(height_unit_m)?;
     let mut reader = TiffReader::open(path)?;
     let info = reader.info().clone();
+    let scale = tiff_height_scale(path, &info, height_unit_m)?;
     let (dx, dy) = match (pixel_size_m, info.pixel_size) {
         (Some(p), _) => p,
         (None, Some(p)) => (p.x_m, p.y_m),

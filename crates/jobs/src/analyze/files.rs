@@ -160,7 +160,7 @@ fn write_image_outputs(
 /// Log–log plot of area against force with both fits (and the Hertz area if known).
 #[cfg(feature = "plots")]
 pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
-    use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
+    use crate::plot::{Axes, Chart, Curve, Legend};
     use contactscope::mechanics::hertz;
     let table = &outcome.rows;
     let fits = &outcome.fits;
@@ -219,10 +219,14 @@ pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
         y_label: table.unit.axis_label().into(),
         axes: Axes::LogLog,
         legend: Legend::UpperLeft,
-        points: vec![PointSet {
-            label: "measured (Otsu contact pixels × pixel area)".into(),
-            xy: measured,
-        }],
+        points: crate::fits::point_sets(
+            &table
+                .rows
+                .iter()
+                .map(super::Row::load_point)
+                .collect::<Vec<_>>(),
+            "measured (Otsu contact pixels × pixel area)",
+        ),
         curves,
         ..Chart::default()
     }

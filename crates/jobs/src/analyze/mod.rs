@@ -13,12 +13,13 @@ use serde::Serialize;
 use contactscope::analysis::{self, Analysis, AnalysisOptions, ImageSink, Progress};
 use contactscope::threshold::Method;
 use contactscope_formats::param::Param;
-use contactscope_formats::ranges::Quantity;
+use contactscope_formats::ranges::{short, Quantity};
 
 pub use report::{AreaTable, AreaUnit, Fits, HertzParams, InputFacts, Row, ThresholdFacts};
 
 use crate::error::Result;
-use crate::series::{self, Micrographs, OpenSeries, DEFAULT_MEMORY_BUDGET};
+use crate::fits::{self, Source};
+use crate::series::{self, Micrographs, OpenSeries, Series, DEFAULT_MEMORY_BUDGET};
 
 /// Everything `analyze` needs. SI units.
 #[derive(Debug, Clone)]
@@ -64,9 +65,7 @@ impl AnalyzeRequest {
     }
 }
 
-/// Mean pressures above this (Pa) are beyond any solid contact: the forces are almost surely
-/// in another unit than assumed (newtons for millinewtons).
-pub const IMPLAUSIBLE_PRESSURE_PA: f64 = 20e9;
+pub use crate::fits::IMPLAUSIBLE_PRESSURE_PA;
 
 /// What `analyze` found: `summary.json` (without `rows`, which is `areas.csv`).
 #[derive(Debug, Clone, Serialize)]
@@ -88,6 +87,61 @@ pub struct AnalyzeOutcome {
     /// The analysis itself (thresholds, measurements), for printing.
     #[serde(skip)]
     pub analysis: Analysis,
+}
+
+impl AnalyzeOutcome {
+    /// Whether the series has loaded images and none of them can enter a fit (no contact, or
+    /// contact cut off by the border, in every one): the command line exits with status 4.
+    pub fn nothing_valid(&self) -> bool {
+        let points: Vec<_> = self.rows.rows.iter().map(Row::load_point).collect();
+        fits::nothing_valid(&points)
+    }
+}
+
+/// Images given twice (the same page of the same file), and images with contact whose
+/// measurements are identical to the last digit (the same image under two names): a series that
+/// repeats an image fits the same point twice.
+fn duplicate_warnings(series: &Series, rows: &[Row]) -> Vec<String> {
+    let mut out = Vec::new();
+    let name = |i: usize| {
+        let image = &series.images[i];
+        format!("{} (page {})", image.path.display(), image.page)
+    };
+    let mut seen: std::collections::HashMap<(&std::path::Path, usize), usize> =
+        std::collections::HashMap::new();
+    let mut measured: std::collections::HashMap<(u64, u64, u64, u64), usize> =
+        std::collections::HashMap::new();
+    for (i, (image, row)) in series.images.iter().zip(rows).enumerate() {
+        if let Some(&first) = seen.get(&(image.path.as_path(), image.page)) {
+            out.push(format!(
+                "{} is given twice (images {} and {}): the fits count it twice",
+                name(i),
+                first + 1,
+                i + 1
+            ));
+            continue;
+        }
+        seen.insert((image.path.as_path(), image.page), i);
+        if row.contact_pixels == 0 {
+            continue;
+        }
+        let key = (
+            row.contact_pixels,
+            row.integrated_intensity.to_bits(),
+            row.background_mean.unwrap_or(f64::NAN).to_bits(),
+            row.patches,
+        );
+        if let Some(&first) = measured.get(&key) {
+            out.push(format!(
+                "{} and {} give identical measurements (the same image twice?)",
+                name(first),
+                name(i)
+            ));
+        } else {
+            measured.insert(key, i);
+        }
+    }
+    out
 }
 
 /// Run `analyze` in memory. `sink` receives each image's plane and contact mask in pass 2
@@ -125,17 +179,19 @@ pub fn run_open(
     warnings.append(&mut analysis.warnings);
     let (rows, fits) = report::table_and_fits(series, &analysis, request.hertz);
     for (row, image) in rows.rows.iter().zip(&series.images) {
-        if let Some(p) = row
-            .mean_pressure_mpa
-            .filter(|p| p * 1e6 > IMPLAUSIBLE_PRESSURE_PA)
-        {
+        let (Some(p), Some(f)) = (row.mean_pressure_mpa, row.force_mn) else {
+            continue;
+        };
+        if let Some(why) = fits::implausible_pressure(p * 1e6) {
             warnings.push(format!(
-                "{} (page {}): mean pressure {p:.0} MPa at {} mN is beyond any solid contact; \
-                 are the forces ({}) in another unit?",
+                "{} (page {}): mean pressure {} MPa at {} mN is {why}; are the forces ({}) or \
+                 the pixel size ({}) in another unit?",
                 image.path.display(),
                 image.page,
-                row.force_mn.unwrap_or(f64::NAN),
-                Param::Forces
+                short(p),
+                short(f),
+                Param::Forces,
+                Param::PixelSize
             ));
         }
     }
@@ -147,6 +203,10 @@ pub fn run_open(
             Param::Manifest
         ));
     }
+    let points: Vec<_> = rows.rows.iter().map(Row::load_point).collect();
+    warnings.extend(fits::exclusion_warnings(&points, Source::Micrographs));
+    warnings.extend(fits::power_law_warnings(fits.power_law.as_ref(), &points));
+    warnings.extend(duplicate_warnings(series, &rows.rows));
     if rows.rows.iter().all(|r| r.contact_pixels == 0) {
         warnings.push(format!(
             "no image has contact pixels at the threshold ({}): areas are 0, no fits or plot",

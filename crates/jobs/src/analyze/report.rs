@@ -13,6 +13,7 @@ use contactscope::analysis::Analysis;
 use contactscope::mechanics::hertz;
 use contactscope_formats::microscopy::select::{LoadAxis, Selection};
 
+use crate::fits::{fit_points, Exclusion, LoadPoint};
 use crate::lab::{self, OptQ, Unit, Q};
 use crate::series::Series;
 
@@ -64,13 +65,32 @@ pub struct Row {
     pub hertz_radius_um: Option<f64>,
     /// Hertz contact area, µm².
     pub hertz_area_um2: Option<f64>,
+    /// A contact pixel lies on the image border: the area is cut off and the image is left out
+    /// of the fits ([`crate::fits`]).
+    #[serde(default)]
+    pub edge_contact: bool,
 }
 
 impl Row {
-    /// Whether the image is a point of the area–load fits and the log–log plot: a positive
-    /// force and some contact (a 0 mN reference frame or an image without contact is not).
+    /// Whether the image can be drawn on the log–log plot: a positive force and some contact (a
+    /// 0 mN reference frame or an image without contact cannot).
     pub fn on_log_axes(&self) -> bool {
         self.force_mn.is_some_and(|f| f > 0.0) && self.area > 0.0
+    }
+
+    /// The image as a load of the fits: left out without contact or with contact at the border.
+    pub fn load_point(&self) -> LoadPoint {
+        LoadPoint {
+            force_mn: self.force_mn.unwrap_or(f64::NAN),
+            area: self.area,
+            excluded: if self.contact_pixels == 0 {
+                Some(Exclusion::NoContact)
+            } else if self.edge_contact {
+                Some(Exclusion::EdgeContact)
+            } else {
+                None
+            },
+        }
     }
 }
 
@@ -181,6 +201,7 @@ impl Serialize for RowOf<'_> {
             m.serialize_entry("hertz_radius_um", &OptQ(r.hertz_radius_um, Unit::Um))?;
             m.serialize_entry("hertz_area_um2", &OptQ(r.hertz_area_um2, Unit::Um2))?;
         }
+        m.serialize_entry("edge_contact", &r.edge_contact)?;
         m.end()
     }
 }
@@ -256,6 +277,7 @@ impl Serialize for PowerLawOf {
         m.serialize_entry("exponent_se", &f.exponent_se)?;
         m.serialize_entry("r_squared", &f.r_squared)?;
         m.serialize_entry("points", &f.points)?;
+        m.serialize_entry("distinct_forces", &f.distinct_forces)?;
         m.end()
     }
 }
@@ -326,14 +348,12 @@ pub fn table_and_fits(
                 friction_mn: image.friction_n.map(|f| f * 1e3),
                 hertz_radius_um: hertz_radius.map(|a| a * 1e6),
                 hertz_area_um2: hertz_radius.map(|a| std::f64::consts::PI * a * a * 1e12),
+                edge_contact: m.edge_contact,
             }
         })
         .collect();
-    let (forces, areas): (Vec<f64>, Vec<f64>) = rows
-        .iter()
-        .filter(|r| r.on_log_axes())
-        .filter_map(|r| r.force_mn.map(|f| (f, r.area)))
-        .unzip();
+    let points: Vec<LoadPoint> = rows.iter().map(Row::load_point).collect();
+    let (forces, areas) = fit_points(&points);
     let proportional_mpa = match unit {
         AreaUnit::SquareMicrometre => fit_proportional(&forces, &areas)
             .filter(|(s, _)| *s > 0.0)
@@ -342,7 +362,7 @@ pub fn table_and_fits(
     };
     let pressures: Vec<f64> = rows
         .iter()
-        .filter(|r| r.force_mn.is_some_and(|f| f > 0.0))
+        .filter(|r| r.load_point().in_fit())
         .filter_map(|r| r.mean_pressure_mpa)
         .collect();
     let fits = Fits {

@@ -214,7 +214,10 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
             prefactor(false),
         );
     }
-    t.float("power_law_r_squared", law().map(|p| p.map(|p| p.r_squared)));
+    t.float(
+        "power_law_r_squared",
+        law().map(|p| p.and_then(|p| p.r_squared)),
+    );
     t.int(
         "power_law_points",
         law().map(|p| p.map(|p| p.points as i64)),

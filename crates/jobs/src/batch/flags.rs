@@ -83,8 +83,8 @@ fn series_flags(record: &Record, thresholds: &ThresholdStats) -> Vec<Flag> {
         flag(
             "edge_contact",
             format!(
-                "contact touches the image border in {at} of {} loaded images (from {} mN): \
-                 those areas are cut off",
+                "contact is cut off by the image border in {at} of {} loaded images (from {} mN): \
+                 those images are left out of the fits",
                 loaded.len(),
                 edge.unwrap_or(f64::NAN)
             ),
@@ -96,11 +96,11 @@ fn series_flags(record: &Record, thresholds: &ThresholdStats) -> Vec<Flag> {
             "weak_fit",
             format!("the power law rests on {} points", p.points),
         ),
-        Some(p) if p.r_squared < WEAK_FIT_R2 => flag(
+        Some(p) if p.r_squared.is_some_and(|r| r < WEAK_FIT_R2) => flag(
             "weak_fit",
             format!(
                 "the power law has R² = {:.3} (< {WEAK_FIT_R2})",
-                p.r_squared
+                p.r_squared.unwrap_or(f64::NAN)
             ),
         ),
         None if !loaded.is_empty() => flag(

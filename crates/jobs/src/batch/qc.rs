@@ -161,7 +161,11 @@ fn combined_plot(
         .into_iter()
         .map(|(name, (xy, fit))| {
             (
-                PointSet { label: name, xy },
+                PointSet {
+                    label: name,
+                    xy,
+                    hollow: false,
+                },
                 Curve {
                     label: String::new(),
                     xy: fit,
@@ -494,7 +498,8 @@ fn row(html: &mut String, e: &Entry, metadata: usize, fits: bool) {
                 "<td class=\"num\" data-v=\"{}\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>",
                 law.map_or(String::new(), |l| l.exponent.to_string()),
                 pm(law.map(|l| l.exponent), law.and_then(|l| l.exponent_se), 3),
-                law.map_or("—".into(), |l| format!("{:.4}", l.r_squared)),
+                law.and_then(|l| l.r_squared)
+                    .map_or("—".into(), |r| format!("{r:.4}")),
                 r.proportional_mpa.map_or("—".into(), |p| format!("{:.1}", p.0)),
             );
         }

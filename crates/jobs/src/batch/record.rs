@@ -165,8 +165,8 @@ pub struct PowerLaw {
     pub exponent: f64,
     /// Standard error of β (none for two points).
     pub exponent_se: Option<f64>,
-    /// R² in log–log.
-    pub r_squared: f64,
+    /// R² in log–log (none for two points or identical areas).
+    pub r_squared: Option<f64>,
     /// Points fitted.
     pub points: usize,
 }

@@ -182,12 +182,8 @@ fn stages(task: &SeriesTask, progress: &mut Progress) -> std::result::Result<(),
     to_hash.extend(task.topography.clone().map(|t| (t, "topography")));
     let lines = task.command_lines();
     let highest = highest_load(&open);
-    let edges = Mutex::new(vec![false; open.series.images.len()]);
     let thumbnail: Mutex<Option<Result<Vec<u8>>>> = Mutex::new(None);
     let observer = |i: usize, plane: &Plane, mask: &Mask| -> contactscope::Result<()> {
-        if let Some(e) = edges.lock().expect("lock").get_mut(i) {
-            *e = touches_border(mask);
-        }
         if i == highest {
             *thumbnail.lock().expect("lock") = Some(draw_thumbnail(plane, mask));
         }
@@ -215,8 +211,7 @@ fn stages(task: &SeriesTask, progress: &mut Progress) -> std::result::Result<(),
     progress.files = files;
     progress.bytes_hashed = bytes;
     let (outcome, _) = analysed.map_err(at("analyze"))?;
-    let edges = edges.into_inner().expect("lock");
-    progress.result = Some(series_result(task, &open, &outcome, &edges));
+    progress.result = Some(series_result(task, &open, &outcome));
     if let Some(png) = thumbnail.into_inner().expect("lock") {
         crate::staging::write_atomic(&task.thumbnail(), &png.map_err(at("qc"))?)
             .map_err(at("qc"))?;
@@ -260,17 +255,6 @@ fn highest_load(open: &OpenSeries) -> usize {
         .filter_map(|(i, im)| im.force_n.map(|f| (i, f)))
         .max_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
         .map_or(images.len().saturating_sub(1), |(i, _)| i)
-}
-
-/// Whether a contact pixel lies on the border of the image.
-fn touches_border(mask: &Mask) -> bool {
-    let (w, h) = (mask.width, mask.height);
-    if w == 0 || h == 0 {
-        return false;
-    }
-    let rows = mask.data[..w].iter().chain(&mask.data[(h - 1) * w..]);
-    let columns = (0..h).flat_map(|y| [mask.data[y * w], mask.data[y * w + w - 1]]);
-    rows.copied().chain(columns).any(|m| m != 0)
 }
 
 #[cfg(feature = "plots")]
@@ -331,12 +315,7 @@ pub fn one_line(text: &str) -> String {
         .join(" ")
 }
 
-fn series_result(
-    task: &SeriesTask,
-    open: &OpenSeries,
-    outcome: &AnalyzeOutcome,
-    edges: &[bool],
-) -> SeriesResult {
+fn series_result(task: &SeriesTask, open: &OpenSeries, outcome: &AnalyzeOutcome) -> SeriesResult {
     let base = if task.input.is_dir() {
         task.input.clone()
     } else {
@@ -350,8 +329,7 @@ fn series_result(
         .rows
         .iter()
         .zip(&open.series.images)
-        .zip(edges)
-        .map(|((row, image), &edge_contact)| ImageResult {
+        .map(|(row, image)| ImageResult {
             row: Row {
                 image: image
                     .path
@@ -361,7 +339,7 @@ fn series_result(
                     .to_string(),
                 ..row.clone()
             },
-            edge_contact,
+            edge_contact: row.edge_contact,
         })
         .collect();
     let first = open.series.files.first();
@@ -428,22 +406,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn border_contact_is_found_on_every_side() {
-        let mask = |on: &[usize]| {
-            let mut data = vec![0u8; 16];
-            for &i in on {
-                data[i] = 1;
-            }
-            Mask {
-                width: 4,
-                height: 4,
-                data,
-            }
-        };
-        assert!(!touches_border(&mask(&[5, 6, 9, 10])), "interior only");
-        for side in [1, 4, 7, 14] {
-            assert!(touches_border(&mask(&[5, side])), "pixel {side}");
-        }
+    fn one_line_joins_words() {
         assert_eq!(one_line("a\n  b\tc "), "a b c");
     }
 }

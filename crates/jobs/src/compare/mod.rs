@@ -310,6 +310,12 @@ pub fn load_micrographs(
     let (threshold, _, warnings) = global_threshold(planes.as_slice(), &|_, _, _| {})?;
     let series = open.series;
     let pixel_m = experiment_pixel(&series, pixel_size_m)?;
+    let mut warnings = warnings;
+    warnings.extend(crate::series::pixel_size_warnings(
+        &series,
+        pixel_m,
+        pixel_size_m.is_some(),
+    ));
     let images = series
         .images
         .iter()

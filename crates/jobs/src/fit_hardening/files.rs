@@ -142,6 +142,7 @@ fn measured_points(measured: &Measured) -> PointSet {
             .zip(&measured.areas_m2)
             .map(|(f, a)| (f * 1e3, a * 1e12))
             .collect(),
+        hollow: false,
     }
 }
 
@@ -190,6 +191,7 @@ fn misfit_chart(fits: &[ModelFit]) -> Option<Chart> {
                 .iter()
                 .map(|&(k, m)| (display(Family::Hardening, k), m))
                 .collect(),
+            hollow: false,
         }],
         curves: Vec::new(),
         ..Chart::default()

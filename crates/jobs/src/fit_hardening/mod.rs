@@ -21,7 +21,7 @@ use contactscope::model_fit::{
 use contactscope::solver::cg::SolverOptions;
 use contactscope::surface::fill::FillInvalid;
 use contactscope_formats::param::Param;
-use contactscope_formats::ranges::Quantity;
+use contactscope_formats::ranges::{short, Quantity};
 
 pub use sweep::{Sweep, SweepMicrographs, SweepRow};
 
@@ -335,6 +335,7 @@ impl Serialize for FittedModel {
             };
             m.serialize_entry(key, &Q(p, unit))?;
             m.serialize_entry(&format!("{key}_se"), &OptQ(fit.parameter_se, unit))?;
+            m.serialize_entry("undetermined", &fit.undetermined)?;
         }
         m.end()
     }
@@ -430,6 +431,18 @@ pub fn run(request: &FitRequest, progress: Option<ProgressHook>) -> Result<FitOu
                 family.name()
             ));
         }
+        if let (true, Some(p)) = (fit.undetermined, fit.best.parameter) {
+            let value = match family {
+                Family::Hardness => format!("p_Y = {} MPa", short(p * 1e-6)),
+                _ => format!("k = {} MPa/nm", short(p * 1e-15)),
+            };
+            warnings.push(format!(
+                "{}: {value} is not determined by the areas: they do not change when it moves 5 % \
+                 either way (misfit {:.4}, flat); the value is one of many that fit as well",
+                family.name(),
+                fit.best.misfit
+            ));
+        }
         if fit.at_range_edge {
             warnings.push(format!(
                 "{}: the best value lies at the end of the search range; widen it",
@@ -485,6 +498,7 @@ fn fit_family(
             best,
             parameter_se: None,
             at_range_edge: false,
+            undetermined: false,
         });
     }
     Ok(fit_parameter(

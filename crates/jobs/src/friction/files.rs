@@ -137,10 +137,12 @@ mod plots {
                 PointSet {
                     label: "static F_s".into(),
                     xy: pts(|s| s.static_friction_n),
+                    hollow: false,
                 },
                 PointSet {
                     label: "kinetic F_k".into(),
                     xy: pts(|s| s.kinetic_friction_n),
+                    hollow: false,
                 },
             ],
             curves: shear
@@ -184,10 +186,12 @@ mod plots {
                 PointSet {
                     label: "μ static".into(),
                     xy: pts(TraceResult::mu_static),
+                    hollow: false,
                 },
                 PointSet {
                     label: "μ kinetic".into(),
                     xy: pts(TraceResult::mu_kinetic),
+                    hollow: false,
                 },
             ],
             curves: Vec::new(),
@@ -215,6 +219,7 @@ mod plots {
             points: vec![PointSet {
                 label: "measured".into(),
                 xy,
+                hollow: false,
             }],
             curves: vec![Curve {
                 label: format!("F = τ·A, τ = {tau_mpa:.1} MPa"),

@@ -79,6 +79,7 @@ fn fit_chart(outcome: &HertzOutcome) -> crate::plot::Chart {
                 .iter()
                 .map(|p| (p.displacement_m * 1e6, p.force_n * 1e3))
                 .collect(),
+            hollow: false,
         }],
         curves: vec![Curve {
             label: format!(

@@ -99,6 +99,7 @@ fn gap_chart(outcome: &NewtonOutcome) -> crate::plot::Chart {
         points: vec![PointSet {
             label: format!("ring maxima, {} profiles", a.used().count()),
             xy: points,
+            hollow: false,
         }],
         curves: vec![
             Curve {

@@ -7,11 +7,12 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle, Palette, Palette99};
 
+use super::legend::Legend;
 use super::{encode_png, plot_err};
 use crate::error::{Error, Result};
 
 /// Size of [`Chart`] images in pixels.
-const PLOT_SIZE: (u32, u32) = (900, 650);
+pub(super) const PLOT_SIZE: (u32, u32) = (900, 650);
 
 /// Registered font name. It doubles as the SVG `font-family` attribute, so it is a CSS font
 /// list: viewers without DejaVu Sans fall back to another sans-serif face rather than to serif.
@@ -41,6 +42,8 @@ pub struct PointSet {
     pub label: String,
     /// Data points `(x, y)`; non-positive or non-finite points are skipped.
     pub xy: Vec<(f64, f64)>,
+    /// Drawn as open circles with a cross: points shown but left out of the fits.
+    pub hollow: bool,
 }
 
 /// One curve (drawn as a line), e.g. a fit evaluated on a grid.
@@ -69,16 +72,6 @@ impl Axes {
     }
 }
 
-/// Corner of a [`Chart`]'s legend.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Legend {
-    /// Top left (default; suits rising curves).
-    #[default]
-    UpperLeft,
-    /// Top right (suits decaying curves).
-    UpperRight,
-}
-
 /// A chart: title, axis labels with units, point sets and curves; the legend shows all
 /// non-empty labels.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -103,12 +96,14 @@ pub struct Chart {
 }
 
 /// What is left of a [`Chart`] after dropping points that log axes cannot show.
-struct Prepared {
-    points: Vec<Vec<(f64, f64)>>,
+pub(super) struct Prepared {
+    pub(super) points: Vec<Vec<(f64, f64)>>,
     /// Per curve, its unbroken runs of drawable vertices.
-    curves: Vec<Vec<Vec<(f64, f64)>>>,
-    x_range: (f64, f64),
-    y_range: (f64, f64),
+    pub(super) curves: Vec<Vec<Vec<(f64, f64)>>>,
+    pub(super) x_range: (f64, f64),
+    pub(super) y_range: (f64, f64),
+    /// The corner the legend is drawn in ([`super::legend::place`]).
+    pub(super) legend: Legend,
 }
 
 impl Chart {
@@ -142,7 +137,7 @@ impl Chart {
         Ok(svg)
     }
 
-    fn prepare(&self) -> Result<Prepared> {
+    pub(super) fn prepare(&self) -> Result<Prepared> {
         let shows = |p: &(f64, f64)| self.axes.shows(*p);
         let points: Vec<Vec<(f64, f64)>> = self
             .points
@@ -159,12 +154,15 @@ impl Chart {
             .flatten()
             .chain(curves.iter().flatten().flatten());
         let (x_range, y_range) = padded_ranges(all, self.axes)?;
-        Ok(Prepared {
+        let mut data = Prepared {
             points,
             curves,
             x_range,
             y_range,
-        })
+            legend: self.legend,
+        };
+        super::legend::place(self, &mut data);
+        Ok(data)
     }
 
     fn render<DB: DrawingBackend>(
@@ -237,6 +235,23 @@ impl Chart {
         let mut labelled = false;
         for (i, (set, xy)) in self.points.iter().zip(&data.points).enumerate() {
             let colour = series_colour(i);
+            if set.hollow {
+                // Open circle and cross: a point shown but left out of the fits.
+                let style = colour.stroke_width(2);
+                chart
+                    .draw_series(xy.iter().map(|&p| Circle::new(p, 6, style)))
+                    .map_err(plot_err)?;
+                let series = chart
+                    .draw_series(xy.iter().map(|&p| Cross::new(p, 4, style)))
+                    .map_err(plot_err)?;
+                if !set.label.is_empty() {
+                    labelled = true;
+                    series
+                        .label(set.label.as_str())
+                        .legend(move |(x, y)| Cross::new((x + 10, y), 4, style));
+                }
+                continue;
+            }
             let series = chart
                 .draw_series(xy.iter().map(|&p| Circle::new(p, 4, colour.filled())))
                 .map_err(plot_err)?;
@@ -267,7 +282,7 @@ impl Chart {
         if labelled {
             chart
                 .configure_series_labels()
-                .position(match self.legend {
+                .position(match data.legend {
                     Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
                     Legend::UpperRight => SeriesLabelPosition::UpperRight,
                 })
@@ -493,6 +508,7 @@ mod tests {
                     .iter()
                     .map(|&f| (f, 120.0 * f64::powf(f, 0.9)))
                     .collect(),
+                hollow: false,
             }],
             curves: vec![Curve {
                 label: "fit A = 120 F^0.9".into(),
@@ -535,6 +551,7 @@ mod tests {
             points: vec![PointSet {
                 label: "bad".into(),
                 xy: vec![(0.0, 1.0), (-1.0, 2.0), (1.0, -3.0), (f64::NAN, 1.0)],
+                hollow: false,
             }],
             curves: vec![Curve {
                 label: "zero".into(),
@@ -560,6 +577,7 @@ mod tests {
             points: vec![PointSet {
                 label: String::new(),
                 xy: vec![(1.0, 1.0)],
+                hollow: false,
             }],
             ..Chart::default()
         };
@@ -597,6 +615,7 @@ mod tests {
             points: vec![PointSet {
                 label: String::new(),
                 xy: vec![(0.0, 0.0)],
+                hollow: false,
             }],
             ..Chart::default()
         };
@@ -692,6 +711,7 @@ mod tests {
             points: vec![PointSet {
                 label: String::new(),
                 xy: vec![(4.0, 37.5), (10.0, 85.4), (100.0, 620.2)],
+                hollow: false,
             }],
             ..Chart::default()
         };

@@ -11,6 +11,7 @@
 //! such points are skipped, and a chart with nothing left to draw is an [`Error::Plot`].
 
 mod chart;
+mod legend;
 mod panels;
 
 use std::io::Cursor;
@@ -20,7 +21,8 @@ use image::{ExtendedColorType, ImageEncoder};
 
 use crate::error::{Error, Result};
 
-pub use chart::{Axes, Chart, Curve, Legend, PointSet};
+pub use chart::{Axes, Chart, Curve, PointSet};
+pub use legend::Legend;
 pub use panels::{edge_panels_png, overlay_png, thumbnail_png, Pixels};
 
 fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {

@@ -103,6 +103,7 @@ fn profiles_chart(outcome: &PsfOutcome) -> crate::plot::Chart {
                 .iter()
                 .map(|&(rr, v)| (rr * px_nm, (v - r.offset) / r.amplitude))
                 .collect(),
+            hollow: false,
         });
         let r_max = r.profile.last().map_or(0.0, |p| p.0);
         chart.curves.push(Curve {

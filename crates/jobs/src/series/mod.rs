@@ -25,15 +25,19 @@ use serde::Serialize;
 
 mod file;
 mod input;
+mod pixel;
 
 pub use file::SeriesFile;
 pub use input::{
     is_manifest, load, LoadedSeries, MemorySeries, Micrographs, OpenSeries, Planes, SeriesSpec,
 };
+pub use pixel::{
+    pixel_size, pixel_size_warnings, PIXEL_SIZE_CONTRADICTION, SUB_DIFFRACTION_PIXEL_M,
+};
 
 use crate::error::{Error, Location, Result};
 use contactscope::analysis::PlaneSource;
-use contactscope::image::{PixelSize, PixelSizeSource, Plane, SampleType};
+use contactscope::image::{Plane, SampleType};
 use contactscope_formats::microscopy::select::{LoadAxis, SelectedPlane, Selection};
 use contactscope_formats::microscopy::MicroscopyFile;
 use contactscope_formats::param::Param;
@@ -179,6 +183,34 @@ fn check_file(file: &SeriesFile, first: Option<&SeriesFile>) -> Result<()> {
 }
 
 /// Resolve the channel of a TIFF file.
+/// A TIFF whose description says it holds something other than a micrograph's intensities (a
+/// map written by `simulate`, a saved contact mask) is not thresholded: refused naming what it
+/// holds and the command that reads it.
+fn refuse_maps(info: &TiffInfo) -> Result<()> {
+    use contactscope_formats::tiff::write::quantity;
+    let Some(q) = info.quantity.as_deref() else {
+        return Ok(());
+    };
+    let hint = match q {
+        quantity::INTENSITY => return Ok(()),
+        quantity::HEIGHT => "read it with `contactscope topography` or `simulate --topography`",
+        quantity::CONTACT => "compare a simulation's contact maps with `contactscope compare`",
+        quantity::CONTACT_MASK => "a mask saved by `analyze --save-masks`",
+        _ => "a map written by `contactscope simulate`",
+    };
+    let unit = info
+        .value_unit
+        .as_deref()
+        .map_or(String::new(), |u| format!(" in {u}"));
+    Err(Error::bad_input(
+        Location::file(&info.path),
+        format!(
+            "holds {}{unit}, not a micrograph's intensities ({hint})",
+            q.replace('_', " ")
+        ),
+    ))
+}
+
 fn tiff_channel(info: &TiffInfo, channel: Option<usize>) -> Result<usize> {
     match channel {
         None if info.channels > 1 => Err(Error::bad_input(
@@ -227,6 +259,7 @@ impl FileTable {
         let file = if contactscope_formats::microscopy::select::is_tiff(path) {
             self.selection.check_tiff(path)?;
             let info = TiffReader::open(path)?.info().clone();
+            refuse_maps(&info)?;
             tiff_channel(&info, self.selection.channel)?;
             SeriesFile::from_tiff(info)
         } else {
@@ -513,69 +546,6 @@ impl Series {
     pub fn planes(&self, memory_budget: usize) -> SeriesPlanes<'_> {
         SeriesPlanes::new(self, memory_budget)
     }
-}
-
-/// The pixel size for the whole series: the override, or the files' metadata if they agree.
-///
-/// Notes from the files' metadata, and the lack of any pixel size, are added to `warnings`.
-pub fn pixel_size(
-    series: &Series,
-    override_m: Option<(f64, f64)>,
-    warnings: &mut Vec<String>,
-) -> Result<Option<PixelSize>> {
-    if let Some((x_m, y_m)) = override_m {
-        return Ok(Some(PixelSize {
-            x_m,
-            y_m,
-            source: PixelSizeSource::CommandLine,
-        }));
-    }
-    let Some(first) = series.files.first() else {
-        // Planes in memory: no metadata.
-        warnings.push(format!(
-            "no pixel size given ({}): areas are in pixels",
-            Param::PixelSize
-        ));
-        return Ok(None);
-    };
-    for other in &series.files[1..] {
-        let agree = match (&first.pixel_size, &other.pixel_size) {
-            (Some(a), Some(b)) => a.same_size(b),
-            (None, None) => true,
-            _ => false,
-        };
-        if !agree {
-            let show = |p: &Option<PixelSize>| {
-                p.map_or("no pixel size".to_string(), |p| {
-                    format!("{:.6}×{:.6} µm", p.x_m * 1e6, p.y_m * 1e6)
-                })
-            };
-            return Err(Error::SeriesMismatch {
-                at: Location::file(&other.path),
-                reason: format!("pixel size is {}", show(&other.pixel_size)),
-                expected: format!(
-                    "{}; give {} to override",
-                    show(&first.pixel_size),
-                    Param::PixelSize
-                ),
-            });
-        }
-    }
-    for f in &series.files {
-        warnings.extend(f.notes.iter().map(|n| format!("{}: {n}", f.path.display())));
-    }
-    if let Some(p) = &first.pixel_size {
-        let at = Location::file(&first.path);
-        Quantity::PixelSize.check_at(p.x_m, &at)?;
-        Quantity::PixelSize.check_at(p.y_m, &at)?;
-    }
-    if first.pixel_size.is_none() {
-        warnings.push(format!(
-            "no pixel size in the files' metadata and no {}: areas are in pixels",
-            Param::PixelSize
-        ));
-    }
-    Ok(first.pixel_size)
 }
 
 /// The file-backed [`PlaneSource`] of a series: pages decoded on demand, each run of images of one

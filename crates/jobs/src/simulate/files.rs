@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use contactscope::solver::cg::Monitor;
-use contactscope_formats::tiff::write::encode_f32_stack;
+use contactscope_formats::tiff::write::{encode_f32_stack, quantity, values_description};
 
 use super::{run, LoadMaps, LoadObserver, MapChoice, SimulateOutcome, SimulateRequest};
 use crate::error::Result;
@@ -95,6 +95,18 @@ impl Map {
         }
     }
 
+    /// What the values are and their unit, for the file's description
+    /// ([`values_description`]).
+    fn quantity(self) -> (&'static str, Option<&'static str>) {
+        match self {
+            Map::Contact => (quantity::CONTACT, None),
+            Map::Pressure => (quantity::PRESSURE, Some("MPa")),
+            Map::Gap => (quantity::GAP, Some("um")),
+            Map::Plastic => (quantity::PLASTIC, Some("um")),
+            Map::Deformed => (quantity::HEIGHT, Some("um")),
+        }
+    }
+
     /// The map's float32 values; `top_m` is the top of the undeformed body.
     fn values(self, maps: &LoadMaps<'_>, top_m: f64) -> Vec<f32> {
         let (base, step) = match maps {
@@ -162,7 +174,11 @@ impl MapWriter<'_> {
                     grid.nx(),
                     grid.ny(),
                     Some((grid.dx_m, grid.dy_m)),
-                    &format!("contactscope simulate {description}{}\n", map.name()),
+                    &format!(
+                        "contactscope simulate {description}{}\n{}",
+                        map.name(),
+                        values_description(map.quantity().0, map.quantity().1)
+                    ),
                 )?)
             })
             .collect();
@@ -176,7 +192,7 @@ impl MapWriter<'_> {
 
 #[cfg(feature = "plots")]
 fn area_plot(outcome: &SimulateOutcome) -> crate::plot::Chart {
-    use crate::plot::{Axes, Chart, Curve, Legend, PointSet};
+    use crate::plot::{Axes, Chart, Curve, Legend};
     let xy: Vec<(f64, f64)> = outcome
         .loads
         .iter()
@@ -199,10 +215,14 @@ fn area_plot(outcome: &SimulateOutcome) -> crate::plot::Chart {
         y_label: "contact area A (µm²)".into(),
         axes: Axes::LogLog,
         legend: Legend::UpperLeft,
-        points: vec![PointSet {
-            label: "simulated (pixels with p > 0)".into(),
-            xy,
-        }],
+        points: crate::fits::point_sets(
+            &outcome
+                .loads
+                .iter()
+                .map(super::SimulatedLoad::load_point)
+                .collect::<Vec<_>>(),
+            "simulated (pixels with p > 0)",
+        ),
         curves,
         ..Chart::default()
     }

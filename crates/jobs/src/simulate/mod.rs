@@ -21,9 +21,10 @@ use contactscope::solver::simulate::{separation, sweep_each, LoadStep, Model, Se
 use contactscope::surface::stats::SurfaceStats;
 use contactscope::surface::Topography;
 use contactscope_formats::param::Param;
-use contactscope_formats::ranges::Quantity;
+use contactscope_formats::ranges::{short, Quantity};
 
 use crate::error::{Error, Result};
+use crate::fits::{self, LoadPoint, Source};
 use crate::heights::{HeightFacts, HeightInput, Roughness};
 use crate::lab::{self, Unit, Q};
 
@@ -316,6 +317,42 @@ pub struct SimulatedLoad {
     pub edge_contact: bool,
 }
 
+impl SimulatedLoad {
+    /// The load as a point of the fit: left out with edge contact or without a contact pixel.
+    pub fn load_point(&self) -> LoadPoint {
+        LoadPoint {
+            force_mn: self.force_n * 1e3,
+            area: self.area_m2 * 1e12,
+            excluded: if self.area_m2 <= 0.0 {
+                Some(fits::Exclusion::NoContact)
+            } else if self.edge_contact {
+                Some(fits::Exclusion::EdgeContact)
+            } else {
+                None
+            },
+        }
+    }
+}
+
+/// A warning for each load whose mean pressure is implausible (`fits::implausible_pressure`).
+fn implausible_pressures(loads: &[SimulatedLoad]) -> Vec<String> {
+    loads
+        .iter()
+        .filter_map(|l| {
+            fits::implausible_pressure(l.mean_pressure_pa).map(|why| {
+                format!(
+                    "{} mN: mean pressure {} MPa is {why}; are the forces ({}), the modulus ({}) \
+                     or the heights' unit right?",
+                    short(l.force_n * 1e3),
+                    short(l.mean_pressure_pa * 1e-6),
+                    Param::Forces,
+                    Param::Modulus
+                )
+            })
+        })
+        .collect()
+}
+
 /// The solver settings a summary records.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SolverFacts {
@@ -338,8 +375,10 @@ pub struct PowerLaw {
     pub exponent_se: Option<f64>,
     /// c in µm²·mN^(−β).
     pub prefactor_um2: f64,
-    /// R² of the log–log regression.
-    pub r_squared: f64,
+    /// R² of the log–log regression (none from fewer than three loads).
+    pub r_squared: Option<f64>,
+    /// Loads fitted (those without edge contact and with a contact pixel).
+    pub points: usize,
 }
 
 impl Serialize for PowerLaw {
@@ -355,6 +394,7 @@ impl Serialize for PowerLaw {
         };
         m.serialize_entry("prefactor_um2_per_mN_pow_exponent", &prefactor)?;
         m.serialize_entry("r_squared", &self.r_squared)?;
+        m.serialize_entry("points", &self.points)?;
         m.end()
     }
 }
@@ -406,6 +446,15 @@ pub enum LoadMaps<'a> {
     },
 }
 
+impl SimulateOutcome {
+    /// Whether every load is invalid (edge contact or no contact pixel): the command line exits
+    /// with status 4 after writing its outputs.
+    pub fn nothing_valid(&self) -> bool {
+        let points: Vec<_> = self.loads.iter().map(SimulatedLoad::load_point).collect();
+        fits::nothing_valid(&points)
+    }
+}
+
 /// What a caller hears of each load while `simulate` runs.
 pub trait LoadObserver {
     /// Load `index` (of `total`) is solved; its maps are the caller's to keep or drop (they are
@@ -435,7 +484,7 @@ pub fn run(
         )
     })?;
     let mut gpu = None;
-    let (loads, mut warnings) = match request.model {
+    let loads = match request.model {
         ModelChoice::GreenwoodTripp => run_gt(request, &roughness, &stats, observer)?,
         ModelChoice::HalfSpace(model) => {
             let mut body = roughness.clone();
@@ -446,20 +495,20 @@ pub fn run(
             run_halfspace(request, model, &body, stats.h_rms_m, gpu, observer, monitor)?
         }
     };
-    warnings.splice(0..0, notes);
-    for l in loads.iter().filter(|l| l.area_m2 <= 0.0) {
-        warnings.push(format!(
-            "{:.6} mN: no pixel in contact (the contact is smaller than a pixel); mean pressure left empty",
-            l.force_n * 1e3
-        ));
+    let mut warnings = notes;
+    let points: Vec<LoadPoint> = loads.iter().map(SimulatedLoad::load_point).collect();
+    warnings.extend(fits::exclusion_warnings(&points, Source::Simulation));
+    let (f, a) = fits::fit_points(&points);
+    let power_law = fit_power_law(&f, &a);
+    warnings.extend(fits::power_law_warnings(power_law.as_ref(), &points));
+    if fits::nothing_valid(&points) {
+        warnings.push(
+            "no load is valid (see above): the table and maps are written, but no area–load fit \
+             rests on them"
+                .into(),
+        );
     }
-    if loads.iter().all(|l| l.area_m2 <= 0.0) {
-        warnings.push("no load has a contact pixel: no area–load plot".into());
-    }
-    let (f, a): (Vec<f64>, Vec<f64>) = loads
-        .iter()
-        .map(|l| (l.force_n * 1e3, l.area_m2 * 1e12))
-        .unzip();
+    warnings.extend(implausible_pressures(&loads));
     let (channel, fill_invalid) = request.heights.facts();
     Ok(SimulateOutcome {
         topography: HeightFacts {
@@ -487,11 +536,12 @@ pub fn run(
             max_iterations: request.max_iterations,
             device: describe(gpu),
         },
-        power_law: fit_power_law(&f, &a).map(|fit| PowerLaw {
+        power_law: power_law.map(|fit| PowerLaw {
             exponent: fit.exponent,
             exponent_se: fit.exponent_se,
             prefactor_um2: fit.prefactor,
             r_squared: fit.r_squared,
+            points: fit.points,
         }),
         loads,
         maps: request.maps,
@@ -500,7 +550,7 @@ pub fn run(
     })
 }
 
-type Rows = (Vec<SimulatedLoad>, Vec<String>);
+type Rows = Vec<SimulatedLoad>;
 
 fn run_halfspace(
     request: &SimulateRequest,
@@ -531,17 +581,10 @@ fn run_halfspace(
     };
     let base = separation(body);
     let total = request.loads_n.len();
-    let mut warnings = Vec::new();
     let mut rows = Vec::with_capacity(total);
     // Each load's maps go to the observer and its fields are dropped before the next load is
     // solved (unless the observer keeps them).
     sweep_each(&setup, &request.loads_n, &mut |i, step| {
-        if step.edge_contact {
-            warnings.push(format!(
-                "at {:.4} mN the contact reaches the border of the map: the free-boundary result is not valid; use a larger map or smaller loads",
-                step.force_n * 1e3
-            ));
-        }
         rows.push(row_of(body, &step));
         let maps = LoadMaps::HalfSpace {
             body,
@@ -550,7 +593,7 @@ fn run_halfspace(
         };
         Ok(observer.load(i, total, maps)?)
     })?;
-    Ok((rows, warnings))
+    Ok(rows)
 }
 
 fn row_of(body: &Topography, s: &LoadStep) -> SimulatedLoad {
@@ -613,5 +656,5 @@ fn run_gt(
         });
         observer.load(i, total, LoadMaps::BearingArea { roughness, mask })?;
     }
-    Ok((rows, Vec::new()))
+    Ok(rows)
 }

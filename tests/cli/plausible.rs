@@ -1,0 +1,336 @@
+//! Nothing silently wrong: every number a command gives is plausible, consistent with its inputs,
+//! or comes with a warning — fits that say what they rest on, maps that say what they hold, pixel
+//! sizes checked against the files' own, results outside physical ranges warned of.
+
+use std::path::{Path, PathBuf};
+
+use crate::common::{fixture_series, rough_surface, run, run_ok, stderr, stdout};
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+fn s(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+/// A 64² map of 100 nm pixels, 20 nm rms: contacts reach its border from about 1 mN.
+fn small_map(dir: &Path) -> PathBuf {
+    let map = dir.join("rough.gsf");
+    run_ok(&[
+        "surface",
+        "--size",
+        "64",
+        "--pixel-size",
+        "100nm",
+        "--rms-height",
+        "20nm",
+        "--out",
+        s(&map),
+    ]);
+    map
+}
+
+fn simulate(map: &Path, forces: &str, out: &Path, maps: &str) -> std::process::Output {
+    run(&[
+        "simulate",
+        "--topography",
+        s(map),
+        "--model",
+        "elastic",
+        "--radius",
+        "290um",
+        "--modulus",
+        "3.7GPa",
+        "--forces",
+        forces,
+        "--maps",
+        maps,
+        "--out",
+        s(out),
+    ])
+}
+
+#[test]
+fn simulated_loads_at_the_border_leave_the_fit_and_all_invalid_exits_4() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = small_map(dir.path());
+    let out = dir.path().join("sim");
+    let o = simulate(&map, "0.0001mN,0.001mN,0.01mN,1mN,10mN", &out, "none");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(
+            "2 of 5 loads left out of the area–load fits and marked on the plot, 1 mN, 10 mN"
+        ),
+        "{err}"
+    );
+    assert!(stdout(&o).contains("(edge contact: left out of the fit)"));
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["power_law"]["points"], 3, "{summary}");
+    let edges: Vec<bool> = summary["loads"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["edge_contact"].as_bool().unwrap())
+        .collect();
+    assert_eq!(edges, [false, false, false, true, true]);
+
+    // Every load at the border: outputs written, a warning, exit status 4.
+    let all = dir.path().join("all");
+    let o = simulate(&map, "5mN,10mN", &all, "none");
+    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no load is valid"), "{}", stderr(&o));
+    assert!(all.join("areas.csv").is_file());
+    assert!(json(&all.join("summary.json"))["power_law"].is_null());
+}
+
+#[test]
+fn an_analysis_says_what_its_fit_rests_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let series = fixture_series().join("series.tif");
+    // Page 0 twice (a manifest naming one page for two loads).
+    let manifest = dir.path().join("twice.csv");
+    std::fs::write(
+        &manifest,
+        format!("file,page,force_mN\n{0},0,4\n{0},0,8\n", s(&series)),
+    )
+    .unwrap();
+    let out = dir.path().join("twice");
+    let o = run_ok(&["analyze", s(&manifest), "--out", s(&out)]);
+    let err = stderr(&o);
+    for needle in [
+        "is given twice (images 1 and 2)",
+        "every load gives the same area",
+        "rests on 2 point(s) at 2 distinct force(s)",
+    ] {
+        assert!(err.contains(needle), "'{needle}' not in {err}");
+    }
+    assert!(
+        stdout(&o).contains("R² = — (fewer than 3 points)"),
+        "{}",
+        stdout(&o)
+    );
+    let law = &json(&out.join("summary.json"))["fits"]["power_law"];
+    assert!(
+        law["r_squared"].is_null() && law["exponent_se"].is_null(),
+        "{law}"
+    );
+    assert_eq!(law["distinct_forces"], 2);
+
+    // A frame without contact (a threshold above every pixel) is named, not dropped silently.
+    let none = dir.path().join("none");
+    let o = run(&[
+        "analyze",
+        s(&series),
+        "--forces",
+        "4,6,10,16,25,40,63,100mN",
+        "--threshold",
+        "65535",
+        "--out",
+        s(&none),
+    ]);
+    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("8 of 8 loads left out of the area–load fits"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(none.join("areas.csv").is_file());
+}
+
+#[test]
+fn every_map_a_command_writes_says_what_it_holds_and_is_read_as_that() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = small_map(dir.path());
+    let sim = dir.path().join("sim");
+    let o = simulate(&map, "0.001mN,0.01mN", &sim, "all");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let masks = dir.path().join("masks");
+    run_ok(&[
+        "analyze",
+        s(&fixture_series().join("series.tif")),
+        "--forces",
+        "4,6,10,16,25,40,63,100mN",
+        "--save-masks",
+        "--out",
+        s(&masks),
+    ]);
+    let synth = dir.path().join("synth");
+    run_ok(&[
+        "synth-series",
+        "--out",
+        s(&synth),
+        "--size",
+        "64",
+        "--forces",
+        "1mN,2mN",
+    ]);
+
+    let mut tiffs: Vec<PathBuf> = [&sim, &masks, &synth]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(d).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "tif"))
+        .collect();
+    tiffs.sort();
+    assert_eq!(tiffs.len(), 5 * 2 + 8 + 1, "{tiffs:?}");
+    for tiff in &tiffs {
+        let name = tiff.file_name().unwrap().to_str().unwrap();
+        let (quantity, unit) = match name {
+            n if n.ends_with("_contact.tif") => ("contact", None),
+            n if n.ends_with("_pressure_MPa.tif") => ("pressure", Some("MPa")),
+            n if n.ends_with("_gap_um.tif") => ("gap", Some("um")),
+            n if n.ends_with("_plastic_um.tif") => ("plastic displacement", Some("um")),
+            n if n.ends_with("_deformed_um.tif") => ("height", Some("um")),
+            n if n.starts_with("mask_") => ("contact mask", None),
+            _ => ("intensity", None),
+        };
+        let info = stdout(&run_ok(&["info", s(tiff)]));
+        let said = match unit {
+            Some(u) => format!("values:       {quantity} in {u}\n"),
+            None => format!("values:       {quantity}\n"),
+        };
+        assert!(info.contains(&said), "{name}: {info}");
+
+        let topo = run(&["topography", s(tiff), "--json", "--detrend", "none"]);
+        if quantity == "height" {
+            // Read in its own unit: the heights in metres are the stored µm × 1e-6.
+            assert!(topo.status.success(), "{name}: {}", stderr(&topo));
+            let facts: serde_json::Value = serde_json::from_slice(&topo.stdout).unwrap();
+            let stored = contactscope_formats::tiff::read_image(tiff, None, None).unwrap();
+            let max_um = stored.values.iter().copied().fold(f64::MIN, f64::max);
+            let read = facts["height_max_um"].as_f64().unwrap();
+            assert!(
+                (read - max_um).abs() <= 1e-9 * max_um.abs().max(1.0),
+                "{read} vs {max_um}"
+            );
+            // A height unit beside the file's own is refused.
+            let both = run(&["topography", s(tiff), "--height-unit", "1nm"]);
+            assert!(
+                stderr(&both).contains("states its height unit (um)"),
+                "{}",
+                stderr(&both)
+            );
+        } else {
+            let err = stderr(&topo);
+            assert!(!topo.status.success(), "{name} read as heights");
+            assert!(err.contains(&format!("holds {quantity}")), "{name}: {err}");
+            assert!(err.contains(name), "{name}: {err}");
+        }
+
+        let analyse = run(&["analyze", s(tiff), "--out", s(&dir.path().join("a"))]);
+        if quantity == "intensity" {
+            assert!(analyse.status.success(), "{name}: {}", stderr(&analyse));
+            std::fs::remove_dir_all(dir.path().join("a")).unwrap();
+        } else {
+            let err = stderr(&analyse);
+            assert!(
+                err.contains("not a micrograph's intensities"),
+                "{name}: {err}"
+            );
+        }
+    }
+
+    // compare takes only contact maps: a pressure map in a contact map's place is refused.
+    std::fs::copy(
+        sim.join("load_001_pressure_MPa.tif"),
+        sim.join("load_001_contact.tif"),
+    )
+    .unwrap();
+    let o = run(&[
+        "compare",
+        "--simulation",
+        s(&sim),
+        "--micrographs",
+        s(&synth),
+        "--psf-fwhm",
+        "450nm",
+        "--out",
+        s(&dir.path().join("c")),
+    ]);
+    assert!(
+        stderr(&o).contains("holds pressure in MPa, not a contact map"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn a_pixel_size_far_from_the_files_own_is_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let series = fixture_series().join("series.tif");
+    let forces = "4,6,10,16,25,40,63,100mN";
+    let analyse = |pixel: &str| {
+        let out = dir.path().join(pixel);
+        run_ok(&[
+            "analyze",
+            s(&series),
+            "--forces",
+            forces,
+            "--pixel-size",
+            pixel,
+            "--out",
+            s(&out),
+        ])
+    };
+    // 1000× the metadata's 0.2 µm: both named, and the absurd pressures that follow.
+    let err = stderr(&analyse("200um"));
+    assert!(
+        err.contains("--pixel-size 200 µm is 1000× the 200 nm of"),
+        "{err}"
+    );
+    assert!(err.contains("ImageJ"), "{err}");
+    assert!(err.contains("below any contact that bears a load"), "{err}");
+    // Below a light microscope's resolution.
+    let err = stderr(&analyse("0.5nm"));
+    assert!(
+        err.contains("far below what a light microscope resolves"),
+        "{err}"
+    );
+    assert!(err.contains("is 400× the 200 nm"), "{err}");
+    // Within 1.5× of the metadata: no word.
+    let err = stderr(&analyse("250nm"));
+    assert!(!err.contains("metadata"), "{err}");
+}
+
+/// The fuzz campaign's one abort: micrographs whose pixel size makes the simulated region tens of
+/// thousands of pixels wide were rendered (gigabytes) before being refused. Under a 2 GiB address
+/// space limit the refusal must come first, as one line.
+#[test]
+fn compare_refuses_an_oversized_rendering_before_allocating_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = small_map(dir.path());
+    let sim = dir.path().join("sim");
+    // Loads that match the micrographs' (on this small map they reach its border: status 4).
+    let o = simulate(&map, "1mN,2mN", &sim, "contact");
+    assert!(sim.join("load_002_contact.tif").is_file(), "{}", stderr(&o));
+    let synth = dir.path().join("synth");
+    run_ok(&[
+        "synth-series",
+        "--out",
+        s(&synth),
+        "--size",
+        "64",
+        "--forces",
+        "1mN,2mN",
+    ]);
+    let line = format!(
+        "ulimit -v 2097152; exec '{}' compare --simulation '{}' --micrographs '{}' \
+         --psf-fwhm 450nm --pixel-size 0.2nm --out '{}'",
+        env!("CARGO_BIN_EXE_contactscope"),
+        s(&sim),
+        s(&synth),
+        s(&dir.path().join("c"))
+    );
+    let o = std::process::Command::new("sh")
+        .args(["-c", &line])
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("larger than the micrograph"), "{err}");
+    assert!(err.contains("check the micrographs' pixel size"), "{err}");
+    assert!(!dir.path().join("c").exists());
+}
