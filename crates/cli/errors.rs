@@ -73,7 +73,17 @@ pub fn usage_line(error: &clap::Error) -> String {
         .skip_while(|l| l.is_empty())
         .take_while(|l| !l.is_empty())
         .collect();
-    let text = paragraph.join(" ");
+    let mut text = paragraph.join(" ");
+    // clap's suggestions ("tip: a similar subcommand exists: 'analyze'") follow in their own
+    // paragraph: kept, on the one line.
+    for tip in rendered
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("tip: "))
+    {
+        if tip.contains("similar") || tip.contains("to pass") {
+            text.push_str(&format!("; {tip}"));
+        }
+    }
     let text = text.strip_prefix("error: ").unwrap_or(&text);
     let text = if text.is_empty() {
         "invalid command line"

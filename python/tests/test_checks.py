@@ -75,12 +75,12 @@ def inputs(tmp_path_factory):
                "20um", "--modulus", "1GPa", "--model", "elastic", "--forces", "20uN,40uN",
                "--out", sim, "-q")
     assert done.returncode == 0, done.stderr
-    # Maps at the micrographs' forces, for compare (the contact outgrows the small map: only
-    # a warning).
+    # Maps at the micrographs' forces, for compare (the contact outgrows the small map: the
+    # outputs are written, exit status 4).
     done = run("simulate", "--topography", d / "h.npy", "--pixel-size", "200nm", "--radius",
                "290um", "--modulus", "3.7GPa", "--model", "elastic", "--forces", "2,4,8mN",
                "--out", d / "sim3", "-q")
-    assert done.returncode == 0, done.stderr
+    assert done.returncode == 4, done.stderr
     beads = cs.synth_beads(seed=5)
     cs.write_tiff(d / "beads.tif", beads, 1e-7)
     rings = cs.synth_newton(seed=7)
@@ -151,7 +151,8 @@ def test_the_bases_are_valid(inputs):
     for command, cases in bases(inputs).items():
         for cli_args, (args, kwargs) in cases:
             done = run(*cli_args)
-            assert done.returncode == 0, (command, done.stderr)
+            # 4: written, but every contact of these small fields touches the border.
+            assert done.returncode in (0, 4), (command, done.stderr)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 FUNCTIONS[command](*args, **kwargs)
@@ -222,7 +223,7 @@ def test_warnings_reach_both_front_ends(inputs):
     d = inputs["dir"]
     # Forces given in the wrong unit (4 N for 4 mN): an implausible mean pressure.
     done = run("analyze", d / "series.tif", "--forces", "2,4,8N", "--out", d / "w1", "-q")
-    assert done.returncode == 0 and "beyond any solid contact" in done.stderr
+    assert done.returncode in (0, 4) and "beyond any solid contact" in done.stderr
     with pytest.warns(cs.ContactscopeWarning, match="beyond any solid contact") as record:
         r = cs.analyze(inputs["images"], forces=[2.0, 4.0, 8.0], pixel_size=2e-7)
     assert any("forces=" in str(w.message) for w in record)
@@ -230,6 +231,6 @@ def test_warnings_reach_both_front_ends(inputs):
     # A contact reaching the border of the map: not a valid free-boundary result.
     done = run("simulate", "--topography", d / "h.npy", "--pixel-size", "100nm", "--modulus",
                "1GPa", "--model", "elastic", "--forces", "2mN", "--out", d / "w2", "-q")
-    assert done.returncode == 0 and "border of the map" in done.stderr
+    assert done.returncode == 4 and "border of the map" in done.stderr
     with pytest.warns(cs.ContactscopeWarning, match="border of the map"):
         cs.simulate(d / "h.npy", 1e-7, 1e9, [2e-3], maps=False)

@@ -452,7 +452,7 @@ def test_compare_widget_layers_and_dice(viewer, series_tif, tmp_path, cli, harde
         assert dice == pytest.approx(r["dice"], abs=1e-12)
         assert w.table.item(i, 0).text() == "sim"
         assert float(w.table.item(i, 3).text()) == pytest.approx(r["dice"], abs=5e-4)
-    assert viewer.layers["sim: imaged"].data.shape == (3, 96, 96)
+    assert viewer.layers["sim: imaged"].data.shape == (3, 160, 160)  # the micrographs' grid
     canvas = getattr(viewer, "canvas", None)
     assert (getattr(canvas, "grid", None) or viewer.grid).enabled
 

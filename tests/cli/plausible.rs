@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::common::{fixture_series, rough_surface, run, run_ok, stderr, stdout};
+use crate::common::{fixture_series, run, run_ok, stderr, stdout};
 
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
@@ -29,6 +29,21 @@ fn small_map(dir: &Path) -> PathBuf {
         s(&map),
     ]);
     map
+}
+
+/// A synthetic series of two 64² micrographs (1 and 2 mN) with its manifest, in `dir/synth`.
+fn small_micrographs(dir: &Path) -> PathBuf {
+    let synth = dir.join("synth");
+    run_ok(&[
+        "synth-series",
+        "--out",
+        s(&synth),
+        "--size",
+        "64",
+        "--forces",
+        "1mN,2mN",
+    ]);
+    synth
 }
 
 fn simulate(map: &Path, forces: &str, out: &Path, maps: &str) -> std::process::Output {
@@ -156,16 +171,7 @@ fn every_map_a_command_writes_says_what_it_holds_and_is_read_as_that() {
         "--out",
         s(&masks),
     ]);
-    let synth = dir.path().join("synth");
-    run_ok(&[
-        "synth-series",
-        "--out",
-        s(&synth),
-        "--size",
-        "64",
-        "--forces",
-        "1mN,2mN",
-    ]);
+    let synth = small_micrographs(dir.path());
 
     let mut tiffs: Vec<PathBuf> = [&sim, &masks, &synth]
         .iter()
@@ -305,16 +311,7 @@ fn compare_refuses_an_oversized_rendering_before_allocating_it() {
     // Loads that match the micrographs' (on this small map they reach its border: status 4).
     let o = simulate(&map, "1mN,2mN", &sim, "contact");
     assert!(sim.join("load_002_contact.tif").is_file(), "{}", stderr(&o));
-    let synth = dir.path().join("synth");
-    run_ok(&[
-        "synth-series",
-        "--out",
-        s(&synth),
-        "--size",
-        "64",
-        "--forces",
-        "1mN,2mN",
-    ]);
+    let synth = small_micrographs(dir.path());
     let line = format!(
         "ulimit -v 2097152; exec '{}' compare --simulation '{}' --micrographs '{}' \
          --psf-fwhm 450nm --pixel-size 0.2nm --out '{}'",
@@ -333,4 +330,41 @@ fn compare_refuses_an_oversized_rendering_before_allocating_it() {
     assert!(err.contains("larger than the micrograph"), "{err}");
     assert!(err.contains("check the micrographs' pixel size"), "{err}");
     assert!(!dir.path().join("c").exists());
+}
+
+#[test]
+fn messages_keep_clap_suggestions_and_point_to_the_right_command() {
+    let one_line = |args: &[&str]| {
+        let o = run(args);
+        assert!(!o.status.success(), "{args:?}");
+        let err = stderr(&o);
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        err
+    };
+    let err = one_line(&["analyse", "x"]);
+    assert!(err.contains("'analyze'"), "{err}");
+    let err = one_line(&["analyze", "x.tif", "--force", "4mN"]);
+    assert!(err.contains("'--forces'"), "{err}");
+    // A height map where a micrograph is expected.
+    let dir = tempfile::tempdir().unwrap();
+    let gwy = dir.path().join("scan.gwy");
+    std::fs::write(&gwy, b"GWYP\0\0\0\0GwyContainer\0rest of a file").unwrap();
+    for command in ["info", "threshold"] {
+        let err = one_line(&[command, s(&gwy)]);
+        assert!(
+            err.contains("a gwy height map") && err.contains("topography"),
+            "{err}"
+        );
+    }
+    // A reference frame before a range of loads.
+    let out = dir.path().join("ranged");
+    let o = run_ok(&[
+        "analyze",
+        s(&fixture_series().join("series.tif")),
+        "--forces",
+        "0,1mN..100mN:7",
+        "--out",
+        s(&out),
+    ]);
+    assert!(stdout(&o).contains("     0.000 "), "{}", stdout(&o));
 }

@@ -217,6 +217,9 @@ pub fn parse_forces(text: &str) -> Result<Vec<f64>> {
 /// A list (each item range-checked by [`quantity_list`], 0 only if `zero_allowed`) or a
 /// log-spaced range (its two ends range-checked; the values between lie within them).
 fn force_values(text: &str, zero_allowed: bool) -> Result<Vec<f64>> {
+    if text.contains(',') && text.contains("..") {
+        return mixed_force_values(text, zero_allowed);
+    }
     let Some((from, rest)) = text.split_once("..") else {
         return quantity_list(text, Dimension::Force, zero_allowed);
     };
@@ -241,6 +244,31 @@ fn force_values(text: &str, zero_allowed: bool) -> Result<Vec<f64>> {
     Ok((0..n)
         .map(|i| a * (b / a).powf(i as f64 / (n - 1) as f64))
         .collect())
+}
+
+/// A list whose items are values and ranges, `0,1mN..40mN:10` (a 0 mN reference frame, then ten
+/// log-spaced loads): each item as [`force_values`] reads it, bare numbers in the unit of the last
+/// item (a range's end).
+fn mixed_force_values(text: &str, zero_allowed: bool) -> Result<Vec<f64>> {
+    let items: Vec<&str> = text.split(',').map(str::trim).collect();
+    let last = items.last().copied().unwrap_or_default();
+    let carrier = match last.split_once("..") {
+        Some((_, rest)) => rest.split(':').next().unwrap_or_default(),
+        None => last,
+    };
+    let mut values = Vec::new();
+    for item in items {
+        if item.contains("..") {
+            values.extend(force_values(item, zero_allowed)?);
+        } else {
+            values.extend(quantity_list(
+                &with_unit_of(item, carrier),
+                Dimension::Force,
+                zero_allowed,
+            )?);
+        }
+    }
+    Ok(values)
 }
 
 /// A bare number (no unit) takes the unit written after the last item, so `1..10MPa/nm:10` and
@@ -426,6 +454,18 @@ mod tests {
         assert!(parse_forces("0mN..100mN:3").is_err(), "log-spaced from 0");
         assert!(parse_forces("-1,4mN").is_err());
         assert!(parse_forces("4,400000mN").is_err(), "400 N is out of range");
+        // A reference frame, then a range: each item read as alone, bare numbers in the last unit.
+        let f = parse_forces("0,1mN..100mN:3").unwrap();
+        assert_eq!(f.len(), 4);
+        assert_eq!(f[0], 0.0);
+        assert_relative_eq!(f[2], 0.01, max_relative = 1e-12);
+        let f = parse_forces("0.5,1..100mN:3,200mN").unwrap();
+        assert_eq!(f.len(), 5);
+        assert_relative_eq!(f[0], 0.5e-3, max_relative = 1e-12);
+        assert!(
+            parse_loads("0,1mN..100mN:3").is_err(),
+            "a simulated load of 0"
+        );
         assert_relative_eq!(
             parse_ratio("4MPa/nm", Dimension::Pressure, Dimension::Length).unwrap(),
             4e15,

@@ -32,7 +32,7 @@ impl Mask {
             return 0;
         }
         let on = |i: usize| u64::from(self.data[i] != 0);
-        let mut n: u64 = (0..w).map(|x| on(x)).sum();
+        let mut n: u64 = (0..w).map(&on).sum();
         if h > 1 {
             n += (0..w).map(|x| on((h - 1) * w + x)).sum::<u64>();
         }

@@ -335,12 +335,21 @@ impl MicroscopyFile {
     /// Open a file, detecting its format from its first bytes, and read its headers.
     pub fn open(path: &Path) -> Result<Self> {
         let mut source = super::binary::FileSource::open(path)?;
-        let head = source.read_up_to(0, 16)?;
-        let format = detect(&head).ok_or_else(|| {
-            unsupported(
+        let head = source.read_up_to(0, 64)?;
+        let format = detect(&head).ok_or_else(|| match crate::topography::detect(&head) {
+            // A height map given where a micrograph is expected: say which command reads it.
+            Some(map) => unsupported(
+                path,
+                format!(
+                    "a {} height map, not a CZI, ND2, LIF or TIFF micrograph: read it with \
+                     `contactscope topography` (or `simulate --topography`)",
+                    map.name()
+                ),
+            ),
+            None => unsupported(
                 path,
                 "not a CZI, ND2, LIF or TIFF file (unknown magic bytes at the start)",
-            )
+            ),
         })?;
         let (series, backend) = match format {
             MicroscopyFormat::Czi => {

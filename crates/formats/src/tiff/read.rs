@@ -172,13 +172,36 @@ fn rational(value: Option<tiff::decoder::ifd::Value>) -> Option<f64> {
     (v.is_finite() && v > 0.0).then_some(v)
 }
 
+/// A file that is not a TIFF but a format contactscope reads elsewhere (a height map, a CZI, ND2
+/// or LIF file named `.tif`): the error that says so and names the command that reads it.
+fn other_format(path: &Path) -> Option<Error> {
+    let mut head = Vec::new();
+    File::open(path)
+        .ok()?
+        .take(64)
+        .read_to_end(&mut head)
+        .ok()?;
+    if let Some(map) = crate::topography::detect(&head) {
+        return Some(Error::Unsupported {
+            at: Location::file(path),
+            reason: format!(
+                "a {} height map, not a TIFF micrograph: read it with `contactscope topography` \
+                 (or `simulate --topography`)",
+                map.name()
+            ),
+        });
+    }
+    None
+}
+
 impl TiffReader {
     /// Open a TIFF file and read its headers (every IFD, no pixel data).
     pub fn open(path: &Path) -> Result<Self> {
         crate::inputs::note_input(path);
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
-        let mut decoder =
-            Decoder::new(BufReader::new(file)).map_err(|e| tiff_error(Location::file(path), e))?;
+        let mut decoder = Decoder::new(BufReader::new(file)).map_err(|e| {
+            other_format(path).unwrap_or_else(|| tiff_error(Location::file(path), e))
+        })?;
         let mut limits = Limits::default();
         limits.decoding_buffer_size = MAX_PAGE_BYTES;
         decoder = decoder.with_limits(limits);

@@ -164,6 +164,7 @@ pub fn run_open(
     sink: ImageSink,
 ) -> Result<AnalyzeOutcome> {
     let series = &open.series;
+    series::refuse_maps(series)?;
     let mut warnings = Vec::new();
     let pixel_size = series::pixel_size(series, request.pixel_size_m, &mut warnings)?;
     let options = AnalysisOptions {

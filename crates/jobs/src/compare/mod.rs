@@ -303,6 +303,7 @@ pub fn load_micrographs(
     pixel_size_m: Option<(f64, f64)>,
 ) -> Result<(Series, MicrographSet)> {
     let open = input.open()?;
+    crate::series::refuse_maps(&open.series)?;
     let planes = match &open.planes {
         Some(planes) => planes.clone(),
         None => open.series.planes(0).scan(|_, plane| Ok(plane.clone()))?,

@@ -183,10 +183,18 @@ fn check_file(file: &SeriesFile, first: Option<&SeriesFile>) -> Result<()> {
 }
 
 /// Resolve the channel of a TIFF file.
-/// A TIFF whose description says it holds something other than a micrograph's intensities (a
-/// map written by `simulate`, a saved contact mask) is not thresholded: refused naming what it
-/// holds and the command that reads it.
-fn refuse_maps(info: &TiffInfo) -> Result<()> {
+/// Micrographs to threshold (`analyze`, `compare`): a TIFF of the series whose description says
+/// it holds something other than intensities (a map written by `simulate`, a saved contact mask)
+/// is refused naming what it holds and the command that reads it. Reading such a file as an
+/// image (Python's `read_image`) is not refused.
+pub fn refuse_maps(series: &Series) -> Result<()> {
+    for info in series.files.iter().filter_map(|f| f.tiff.as_ref()) {
+        refuse_map(info)?;
+    }
+    Ok(())
+}
+
+fn refuse_map(info: &TiffInfo) -> Result<()> {
     use contactscope_formats::tiff::write::quantity;
     let Some(q) = info.quantity.as_deref() else {
         return Ok(());
@@ -259,7 +267,6 @@ impl FileTable {
         let file = if contactscope_formats::microscopy::select::is_tiff(path) {
             self.selection.check_tiff(path)?;
             let info = TiffReader::open(path)?.info().clone();
-            refuse_maps(&info)?;
             tiff_channel(&info, self.selection.channel)?;
             SeriesFile::from_tiff(info)
         } else {
