@@ -170,7 +170,9 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
         let beta = contactscope_jobs::table::value_pm_or(fit.exponent, fit.exponent_se, 3);
         let r2 = fit
             .r_squared
-            .map_or("— (fewer than 3 points)".into(), |r| format!("{r:.4}"));
+            .map_or("— (fewer than 3 distinct forces)".into(), |r| {
+                format!("{r:.4}")
+            });
         println!("power law: A ∝ N^β, β = {beta}, R² = {r2}");
     }
     if let Some((p, _)) = outcome.fits.proportional_mpa {

@@ -194,7 +194,9 @@ pub fn run(args: Args) -> Result<Finished> {
         let beta = contactscope_jobs::table::value_pm_or(fit.exponent, fit.exponent_se, 3);
         let r2 = fit
             .r_squared
-            .map_or("— (fewer than 3 loads)".into(), |r| format!("{r:.4}"));
+            .map_or("— (fewer than 3 distinct forces)".into(), |r| {
+                format!("{r:.4}")
+            });
         println!(
             "power law over {} loads: A ∝ N^β, β = {beta}, R² = {r2}",
             fit.points

@@ -122,7 +122,7 @@ fn an_analysis_says_what_its_fit_rests_on() {
         assert!(err.contains(needle), "'{needle}' not in {err}");
     }
     assert!(
-        stdout(&o).contains("R² = — (fewer than 3 points)"),
+        stdout(&o).contains("R² = — (fewer than 3 distinct forces)"),
         "{}",
         stdout(&o)
     );
@@ -367,4 +367,44 @@ fn messages_keep_clap_suggestions_and_point_to_the_right_command() {
         s(&out),
     ]);
     assert!(stdout(&o).contains("     0.000 "), "{}", stdout(&o));
+}
+
+/// Another program's ImageJ TIFF: a length `vunit` is honoured as the heights' unit; a unit that
+/// is not a length ("Gray Value") says nothing about heights and leaves `--height-unit` to decide.
+#[test]
+fn a_foreign_value_unit_is_honoured_only_when_it_is_a_length() {
+    let dir = tempfile::tempdir().unwrap();
+    let heights: Vec<f32> = (0..64).map(|i| (i % 8) as f32 * 10.0).collect();
+    let write = |name: &str, extra: &str| {
+        let path = dir.path().join(name);
+        let bytes = contactscope_formats::tiff::encode_f32_stack(
+            &[&heights],
+            8,
+            8,
+            Some((1e-7, 1e-7)),
+            extra,
+        )
+        .unwrap();
+        std::fs::write(&path, bytes).unwrap();
+        path
+    };
+    let max_um = |args: &[&str]| {
+        let o = run_ok(args);
+        let facts: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        facts["height_max_um"].as_f64().unwrap()
+    };
+    let nm = write("nm.tif", "vunit=nm\n");
+    let read = max_um(&["topography", s(&nm), "--json", "--detrend", "none"]);
+    assert!((read - 0.07).abs() < 1e-9, "{read}");
+    let grey = write("grey.tif", "vunit=Gray Value\n");
+    let read = max_um(&[
+        "topography",
+        s(&grey),
+        "--height-unit",
+        "1nm",
+        "--json",
+        "--detrend",
+        "none",
+    ]);
+    assert!((read - 0.07).abs() < 1e-9, "{read}");
 }

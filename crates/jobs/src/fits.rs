@@ -154,12 +154,12 @@ pub fn power_law_warnings(fit: Option<&PowerLawFit>, points: &[LoadPoint]) -> Ve
     let mut out = Vec::new();
     if fit.distinct_forces < 3 {
         out.push(format!(
-            "the power law rests on {} point(s) at {} distinct force(s): β has {}no R², and two \
-             forces always fit exactly",
+            "the power law rests on {} point(s) at {} distinct force(s): a line through two \
+             force levels cannot test the law, so it has no R²{}",
             fit.points,
             fit.distinct_forces,
             if fit.exponent_se.is_none() {
-                "no standard error and "
+                ", and β has no standard error"
             } else {
                 ""
             }
@@ -281,6 +281,18 @@ mod tests {
         let w = power_law_warnings(fit_power_law(&f, &a).as_ref(), &two);
         assert!(w[0].contains("2 point(s) at 2 distinct force(s)"), "{w:?}");
         assert!(w[0].contains("no standard error"), "{w:?}");
+        // Replicates at two forces: a standard error, still no R².
+        let replicates = [
+            point(1.0, 2.0, None),
+            point(1.0, 2.2, None),
+            point(2.0, 3.0, None),
+        ];
+        let (f, a) = fit_points(&replicates);
+        let fit = fit_power_law(&f, &a).unwrap();
+        assert!(fit.exponent_se.is_some() && fit.r_squared.is_none());
+        let w = power_law_warnings(Some(&fit), &replicates);
+        assert!(w[0].contains("3 point(s) at 2 distinct force(s)"), "{w:?}");
+        assert!(!w[0].contains("standard error"), "{w:?}");
         let same = [
             point(1.0, 7.0, None),
             point(2.0, 7.0, None),

@@ -259,7 +259,6 @@ impl TopographySource {
     }
 }
 
-/// A pixel size (x, y), m, within the plausible range.
 /// Heights given in memory (a Python array) are held to the bound of heights read from a file,
 /// ±[`MAX_FILE_HEIGHT_M`](contactscope_formats::topography::MAX_FILE_HEIGHT_M): beyond it they
 /// were almost always given in another unit than metres (a scan in nanometres gave 1-pixel
@@ -282,6 +281,7 @@ fn check_memory_heights(heights: &ndarray::Array2<f64>) -> Result<()> {
     }
 }
 
+/// A pixel size (x, y), m, within the plausible range.
 fn check_pixel_size((x, y): (f64, f64)) -> Result<()> {
     Quantity::PixelSize.check(x, Param::PixelSize)?;
     Quantity::PixelSize.check(y, Param::PixelSize)?;

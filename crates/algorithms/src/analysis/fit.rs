@@ -13,7 +13,9 @@ pub struct PowerLawFit {
     /// Standard error of β (needs at least 3 points; `None` otherwise).
     pub exponent_se: Option<f64>,
     /// Coefficient of determination of the log–log regression; `None` with fewer than three
-    /// points (two points always give 1) or when every area is the same (no variance to explain).
+    /// distinct forces (a line through two force levels passes through their means, so R² then
+    /// measures only the scatter of replicates, and two points always give 1) or when every area
+    /// is the same (no variance to explain).
     pub r_squared: Option<f64>,
     /// Points used (positive force and area).
     pub points: usize,
@@ -55,10 +57,10 @@ pub fn fit_power_law(x: &[f64], y: &[f64]) -> Option<PowerLawFit> {
         .iter()
         .map(|p| (p.1 - intercept - beta * p.0).powi(2))
         .sum();
-    let r_squared = (n > 2 && syy > 0.0).then(|| 1.0 - ss_res / syy);
     let mut xs: Vec<f64> = pts.iter().map(|p| p.0).collect();
     xs.sort_by(f64::total_cmp);
     xs.dedup();
+    let r_squared = (xs.len() > 2 && syy > 0.0).then(|| 1.0 - ss_res / syy);
     let exponent_se = (n > 2).then(|| (ss_res / (n - 2) as f64 / sxx).sqrt());
     Some(PowerLawFit {
         prefactor: intercept.exp(),
@@ -122,7 +124,7 @@ mod tests {
     }
 
     #[test]
-    fn two_points_or_constant_areas_have_no_r_squared() {
+    fn two_forces_or_constant_areas_have_no_r_squared() {
         let two = fit_power_law(&[1.0, 2.0], &[1.0, 3.0]).unwrap();
         assert_eq!(
             (two.r_squared, two.exponent_se, two.points),
@@ -132,6 +134,8 @@ mod tests {
         assert_eq!((flat.exponent, flat.r_squared), (0.0, None));
         let repeated = fit_power_law(&[1.0, 1.0, 2.0, 2.0], &[1.0, 1.1, 2.0, 2.1]).unwrap();
         assert_eq!((repeated.points, repeated.distinct_forces), (4, 2));
+        // Replicates give β a standard error, but two force levels cannot test the law: no R².
+        assert!(repeated.exponent_se.is_some() && repeated.r_squared.is_none());
     }
 
     #[test]

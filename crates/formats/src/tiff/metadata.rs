@@ -23,8 +23,8 @@ pub struct ImageJDescription {
     /// `quantity=`: what the values are (contactscope's maps: `height`, `pressure`, `gap`,
     /// `plastic_displacement`, `contact`, `contact_mask`, `intensity`).
     pub quantity: Option<String>,
-    /// `vunit=`: the unit of the values (ImageJ's calibration key; contactscope writes `um`,
-    /// `MPa`, or `1` for 0/1 maps).
+    /// `vunit=`: the unit of the values (ImageJ's calibration key; contactscope writes `um` and
+    /// `MPa`, and no unit for 0/1 maps, masks and micrographs).
     pub value_unit: Option<String>,
 }
 

@@ -172,8 +172,8 @@ fn rational(value: Option<tiff::decoder::ifd::Value>) -> Option<f64> {
     (v.is_finite() && v > 0.0).then_some(v)
 }
 
-/// A file that is not a TIFF but a format contactscope reads elsewhere (a height map, a CZI, ND2
-/// or LIF file named `.tif`): the error that says so and names the command that reads it.
+/// A file that is not a TIFF but a height map contactscope reads with another command: the
+/// error that says so and names that command.
 fn other_format(path: &Path) -> Option<Error> {
     let mut head = Vec::new();
     File::open(path)

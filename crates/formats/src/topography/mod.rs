@@ -213,8 +213,8 @@ pub fn read_topography(
     }
 }
 
-/// The metres per stored value of a TIFF height map: the unit its ImageJ description states
-/// (`vunit=`, as contactscope's maps write it), else `height_unit_m`, else 1. A file that says
+/// The metres per stored value of a TIFF height map: the length unit its ImageJ description
+/// states (`vunit=`, as contactscope's maps write it), else `height_unit_m`, else 1. A file that says
 /// its values are something other than heights (`quantity=pressure`, a contact map, a
 /// micrograph) is refused naming what it holds, and so is a `height_unit_m` beside a stated unit.
 fn tiff_height_scale(path: &Path, info: &TiffInfo, height_unit_m: Option<f64>) -> Result<f64> {
@@ -242,14 +242,19 @@ fn tiff_height_scale(path: &Path, info: &TiffInfo, height_unit_m: Option<f64>) -
     let Some(unit) = info.value_unit.as_deref() else {
         return unitless_scale(height_unit_m);
     };
-    let Some(factor) = length_unit_factor(unit) else {
-        return Err(bad(
+    match (length_unit_factor(unit), info.quantity.is_some()) {
+        (Some(factor), _) => {
+            refuse_height_unit(path, height_unit_m, unit)?;
+            Ok(factor)
+        }
+        (None, true) => Err(bad(
             path,
-            format!("the file's values are in '{unit}', not a length: not a height map"),
-        ));
-    };
-    refuse_height_unit(path, height_unit_m, unit)?;
-    Ok(factor)
+            format!("the file says its heights are in '{unit}', which is not a length"),
+        )),
+        // Another program's calibration unit that is not a length ("Gray Value"): it says
+        // nothing about heights, which are then in the unit given, as for any TIFF.
+        (None, false) => unitless_scale(height_unit_m),
+    }
 }
 
 /// Read the first page of a float32/float64 TIFF. Pixel size: `pixel_size_m`, else the file's

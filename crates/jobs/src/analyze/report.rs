@@ -65,7 +65,7 @@ pub struct Row {
     pub hertz_radius_um: Option<f64>,
     /// Hertz contact area, µm².
     pub hertz_area_um2: Option<f64>,
-    /// A contact pixel lies on the image border: the area is cut off and the image is left out
+    /// The contact is cut off by the image border (`Mask::edge_contact`): the image is left out
     /// of the fits ([`crate::fits`]).
     #[serde(default)]
     pub edge_contact: bool,

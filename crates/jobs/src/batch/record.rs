@@ -165,7 +165,7 @@ pub struct PowerLaw {
     pub exponent: f64,
     /// Standard error of β (none for two points).
     pub exponent_se: Option<f64>,
-    /// R² in log–log (none for two points or identical areas).
+    /// R² in log–log (none from fewer than three distinct forces, or identical areas).
     pub r_squared: Option<f64>,
     /// Points fitted.
     pub points: usize,

@@ -182,7 +182,6 @@ fn check_file(file: &SeriesFile, first: Option<&SeriesFile>) -> Result<()> {
     Ok(())
 }
 
-/// Resolve the channel of a TIFF file.
 /// Micrographs to threshold (`analyze`, `compare`): a TIFF of the series whose description says
 /// it holds something other than intensities (a map written by `simulate`, a saved contact mask)
 /// is refused naming what it holds and the command that reads it. Reading such a file as an
@@ -219,6 +218,7 @@ fn refuse_map(info: &TiffInfo) -> Result<()> {
     ))
 }
 
+/// Resolve the channel of a TIFF file.
 fn tiff_channel(info: &TiffInfo, channel: Option<usize>) -> Result<usize> {
     match channel {
         None if info.channels > 1 => Err(Error::bad_input(

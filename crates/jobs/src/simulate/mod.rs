@@ -375,7 +375,7 @@ pub struct PowerLaw {
     pub exponent_se: Option<f64>,
     /// c in µm²·mN^(−β).
     pub prefactor_um2: f64,
-    /// R² of the log–log regression (none from fewer than three loads).
+    /// R² of the log–log regression (none from fewer than three distinct forces).
     pub r_squared: Option<f64>,
     /// Loads fitted (those without edge contact and with a contact pixel).
     pub points: usize,
@@ -503,7 +503,7 @@ pub fn run(
     warnings.extend(fits::power_law_warnings(power_law.as_ref(), &points));
     if fits::nothing_valid(&points) {
         warnings.push(
-            "no load is valid (see above): the table and maps are written, but no area–load fit \
+            "no load is valid (see above): the loads' numbers are given, but no area–load fit \
              rests on them"
                 .into(),
         );
