@@ -10,7 +10,7 @@ use clap::ValueEnum;
 
 use contactscope::surface::fill::FillInvalid;
 use contactscope::surface::Detrend;
-use contactscope_formats::microscopy::select::{LoadAxis, Selection};
+use contactscope_formats::microscopy::select::{ChannelChoice, LoadAxis, Selection};
 use contactscope_formats::ranges::Quantity;
 use contactscope_formats::units::{self, Dimension};
 use contactscope_jobs::heights::TopographySource;
@@ -289,9 +289,10 @@ pub struct SelectionArgs {
     /// Series of a CZI (scene) or LIF (image) file; needed when the file has several.
     #[arg(long)]
     pub series: Option<usize>,
-    /// Channel; needed when the file has several (TIFF: samples or ImageJ channels).
+    /// Channel, by index or by the name `info` shows (CZI, ND2, LIF: AF488, TL, …); needed
+    /// when the file has several (TIFF: samples or ImageJ channels, by index).
     #[arg(long)]
-    pub channel: Option<usize>,
+    pub channel: Option<ChannelChoice>,
     /// Focal plane of a CZI, ND2 or LIF file; needed when it has several.
     #[arg(long)]
     pub z: Option<usize>,
@@ -327,7 +328,7 @@ impl SelectionArgs {
     pub fn selection(&self) -> Selection {
         Selection {
             series: self.series,
-            channel: self.channel,
+            channel: self.channel.clone(),
             z: self.z,
             t: self.t,
             extra: self.axis.iter().cloned().collect(),

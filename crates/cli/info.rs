@@ -124,6 +124,23 @@ fn print_summary(summary: &InfoSummary) {
         if !s.rows.is_y() {
             println!("  {}", s.rows.describe());
         }
+        if s.channels.iter().any(|c| c.name.is_some()) {
+            let names: Vec<String> = s
+                .channels
+                .iter()
+                .enumerate()
+                .map(|(i, c)| {
+                    let nm = c
+                        .emission_m
+                        .map_or(String::new(), |w| format!(", emission {:.0} nm", w * 1e9));
+                    match &c.name {
+                        Some(n) => format!("{i} '{n}'{nm}"),
+                        None => format!("{i}{nm}"),
+                    }
+                })
+                .collect();
+            println!("  channels (--channel INDEX or NAME): {}", names.join("; "));
+        }
         let p = &s.pixel_size_um;
         match (p.x, p.y) {
             (Some(x), Some(y)) => println!(

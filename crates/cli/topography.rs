@@ -21,9 +21,10 @@ pub struct Args {
     /// file's height channel.
     #[arg(long)]
     channel: Option<String>,
-    /// Print JSON: the stored map's summary (file, format, channel, nx, ny,
-    /// pixel_size_um, valid_points, height_*_um, h_rms_um, slope_rms, curvature_rms) and,
-    /// under "detrended", the statistics after --detrend.
+    /// Print JSON: the stored map's summary (file, format, channel, nx, ny, pixel_size_um,
+    /// valid_points, height_*_um, h_rms_as_stored_um, h_prime_rms_as_stored,
+    /// h_double_prime_rms_as_stored_per_um) and, under "detrended", the roughness after
+    /// --detrend (h_rms_nm, h_prime_rms, h_double_prime_rms_per_um, as simulate names them).
     #[arg(long)]
     json: bool,
 }

@@ -21,12 +21,30 @@ use crate::series::ImagesArg;
 use crate::{bad, compute, pixel_opt, PixelArg};
 
 /// Simulated maps as Python gives them.
-#[derive(FromPyObject)]
 enum MapsArg<'py> {
     /// A folder written by `simulate`.
     Folder(PathBuf),
     /// Contact maps (loads, ny, nx), 1 = contact.
     Arrays(PyReadonlyArray3<'py, f64>),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for MapsArg<'py> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Some(dir) = crate::extract::path(&obj) {
+            return Ok(MapsArg::Folder(dir));
+        }
+        obj.extract::<PyReadonlyArray3<'py, f64>>()
+            .map(MapsArg::Arrays)
+            .map_err(|_| {
+                crate::extract::wrong_type(
+                    "the simulated maps",
+                    "a folder written by simulate or a (loads, rows, columns) float64 array",
+                    &obj,
+                )
+            })
+    }
 }
 
 fn simulation(

@@ -17,10 +17,28 @@ use crate::heights::{height_input, HeightsArg};
 use crate::{bad, compute, PixelArg};
 
 /// The measured curve: an `areas.csv` path, or (forces N, areas m²).
-#[derive(FromPyObject)]
 enum MeasuredArg {
     Path(PathBuf),
     Pairs((Vec<f64>, Vec<f64>)),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for MeasuredArg {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Some(p) = crate::extract::path(&obj) {
+            return Ok(MeasuredArg::Path(p));
+        }
+        obj.extract::<(Vec<f64>, Vec<f64>)>()
+            .map(MeasuredArg::Pairs)
+            .map_err(|_| {
+                crate::extract::wrong_type(
+                    "the measured curve",
+                    "an areas.csv path or (forces in N, areas in m²)",
+                    &obj,
+                )
+            })
+    }
 }
 
 fn measured_input(measured: MeasuredArg) -> PyResult<MeasuredInput> {

@@ -14,12 +14,30 @@ use contactscope_jobs::heights::{HeightInput, TopographySource};
 use crate::{bad, PixelArg};
 
 /// Heights as Python gives them.
-#[derive(FromPyObject)]
 pub(crate) enum HeightsArg<'py> {
     /// A file of any height-map format.
     Path(PathBuf),
     /// Heights in m, rows = y.
     Array(PyReadonlyArray2<'py, f64>),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for HeightsArg<'py> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Some(p) = crate::extract::path(&obj) {
+            return Ok(HeightsArg::Path(p));
+        }
+        obj.extract::<PyReadonlyArray2<'py, f64>>()
+            .map(HeightsArg::Array)
+            .map_err(|_| {
+                crate::extract::wrong_type(
+                    "heights",
+                    "a height-map file or a 2-D float64 array of heights in m",
+                    &obj,
+                )
+            })
+    }
 }
 
 /// `"none"`, `"mean"` or `"plane"`.

@@ -20,6 +20,7 @@ use contactscope_jobs::Error;
 mod batch;
 mod compare;
 mod convert;
+mod extract;
 mod fit;
 mod heights;
 mod images;
@@ -164,14 +165,39 @@ fn get_num_threads() -> usize {
 }
 
 /// A pixel size given as one number (square pixels) or an (x, y) pair, metres.
-#[derive(FromPyObject, Clone)]
+#[derive(Clone)]
 pub(crate) enum PixelArg {
     /// Square pixels.
     Square(f64),
-    /// (x, y).
-    Pair((f64, f64)),
     /// [x, y] (a list or an array).
     List(Vec<f64>),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for PixelArg {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let obj: &Bound<'py, PyAny> = &obj;
+        if let Some(v) = extract::real(obj) {
+            return Ok(PixelArg::Square(v));
+        }
+        if !obj.is_instance_of::<pyo3::types::PyString>() {
+            if let Ok(v) = obj.extract::<Vec<f64>>() {
+                return Ok(PixelArg::List(v));
+            }
+        }
+        let hint = match obj.cast::<pyo3::types::PyString>() {
+            Ok(s) => format!(
+                " (parse_pixel_size('{}') converts a length with its unit)",
+                s.to_string().replace('\'', "\\'")
+            ),
+            Err(_) => String::new(),
+        };
+        Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "a pixel size must be a number of metres (2e-7 for 200 nm) or an (x, y) pair; got {}{hint}",
+            extract::given(obj)
+        )))
+    }
 }
 
 impl PixelArg {
@@ -179,7 +205,6 @@ impl PixelArg {
     pub(crate) fn xy(self) -> PyResult<(f64, f64)> {
         let (x, y) = match self {
             PixelArg::Square(s) => (s, s),
-            PixelArg::Pair(p) => p,
             PixelArg::List(v) if v.len() == 2 => (v[0], v[1]),
             PixelArg::List(v) => {
                 return Err(bad(format!(

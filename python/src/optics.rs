@@ -22,16 +22,35 @@ use contactscope_jobs::newton::NewtonRequest;
 use contactscope_jobs::psf::PsfRequest;
 
 use crate::convert::outcome_dict;
+use crate::extract::ChannelArg;
 use crate::images::StackIn;
 use crate::{bad, compute, pixel_opt, PixelArg};
 
 /// An image file, or a stack in its stored sample type.
-#[derive(FromPyObject)]
 enum ImageArg<'py> {
     /// A stack (planes, rows, columns).
     Stack(StackIn<'py>),
     /// A file (TIFF, CZI, ND2, LIF).
     File(PathBuf),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for ImageArg<'py> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Some(p) = crate::extract::path(&obj) {
+            return Ok(ImageArg::File(p));
+        }
+        obj.extract::<StackIn<'py>>()
+            .map(ImageArg::Stack)
+            .map_err(|_| {
+                crate::extract::wrong_type(
+                    "an image",
+                    "a file (TIFF, CZI, ND2, LIF) or a (planes, rows, columns) array of uint8, uint16, int16, float32 or float64",
+                    &obj,
+                )
+            })
+    }
 }
 
 impl ImageArg<'_> {
@@ -77,14 +96,14 @@ fn memory_images(stack: &StackIn<'_>, label: &str) -> MemoryImages {
 /// `--axis`.
 fn selection(
     series: Option<usize>,
-    channel: Option<usize>,
+    channel: Option<ChannelArg>,
     z: Option<usize>,
     t: Option<usize>,
     axes: Option<BTreeMap<String, usize>>,
 ) -> Selection {
     Selection {
         series,
-        channel,
+        channel: channel.and_then(|c| c.0),
         z,
         t,
         extra: axes.unwrap_or_default(),
@@ -104,7 +123,7 @@ fn psf<'py>(
     bead_diameter: Option<f64>,
     saturation_level: Option<f64>,
     series: Option<usize>,
-    channel: Option<usize>,
+    channel: Option<ChannelArg>,
     z: Option<usize>,
     t: Option<usize>,
     axes: Option<BTreeMap<String, usize>>,
@@ -137,7 +156,7 @@ fn newton<'py>(
     phase: Option<&str>,
     contact_channel: Option<usize>,
     series: Option<usize>,
-    channel: Option<usize>,
+    channel: Option<ChannelArg>,
     z: Option<usize>,
     t: Option<usize>,
     axes: Option<BTreeMap<String, usize>>,
@@ -178,7 +197,7 @@ fn autocorrelation<'py>(
     pixel_size: Option<PixelArg>,
     max_lag: Option<f64>,
     series: Option<usize>,
-    channel: Option<usize>,
+    channel: Option<ChannelArg>,
     z: Option<usize>,
     t: Option<usize>,
     axes: Option<BTreeMap<String, usize>>,

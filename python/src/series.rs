@@ -14,7 +14,7 @@ use pyo3::types::PyDict;
 use contactscope::analysis::Pass;
 use contactscope::image::{PixelSize, Plane, SampleType};
 use contactscope::threshold::{Method, Threshold};
-use contactscope_formats::microscopy::select::{LoadAxis, Selection};
+use contactscope_formats::microscopy::select::{ChannelChoice, LoadAxis, Selection};
 use contactscope_formats::param::Param;
 use contactscope_jobs::analyze::files::{run_to_folder, ImageOutputs};
 use contactscope_jobs::analyze::{AnalyzeRequest, HertzParams};
@@ -76,26 +76,46 @@ fn load_axis_of(name: Option<&str>) -> PyResult<Option<LoadAxis>> {
 
 /// The files of a series as the command line's inputs, `--manifest`, selection flags,
 /// `--load-axis` and `--forces`.
-#[derive(FromPyObject)]
 pub(crate) struct SpecArgs {
-    #[pyo3(item)]
     inputs: Vec<PathBuf>,
-    #[pyo3(item)]
     manifest: Option<PathBuf>,
-    #[pyo3(item)]
     series: Option<usize>,
-    #[pyo3(item)]
-    channel: Option<usize>,
-    #[pyo3(item)]
+    channel: Option<ChannelChoice>,
     z: Option<usize>,
-    #[pyo3(item)]
     t: Option<usize>,
-    #[pyo3(item)]
     axes: Option<BTreeMap<String, usize>>,
-    #[pyo3(item)]
     load_axis: Option<String>,
-    #[pyo3(item)]
     forces: Option<Vec<f64>>,
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for SpecArgs {
+    type Error = PyErr;
+
+    /// The dict the Python layer's `_spec` builds from the keywords; each wrong value is
+    /// answered naming its keyword.
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        use crate::extract::{index, item};
+        let obj: &Bound<'py, PyAny> = &obj;
+        let get = |key: &str| obj.get_item(key).ok().filter(|v| !v.is_none());
+        let idx = |key: &str| match get(key) {
+            Some(v) => index(&v, &format!("{key}=")),
+            None => Ok(None),
+        };
+        Ok(SpecArgs {
+            inputs: item(obj, "inputs", "a path or a list of paths")?.unwrap_or_default(),
+            manifest: item(obj, "manifest", "a path")?,
+            series: idx("series")?,
+            channel: match get("channel") {
+                Some(v) => crate::extract::channel(&v)?,
+                None => None,
+            },
+            z: idx("z")?,
+            t: idx("t")?,
+            axes: item(obj, "axes", "a dict of axis names to indices ({\"H\": 0})")?,
+            load_axis: item(obj, "load_axis", "\"t\", \"z\" or \"series\"")?,
+            forces: item(obj, "forces", "a sequence of forces in N")?,
+        })
+    }
 }
 
 impl SpecArgs {
@@ -156,12 +176,30 @@ fn read_series<'py>(
 }
 
 /// Images handed over as arrays, or the files of a series.
-#[derive(FromPyObject)]
 pub(crate) enum ImagesArg<'py> {
     /// A dict of the file spec (`read_series`' arguments).
     Files(SpecArgs),
     /// A stack in its stored sample type.
     Arrays(StackIn<'py>),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for ImagesArg<'py> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if obj.is_instance_of::<PyDict>() {
+            return obj.extract::<SpecArgs>().map(ImagesArg::Files);
+        }
+        obj.extract::<StackIn<'py>>()
+            .map(ImagesArg::Arrays)
+            .map_err(|_| {
+                crate::extract::wrong_type(
+                    "the images",
+                    "files (paths, a folder, a manifest) or a (images, rows, columns) array of uint8, uint16, int16, float32 or float64",
+                    &obj,
+                )
+            })
+    }
 }
 
 /// The micrographs of a request: the files, or the arrays (with their forces).
@@ -196,10 +234,26 @@ fn otsu_threshold<'py>(py: Python<'py>, images: ImagesArg<'py>) -> PyResult<Boun
 }
 
 /// The method as the command line names it: "otsu", "per-image" or a number.
-#[derive(FromPyObject)]
 enum MethodArg {
     Manual(f64),
     Name(String),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for MethodArg {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Some(t) = crate::extract::real(&obj) {
+            return Ok(MethodArg::Manual(t));
+        }
+        obj.extract::<String>().map(MethodArg::Name).map_err(|_| {
+            crate::extract::wrong_type(
+                "method=",
+                "\"otsu\", \"per-image\" or a threshold (a number)",
+                &obj,
+            )
+        })
+    }
 }
 
 /// The series analysis (the command line's `analyze`): files or arrays, forces in N, pixel

@@ -25,6 +25,20 @@ pub(crate) fn model_of(
     initial_hardness: Option<f64>,
     alpha: Option<f64>,
 ) -> PyResult<ModelChoice> {
+    const MODELS: [&str; 4] = ["elastic", "hardness", "hardening", "gt"];
+    if !MODELS.contains(&model) {
+        // The name first: a misspelt model must not be blamed on its parameters.
+        let hint = MODELS
+            .iter()
+            .find(|m| m.eq_ignore_ascii_case(model.trim()))
+            .map(|m| format!("; did you mean \"{m}\"?"))
+            .unwrap_or_default();
+        return Err(bad(format!(
+            "{}\"{model}\" is not one of {}{hint}",
+            Param::Model,
+            MODELS.map(|m| format!("\"{m}\"")).join(", ")
+        )));
+    }
     let unused = |what: Param, value: Option<f64>, applies: &str| match value {
         Some(_) => Err(bad(format!("{what} applies to model=\"{applies}\" only"))),
         None => Ok(()),
@@ -58,21 +72,28 @@ pub(crate) fn model_of(
             })?,
             initial_pa: initial_hardness.unwrap_or(0.0),
         }),
-        other => {
-            return Err(bad(format!(
-                "{}\"{other}\" is not one of elastic, hardness, hardening, gt",
-                Param::Model
-            )))
-        }
+        other => return Err(bad(format!("{}\"{other}\" is not a model", Param::Model))),
     })
 }
 
 /// `maps=`: `"none"`, `"contact"` or `"all"`; `True` and `False` (the older spelling) mean
 /// `"all"` and `"none"`.
-#[derive(FromPyObject)]
 enum MapsArg {
     Flag(bool),
     Name(String),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for MapsArg {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Ok(flag) = obj.cast::<pyo3::types::PyBool>() {
+            return Ok(MapsArg::Flag(flag.is_true()));
+        }
+        obj.extract::<String>().map(MapsArg::Name).map_err(|_| {
+            crate::extract::wrong_type("maps=", "\"none\", \"contact\" or \"all\"", &obj)
+        })
+    }
 }
 
 fn maps_of(arg: MapsArg) -> PyResult<MapChoice> {

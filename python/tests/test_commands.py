@@ -206,10 +206,10 @@ def test_read_topography_describes_like_cli(cli, surface_npy):
     s = t.summary
     assert set(s) == {si(k) for k in theirs}
     assert set(s["detrended"]) == {si(k) for k in theirs["detrended"]}
-    for key in ("file", "format", "channel", "nx", "ny", "valid_points", "slope_rms",
-                "curvature_rms"):
+    for key in ("file", "format", "channel", "nx", "ny", "valid_points",
+                "h_prime_rms_as_stored"):
         assert s[key] == theirs[key], key
-    for key in ("height_min_um", "height_max_um", "height_mean_um", "h_rms_um"):
+    for key in ("height_min_um", "height_max_um", "height_mean_um", "h_rms_as_stored_um"):
         assert s[si(key)] * 1e6 == pytest.approx(theirs[key], rel=1e-12), key
     assert s["pixel_size_m"] == {"x": 100e-9, "y": 100e-9}
     d, e = s["detrended"], theirs["detrended"]

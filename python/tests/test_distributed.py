@@ -306,6 +306,18 @@ def test_a_sweep_writes_its_folder_whole(client, tmp_path):
     assert rows[0]["area_um2"] == "" and "exceeds" in rows[0]["error"]
     assert [float(x["area_um2"]) for x in rows[3:]] == pytest.approx(
         [a * 1e12 for a in r.rows[1]["areas_m2"]], rel=1e-15)
+    # to_pandas() has the table's columns, in SI units, with the same values.
+    pd = pytest.importorskip("pandas", reason="to_pandas() needs pandas, an optional dependency")
+    df = r.to_pandas()
+    table = pd.read_csv(out / "sweep.csv", keep_default_na=False)
+    si = {"hardness_MPa": ("hardness_pa", 1e6), "force_mN": ("force_n", 1e-3),
+          "area_um2": ("area_m2", 1e-12)}
+    assert list(df.columns) == [si.get(c, (c,))[0] for c in table.columns]
+    for column, (name, factor) in si.items():
+        mine = df[name].to_numpy(dtype=float)
+        theirs = pd.to_numeric(table[column], errors="coerce").to_numpy() * factor
+        np.testing.assert_allclose(mine, theirs, rtol=1e-12, equal_nan=True)
+    assert list(df["model"]) == list(table["model"])
     summary = json.loads((out / "sweep.json").read_text())
     assert summary["loads_mN"] == pytest.approx([f * 1e3 for f in LOADS])
     assert summary["failed"] == 1 and summary["ramps"] == 2 and summary["device"] == "cpu"

@@ -53,15 +53,17 @@ def test_vendor_height_maps_match_cli(cli):
     t = cs.read_topography(ibw, channel="HeightTrace", detrend="none")
     summary = json.loads(cli("topography", ibw, "--json", "--channel", "HeightTrace"))
     assert t.heights.shape == (summary["ny"], summary["nx"])
-    assert t.heights.std() * 1e6 == pytest.approx(summary["h_rms_um"], rel=1e-6)
+    assert t.heights.std() * 1e6 == pytest.approx(summary["h_rms_as_stored_um"], rel=1e-6)
     assert t.pixel_size_m[0] * 1e6 == pytest.approx(summary["pixel_size_um"]["x"], rel=1e-12)
     # Python describes the file as `topography --json` does, in SI units.
     mine = t.summary
-    for key in ("file", "format", "channel", "nx", "ny", "valid_points", "slope_rms",
-                "curvature_rms"):
+    for key in ("file", "format", "channel", "nx", "ny", "valid_points",
+                "h_prime_rms_as_stored"):
         assert mine[key] == summary[key], key
-    for key in ("height_min", "height_max", "height_mean", "h_rms"):
+    for key in ("height_min", "height_max", "height_mean", "h_rms_as_stored"):
         assert mine[f"{key}_m"] * 1e6 == pytest.approx(summary[f"{key}_um"], rel=1e-12), key
+    assert mine["h_double_prime_rms_as_stored_per_m"] * 1e-6 == pytest.approx(
+        summary["h_double_prime_rms_as_stored_per_um"], rel=1e-12)
     with pytest.raises(cs.InputError, match="channel"):
         cs.read_topography(ibw, channel="NoSuchChannel")
 

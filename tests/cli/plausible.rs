@@ -332,6 +332,68 @@ fn compare_refuses_an_oversized_rendering_before_allocating_it() {
     assert!(!dir.path().join("c").exists());
 }
 
+/// Run `args` under a 2 GiB address-space limit: a size that passed the checks and then
+/// allocated would abort instead of failing in one line.
+fn run_limited(args: &[&str]) -> std::process::Output {
+    let quoted: Vec<String> = args.iter().map(|a| format!("'{a}'")).collect();
+    let line = format!(
+        "ulimit -v 2097152; exec '{}' {}",
+        env!("CARGO_BIN_EXE_contactscope"),
+        quoted.join(" ")
+    );
+    std::process::Command::new("sh")
+        .args(["-c", &line])
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn sizes_are_checked_before_the_grids_are_allocated() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s");
+    // 100 images of 8192² kept in memory (19 GiB).
+    let o = run_limited(&[
+        "synth-series",
+        "--size",
+        "8192",
+        "--forces",
+        "4mN..4.4mN:100",
+        "--out",
+        s(&out),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("100 images of 8192×8192 px would hold 18.8 GiB"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // A simulated contact map imaged on 0.2 nm pixels: 32,000² per load from the 6.4 µm map
+    // (each side within the limit, the plane 7.6 GiB), refused before the first load is solved.
+    let map = small_map(dir.path());
+    let measured = dir.path().join("areas.csv");
+    std::fs::write(&measured, "force_mN,area_um2\n1,2\n2,3\n3,4\n").unwrap();
+    let o = run_limited(&[
+        "fit-hardening",
+        "--areas",
+        s(&measured),
+        "--topography",
+        s(&map),
+        "--modulus",
+        "3.7GPa",
+        "--imaged-areas",
+        "--psf-fwhm",
+        "450nm",
+        "--micrograph-pixel-size",
+        "0.2nm",
+        "--out",
+        s(&dir.path().join("fit")),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("resampling"), "{err}");
+}
+
 #[test]
 fn messages_keep_clap_suggestions_and_point_to_the_right_command() {
     let one_line = |args: &[&str]| {

@@ -79,7 +79,7 @@ fn topography_json_gives_surface_topographys_numbers() {
     close("height_min_um", -0.704_623_857_927_799_7);
     close("height_max_um", -0.331_233_451_333_901_03);
     close("height_mean_um", -0.538_691_195_036_984);
-    close("h_rms_um", 0.089_454_814_912_564_12);
+    close("h_rms_as_stored_um", 0.089_454_814_912_564_12);
     assert!((v["pixel_size_um"]["x"].as_f64().unwrap() / (20.0 / 255.0) - 1.0).abs() < 1e-12);
     assert!(v["detrended"]["h_rms_nm"].as_f64().unwrap() > 0.0);
 

@@ -213,7 +213,7 @@ fn height_maps_match_surface_topography() {
             s.height_mean_m
         );
         assert!(
-            s.slope_rms.unwrap() > 0.0 && s.curvature_rms.unwrap() > 0.0,
+            s.h_prime_rms.unwrap() > 0.0 && s.h_double_prime_rms_per_m.unwrap() > 0.0,
             "{file}"
         );
         // Format found from the content, also under another name.

@@ -80,7 +80,7 @@ fn invalid_points_are_refused_unless_filled() {
         &frt,
         &["--fill-invalid", "mean", "--detrend", "none"],
     );
-    let h_valid_nm = t["h_rms_um"].as_f64().unwrap() * 1e3;
+    let h_valid_nm = t["h_rms_as_stored_um"].as_f64().unwrap() * 1e3;
     let expected = h_valid_nm * (valid as f64 / total as f64).sqrt();
     let got = mean["topography"]["h_rms_nm"].as_f64().unwrap();
     assert!((got / expected - 1.0).abs() < 1e-9, "{got} vs {expected}");

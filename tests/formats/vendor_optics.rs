@@ -84,7 +84,7 @@ fn psf_and_newton_readers_take_the_selected_planes() {
     let mut f = MicroscopyFile::open(&file).unwrap();
     // psf: a z stack of the selected channel and time point, in z order, with the ND2 pixel size.
     let sel = Selection {
-        channel: Some(1),
+        channel: Some(1.into()),
         t: Some(2),
         ..Selection::default()
     };

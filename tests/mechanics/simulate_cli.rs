@@ -48,9 +48,12 @@ fn surface_topography_and_elastic_simulation() {
     assert!((d["pixel_size_x_nm"].as_f64().unwrap() - 32.0).abs() < 1e-9);
     assert!((v["pixel_size_um"]["x"].as_f64().unwrap() - 0.032).abs() < 1e-12);
     // Without detrending, the stored map's summary and the roughness statistics agree.
-    let slope = v["slope_rms"].as_f64().unwrap();
+    let slope = v["h_prime_rms_as_stored"].as_f64().unwrap();
     assert!((slope / d["h_prime_rms"].as_f64().unwrap() - 1.0).abs() < 1e-9);
-    let h_rms_um = v["h_rms_um"].as_f64().unwrap();
+    let curvature = v["h_double_prime_rms_as_stored_per_um"].as_f64().unwrap();
+    let detrended = d["h_double_prime_rms_per_um"].as_f64().unwrap();
+    assert!((curvature / detrended - 1.0).abs() < 1e-9);
+    let h_rms_um = v["h_rms_as_stored_um"].as_f64().unwrap();
     assert!((h_rms_um * 1e3 / d["h_rms_nm"].as_f64().unwrap() - 1.0).abs() < 1e-6);
 
     let out = dir.path().join("sim");

@@ -168,6 +168,23 @@ fn force_ranges_and_a_zero_reference_frame() {
         column(&h, &r, "area_um2"),
         "force_N and force_mN manifests agree"
     );
+    // The same as a spreadsheet saves it where the decimal mark is a comma: semicolons between
+    // fields, decimal commas, a byte-order mark.
+    let semicolons = tmp.path().join("semicolons.csv");
+    let mut text = String::from("\u{feff}file;page;force_N\n");
+    for (page, f) in [0.0, 6.0, 10.0, 16.0, 25.0, 40.0, 63.0, 100.0]
+        .iter()
+        .enumerate()
+    {
+        let newtons = format!("{}", f * 1e-3).replace('.', ",");
+        text += &format!("{};{page};{newtons}\n", s(&tif));
+    }
+    fs::write(&semicolons, text).unwrap();
+    let out3 = tmp.path().join("semicolons");
+    run_ok(&["analyze", s(&semicolons), "--out", s(&out3), "-q"]);
+    let (h3, r3) = read_csv(&out3.join("areas.csv"));
+    assert_eq!(column(&h3, &r3, "force_mN"), column(&h2, &r2, "force_mN"));
+    assert_eq!(column(&h3, &r3, "area_um2"), column(&h, &r, "area_um2"));
 }
 
 #[test]

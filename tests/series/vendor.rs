@@ -203,9 +203,50 @@ fn unselected_axes_and_mismatched_counts_are_clear_errors() {
         assert_eq!(e.trim().lines().count(), 1, "one line: {e}");
         e
     };
+    // Every axis to choose in one message, the channels with their names.
     let e = err(&["analyze", s(&nd2), "--forces", "1mN", "--out", out]);
     assert!(
-        e.contains("cluster.nd2: 2 channels; choose one with --channel 0..1"),
+        e.contains(
+            "cluster.nd2: 2 channels, 10 z planes and 3 time points; choose one of each with \
+             --channel 0..1 or a name (0 '5-FAM/pH 9.0', 1 'FM 4-64/2% CHAPS'), --z 0..9 and \
+             --t 0..2"
+        ),
+        "{e}"
+    );
+    // A channel by name (without regard to case) reads the plane its index reads.
+    let by_index = run_ok(&[
+        "threshold",
+        s(&nd2),
+        "--channel",
+        "1",
+        "--z",
+        "4",
+        "--t",
+        "2",
+    ]);
+    let by_name = run_ok(&[
+        "threshold",
+        s(&nd2),
+        "--channel",
+        "fm 4-64/2% chaps",
+        "--z",
+        "4",
+        "--t",
+        "2",
+    ]);
+    assert_eq!(by_index.stdout, by_name.stdout);
+    let e = err(&[
+        "threshold",
+        s(&nd2),
+        "--channel",
+        "AF488",
+        "--z",
+        "1",
+        "--t",
+        "0",
+    ]);
+    assert!(
+        e.contains("--channel AF488: no channel has that name; the channels are 0 '5-FAM/pH 9.0', 1 'FM 4-64/2% CHAPS'"),
         "{e}"
     );
     let e = err(&[
@@ -218,7 +259,10 @@ fn unselected_axes_and_mismatched_counts_are_clear_errors() {
         "--out",
         out,
     ]);
-    assert!(e.contains("10 z planes; choose one with --z 0..9"), "{e}");
+    assert!(
+        e.contains("10 z planes and 3 time points; choose one of each with --z 0..9 and --t 0..2"),
+        "{e}"
+    );
     let e = err(&["threshold", s(&nd2), "--channel", "0", "--z", "1"]);
     assert!(e.contains("3 time points; choose one with --t 0..2"), "{e}");
     let e = err(&[
@@ -260,6 +304,8 @@ fn unselected_axes_and_mismatched_counts_are_clear_errors() {
         "0",
         "--z",
         "1",
+        "--t",
+        "0",
         "--load-axis",
         "z",
     ]);
@@ -269,7 +315,14 @@ fn unselected_axes_and_mismatched_counts_are_clear_errors() {
     );
     let lif = dir.join("lif/LeicaLASX_wavelength-sweep_example.lif");
     let e = err(&["threshold", s(&lif)]);
-    assert!(e.contains("3 series; choose one with --series 0..2"), "{e}");
+    assert!(
+        e.contains(
+            "3 series and 20 planes along axis lambda_emission in series 0; choose one of each \
+             with --series 0..2 (0 'x_y_lambdaEmi', 1 'x_y_lambdaExc', 2 'x_y_z_t_lambdaEmi') \
+             and --axis lambda_emission=0..19"
+        ),
+        "{e}"
+    );
     let airy = dir.join("czi/LSM880_AiryScan.czi");
     let e = err(&["threshold", s(&airy), "--channel", "0"]);
     assert!(e.contains("axis H") && e.contains("Airyscan"), "{e}");

@@ -11,6 +11,34 @@ pub(crate) struct Table {
     path: PathBuf,
     header: Vec<String>,
     rows: Vec<csv::StringRecord>,
+    delimiter: u8,
+}
+
+/// The field delimiter of a CSV text: `;` when its first line that is not a `#` comment has
+/// semicolons and no commas (the CSV a spreadsheet writes in locales whose decimal mark is the
+/// comma), else `,`.
+pub(crate) fn sniff_delimiter(text: &str) -> u8 {
+    let first = text
+        .trim_start_matches('\u{feff}')
+        .lines()
+        .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    match first {
+        Some(l) if l.contains(';') && !l.contains(',') => b';',
+        _ => b',',
+    }
+}
+
+/// A number cell of a CSV with `delimiter`: in a semicolon-separated file a decimal comma
+/// (`4,5`) is the decimal point.
+pub(crate) fn parse_number(cell: &str, delimiter: u8) -> Option<f64> {
+    let cell = cell.trim();
+    match cell.parse::<f64>() {
+        Ok(v) => Some(v),
+        Err(_) if delimiter == b';' && cell.matches(',').count() == 1 && !cell.contains('.') => {
+            cell.replace(',', ".").parse().ok()
+        }
+        Err(_) => None,
+    }
 }
 
 impl Table {
@@ -18,11 +46,16 @@ impl Table {
     pub(crate) fn read(path: &Path) -> Result<Table> {
         crate::staging::note_input(path);
         let at = || Location::file(path);
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let text = std::str::from_utf8(&bytes)
+            .map_err(|_| Error::bad_input(at(), "not UTF-8 text (save the table as CSV UTF-8)"))?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let delimiter = sniff_delimiter(text);
         let mut reader = csv::ReaderBuilder::new()
+            .delimiter(delimiter)
             .trim(csv::Trim::All)
             .comment(Some(b'#'))
-            .from_path(path)
-            .map_err(|e| csv_error(path, e))?;
+            .from_reader(text.as_bytes());
         let header = reader
             .headers()
             .map_err(|e| csv_error(path, e))?
@@ -37,6 +70,7 @@ impl Table {
             path: path.to_path_buf(),
             header,
             rows,
+            delimiter,
         })
     }
 
@@ -110,8 +144,8 @@ impl Table {
             .enumerate()
             .map(|(k, row)| {
                 let cell = row.get(i).unwrap_or("");
-                match cell.parse::<f64>() {
-                    Ok(v) if v.is_finite() => Ok(v * factor),
+                match parse_number(cell, self.delimiter) {
+                    Some(v) if v.is_finite() => Ok(v * factor),
                     _ => Err(Error::bad_input(
                         self.location(),
                         format!(

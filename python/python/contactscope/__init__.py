@@ -23,6 +23,13 @@ from typing import Any, Dict, Iterable, Optional, Sequence, Union
 import numpy as np
 
 from . import _contactscope as _cs
+from ._args import command_line as _command_line
+from ._args import f64 as _f64
+from ._args import number as _number
+from ._args import numbers_of as _numbers
+from ._args import optional_number as _opt_number
+from ._args import optional_numbers as _opt_numbers
+from ._args import spec as _spec
 from ._contactscope import (  # noqa: F401  (re-exported)
     ConvergenceError,
     FileError,
@@ -163,35 +170,7 @@ def _stack(images: Any) -> np.ndarray:
     return np.ascontiguousarray(a)
 
 
-def _f64(a: Any, ndim: int, what: str) -> np.ndarray:
-    a = np.asarray(a, dtype=np.float64)
-    if ndim == 3 and a.ndim == 2:
-        a = a[np.newaxis]
-    if a.ndim != ndim:
-        raise InputError(f"{what} must be a {ndim}-D array; got {a.ndim} dimensions")
-    return np.ascontiguousarray(a)
-
-
-def _spec(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
-          forces: Optional[Sequence[float]] = None, channel: Optional[int] = None,
-          series: Optional[int] = None, z: Optional[int] = None, t: Optional[int] = None,
-          axes: Optional[Dict[str, int]] = None,
-          load_axis: Optional[str] = None) -> Dict[str, Any]:
-    """The files of a series as the command line takes them: files and folders, or one
-    manifest (``.csv``), with the selection flags."""
-    if isinstance(paths_or_manifest, (str, os.PathLike)):
-        paths = [os.fspath(paths_or_manifest)]
-    else:
-        paths = [os.fspath(p) for p in paths_or_manifest]
-    manifest = None
-    if len(paths) == 1 and paths[0].lower().endswith(".csv"):
-        manifest, paths = paths[0], []
-    return {"inputs": paths, "manifest": manifest, "series": series, "channel": channel,
-            "z": z, "t": t, "axes": axes, "load_axis": load_axis,
-            "forces": None if forces is None else [float(f) for f in forces]}
-
-
-def read_image(path: PathLike, channel: Optional[int] = None,
+def read_image(path: PathLike, channel: Union[int, str, None] = None,
                pixel_size: Optional[PixelSize] = None, *, series: Optional[int] = None,
                z: Optional[int] = None, t: Optional[int] = None,
                axes: Optional[Dict[str, int]] = None,
@@ -201,9 +180,10 @@ def read_image(path: PathLike, channel: Optional[int] = None,
     float32, as tifffile returns them).
 
     A vendor file gives the plane that ``series``, ``channel``, ``z``, ``t`` and ``axes`` (extra
-    axes by name, e.g. ``{"H": 3}`` for an Airyscan phase) select, index 0 where not given, or
-    every plane along ``load_axis`` ("t", "z" or "series") — as the command line's selection
-    flags. Returns ``images`` (images, rows, columns), ``pixel_size_m`` ((x, y) in m from the
+    axes by name, e.g. ``{"H": 3}`` for an Airyscan phase) select, or every plane along
+    ``load_axis`` ("t", "z" or "series") — as the command line's selection flags: an axis
+    longer than 1 must be chosen (the error lists every such axis at once), and ``channel`` is
+    an index or the channel's name as :func:`info` lists it ("AF488"). Returns ``images`` (images, rows, columns), ``pixel_size_m`` ((x, y) in m from the
     file's metadata or ``pixel_size``, m; ``None`` if unknown), ``pixel_size_source``,
     ``path`` and ``warnings``.
     """
@@ -215,7 +195,7 @@ def read_image(path: PathLike, channel: Optional[int] = None,
 
 
 def read_series(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
-                forces: Optional[Sequence[float]] = None, channel: Optional[int] = None,
+                forces: Optional[Sequence[float]] = None, channel: Union[int, str, None] = None,
                 pixel_size: Optional[PixelSize] = None, *, series: Optional[int] = None,
                 z: Optional[int] = None, t: Optional[int] = None,
                 axes: Optional[Dict[str, int]] = None,
@@ -267,7 +247,8 @@ def otsu_threshold(images: Any) -> float:
 def measure(image: Any, threshold: float, pixel_size: Optional[PixelSize] = None) -> Results:
     """Contact (value > ``threshold``) of one 2-D image: ``contact_pixels``, ``area_m2`` (with
     ``pixel_size`` in m), intensities, 8-connected ``patches`` and the boolean ``mask``."""
-    return Results(_cs.measure(_stack(image), float(threshold), pixel_size))
+    threshold = _number(threshold, "threshold", "intensity units")
+    return Results(_cs.measure(_stack(image), threshold, pixel_size))
 
 
 def analyze(series: Any, forces: Optional[Sequence[float]] = None,
@@ -296,17 +277,16 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
     ``out``: also write the folder the command line's ``analyze --out`` writes, by the same
     writer (``areas.csv``, ``summary.json``, ``area_vs_load.png``/``.svg``; ``overlays`` and
     ``save_masks`` as ``--overlays`` and ``--save-masks``), all or nothing; ``summary.json``
-    records ``command_line`` (a list of words, e.g. the equivalent command) and ``written``
-    lists the files. ``progress(pass, done, total)`` is called as the images are read
+    records ``command_line`` (a list of words, e.g. the equivalent command; by default the
+    interpreter and this call) and ``written`` lists the files. ``progress(pass, done, total)`` is called as the images are read
     (``"histogram"``) and measured (``"measure"``), from the threads doing the work.
     """
     if isinstance(series, Series) and pixel_size is None:
         pixel_size = series._pixel_size
-    forces = None if forces is None else [float(f) for f in forces]
+    forces = _opt_numbers(forces, "forces", "N")
     result = Results(_cs.analyze(_images(series), forces, pixel_size, method, radius, modulus,
                                  masks, None if out is None else os.fspath(out),
-                                 None if command_line is None else [str(w) for w in command_line],
-                                 bool(overlays), bool(save_masks), progress), table="rows")
+                                 _command_line(command_line, "analyze", out), bool(overlays), bool(save_masks), progress), table="rows")
     _warn(result)
     return result
 
@@ -320,8 +300,8 @@ def _image(image: Any) -> Any:
 
 def psf(beads: Any, pixel_size: Optional[PixelSize] = None,
         bead_diameter: Optional[float] = None, saturation_level: Optional[float] = None, *,
-        series: Optional[int] = None, channel: Optional[int] = None, z: Optional[int] = None,
-        t: Optional[int] = None, axes: Optional[Dict[str, int]] = None) -> Results:
+        series: Optional[int] = None, channel: Union[int, str, None] = None,
+        z: Optional[int] = None, t: Optional[int] = None, axes: Optional[Dict[str, int]] = None) -> Results:
     """The point-spread function from sub-resolution beads, the command line's ``psf``.
 
     ``beads``: a bead image or z stack as a file (TIFF: every page of ``channel``; CZI, ND2,
@@ -347,7 +327,7 @@ def psf(beads: Any, pixel_size: Optional[PixelSize] = None,
 
 def autocorrelation(images: Any, pixel_size: Optional[PixelSize] = None,
                     max_lag: Optional[float] = None, *, series: Optional[int] = None,
-                    channel: Optional[int] = None, z: Optional[int] = None,
+                    channel: Union[int, str, None] = None, z: Optional[int] = None,
                     t: Optional[int] = None, axes: Optional[Dict[str, int]] = None) -> Results:
     """Radially averaged intensity autocorrelation C(r), the command line's ``autocorr``.
 
@@ -378,7 +358,7 @@ def newton(reflection: Any, contact: Any, pixel_size: Optional[PixelSize] = None
            wavelength: Optional[float] = None, medium_index: Optional[float] = None,
            profiles: Optional[int] = None, phase: Optional[str] = None, *,
            contact_channel: Optional[int] = None, series: Optional[int] = None,
-           channel: Optional[int] = None, z: Optional[int] = None, t: Optional[int] = None,
+           channel: Union[int, str, None] = None, z: Optional[int] = None, t: Optional[int] = None,
            axes: Optional[Dict[str, int]] = None) -> Results:
     """The detection gap from Newton rings around the fluorescent contact, the command line's
     ``newton``.
@@ -411,7 +391,8 @@ def blur_and_resample(map: Any, pixel_size: PixelSize, fwhm: float,
     """A map (e.g. a simulated contact map, 1 = contact; pixel size in m) as the microscope sees
     it: Gaussian PSF blur of FWHM ``fwhm`` (m), then integrated over image pixels of
     ``image_pixel_size`` (m). A binary map's image sums to its area in image pixels."""
-    return _cs.blur_and_resample(_f64(map, 2, "map"), pixel_size, float(fwhm), image_pixel_size)
+    return _cs.blur_and_resample(_f64(map, 2, "map"), pixel_size, _number(fwhm, "fwhm", "m"),
+                                 image_pixel_size)
 
 
 def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Optional[PixelSize],
@@ -450,17 +431,17 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
     """
     if isinstance(micrographs, Series) and pixel_size is None:
         pixel_size = micrographs._pixel_size
-    forces = None if forces is None else [float(f) for f in forces]
+    forces = _opt_numbers(forces, "forces", "N")
     if isinstance(maps, (str, os.PathLike)):
         maps = os.fspath(maps)
     else:
         maps = _f64(maps, 3, "maps")
-    map_forces = None if map_forces is None else [float(f) for f in map_forces]
+    map_forces = _opt_numbers(map_forces, "map_forces", "N")
     result = Results(_cs.compare(_images(micrographs), forces, pixel_size, maps, map_forces,
-                                 map_pixel_size, float(psf_fwhm), dihedral, upsample,
-                                 force_tolerance, bool(images),
+                                 map_pixel_size, _number(psf_fwhm, "psf_fwhm", "m"), dihedral,
+                                 upsample, force_tolerance, bool(images),
                                  None if out is None else os.fspath(out),
-                                 None if command_line is None else [str(w) for w in command_line]),
+                                 _command_line(command_line, "compare", out)),
                      table="loads")
     _warn(result)
     return result
@@ -484,8 +465,9 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
     "mean" or "plane", the command line's default), ``pixel_size_m`` ((x, y), m), ``notes`` and
     ``summary``: the command line's ``topography --json`` in SI units, describing the file as
     stored (``file``, ``format``, ``channel``, ``nx``, ``ny``, ``pixel_size_m`` {``x``, ``y``},
-    ``valid_points``, ``height_min_m``, ``height_max_m``, ``height_mean_m``, ``h_rms_m``,
-    ``slope_rms``, ``curvature_rms`` (1/m)) and after detrending (``detrended``: ``detrend``,
+    ``valid_points``, ``height_min_m``, ``height_max_m``, ``height_mean_m``,
+    ``h_rms_as_stored_m``, ``h_prime_rms_as_stored``, ``h_double_prime_rms_as_stored_per_m``)
+    and after detrending (``detrended``: ``detrend``,
     ``pixel_size_x_m``, ``pixel_size_y_m``, ``h_rms_m``, ``h_prime_rms``,
     ``h_double_prime_rms_per_m``).
     """
@@ -559,7 +541,8 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
     """
     if not isinstance(heights, (str, os.PathLike)):
         heights = _f64(heights, 2, "heights")
-    result = Results(_cs.simulate(heights, pixel_size, float(modulus), [float(f) for f in loads],
+    result = Results(_cs.simulate(heights, pixel_size, _number(modulus, "modulus", "Pa"),
+                                  _numbers(loads, "loads", "N"),
                                   model, hardness, k, initial_hardness, alpha, radius, periodic,
                                   tolerance, max_iterations, maps, detrend, height_unit,
                                   channel, fill_invalid, device), table="loads")
@@ -584,15 +567,16 @@ def ramp(heights: Any, pixel_size: Optional[PixelSize], modulus: float, family: 
     of one load ramp (``loads`` in N, increasing) for ``family`` ("elastic", "gt", "hardness"
     with p_Y in Pa, "hardening" with k in Pa/m), on the body :func:`fit_hardening` builds from
     the same arguments and counted as it counts them; ``device`` as :func:`simulate`."""
-    return Results(_cs.ramp(_heights(heights), pixel_size, float(modulus), family, parameter,
-                            [float(f) for f in loads], radius, tolerance, max_iterations,
-                            imaging_fwhm, imaging_pixel_size, detrend, periodic, device))
+    return Results(_cs.ramp(_heights(heights), pixel_size, _number(modulus, "modulus", "Pa"),
+                            family, parameter, _numbers(loads, "loads", "N"), radius, tolerance,
+                            max_iterations, imaging_fwhm, imaging_pixel_size, detrend, periodic,
+                            device))
 
 
 def misfit(forces: Sequence[float], areas: Sequence[float], simulated: Sequence[float]) -> float:
     """RMS over the measured loads of ln(A_sim/A_exp) (forces in N, areas in m²)."""
-    return _cs.misfit([float(f) for f in forces], [float(a) for a in areas],
-                      [float(s) for s in simulated])
+    return _cs.misfit(_numbers(forces, "forces", "N"), _numbers(areas, "areas", "m²"),
+                      _numbers(simulated, "simulated", "m²"))
 
 
 class FitResults(Results):
@@ -687,10 +671,10 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
     else:
         if areas is None:
             raise InputError("areas (m²) are needed with forces (N)")
-        measured = ([float(f) for f in forces], [float(a) for a in areas])
+        measured = (_numbers(forces, "forces", "N"), _numbers(areas, "areas", "m²"))
     result = FitResults(_cs.fit_hardening(measured, _heights(heights), pixel_size,
-                                          float(modulus), radius, families, range, grid,
-                                          ln_tolerance, tolerance, max_iterations,
+                                          _number(modulus, "modulus", "Pa"), radius, families,
+                                          range, grid, ln_tolerance, tolerance, max_iterations,
                                           imaging_fwhm, imaging_pixel_size, detrend, periodic,
                                           height_unit, channel, fill_invalid, device))
     _warn(result)
@@ -721,10 +705,10 @@ def friction(traces: Union[PathLike, Sequence[PathLike]], normal_force: Optional
     if isinstance(traces, (str, os.PathLike)):
         traces = [traces]
     result = Results(_cs.friction([os.fspath(t) for t in traces],
-                                  None if normal_force is None else float(normal_force),
-                                  None if rotation_radius is None else float(rotation_radius),
+                                  _opt_number(normal_force, "normal_force", "N"),
+                                  _opt_number(rotation_radius, "rotation_radius", "m"),
                                   None if areas is None else os.fspath(areas),
-                                  None if force_tolerance is None else float(force_tolerance)),
+                                  _opt_number(force_tolerance, "force_tolerance", "N")),
                      table="traces")
     _warn(result)
     return result
@@ -747,8 +731,9 @@ def hertz(squeeze: PathLike, radius: float, loads: Optional[Sequence[float]] = N
     ``points``: the fitted points as ``hertz_fit.csv`` has them (``force_n``,
     ``displacement_m``, ``delta_m``, ``fitted_force_n``, ``residual_n``).
     """
-    loads = None if loads is None else [float(f) for f in loads]
-    return Results(_cs.hertz(os.fspath(squeeze), float(radius), loads), table="predicted")
+    loads = _opt_numbers(loads, "loads", "N")
+    radius = _number(radius, "radius", "m")
+    return Results(_cs.hertz(os.fspath(squeeze), radius, loads), table="predicted")
 
 
 def parse_forces(text: str) -> list:
@@ -785,7 +770,7 @@ def synth_series(width: Optional[int] = None, height: Optional[int] = None,
     (loads, rows, columns), ``forces_n`` (N), ``true_area_m2`` (m²), ``true_contact_pixels``
     and the true masks ``truth``; pixel size in m. Defaults: the bundled fixture (256 × 256
     pixels of 200 nm, 8 loads 4–100 mN, seed 2018)."""
-    forces = None if forces is None else [float(f) for f in forces]
+    forces = _opt_numbers(forces, "forces", "N")
     return Results(_cs.synth_series(width, height, pixel_size, forces, seed))
 
 

@@ -37,7 +37,7 @@ class SeriesSpec(TypedDict):
     inputs: List[str]
     manifest: Optional[str]
     series: Optional[int]
-    channel: Optional[int]
+    channel: Union[int, str, None]
     z: Optional[int]
     t: Optional[int]
     axes: Optional[Dict[str, int]]
@@ -169,7 +169,7 @@ def psf(
     bead_diameter: Optional[float] = None,
     saturation_level: Optional[float] = None,
     series: Optional[int] = None,
-    channel: Optional[int] = None,
+    channel: Union[int, str, None] = None,
     z: Optional[int] = None,
     t: Optional[int] = None,
     axes: Selection = None,
@@ -203,7 +203,7 @@ def autocorrelation(
     pixel_size: Optional[PixelSize] = None,
     max_lag: Optional[float] = None,
     series: Optional[int] = None,
-    channel: Optional[int] = None,
+    channel: Union[int, str, None] = None,
     z: Optional[int] = None,
     t: Optional[int] = None,
     axes: Selection = None,
@@ -293,7 +293,7 @@ def newton(
     phase: Optional[str] = None,
     contact_channel: Optional[int] = None,
     series: Optional[int] = None,
-    channel: Optional[int] = None,
+    channel: Union[int, str, None] = None,
     z: Optional[int] = None,
     t: Optional[int] = None,
     axes: Selection = None,
@@ -370,9 +370,9 @@ class TopographySummary(TypedDict, total=False):
     height_min_m: float
     height_max_m: float
     height_mean_m: float
-    h_rms_m: float
-    slope_rms: Optional[float]
-    curvature_rms: Optional[float]
+    h_rms_as_stored_m: float
+    h_prime_rms_as_stored: Optional[float]
+    h_double_prime_rms_as_stored_per_m: Optional[float]
     detrended: Optional[TopographyDetrended]
     note: str
 
@@ -630,6 +630,13 @@ class VoxelSize(TypedDict):
     y: Optional[float]
     z: Optional[float]
 
+class InfoChannel(TypedDict):
+    """One channel: its name (what ``channel=`` matches) and wavelengths (m)."""
+
+    name: Optional[str]
+    emission_m: Optional[float]
+    excitation_m: Optional[float]
+
 class InfoSeries(TypedDict, total=False):
     """One series (``planes`` only with ``stats=True``)."""
 
@@ -637,6 +644,7 @@ class InfoSeries(TypedDict, total=False):
     name: str
     axes: Dict[str, int]
     dtype: str
+    channels: List[InfoChannel]
     pixel_size_m: VoxelSize
     pixel_size_source: Optional[str]
     planes: List[Dict[str, Any]]

@@ -480,6 +480,11 @@ def _parameter_column(family: str) -> Tuple[Optional[str], float]:
     return None, 1.0
 
 
+# The SI name of each lab-unit column of sweep.csv: to_pandas() has the same columns, in SI.
+_SI_COLUMNS = {"k_MPa_per_nm": "k_pa_per_m", "hardness_MPa": "hardness_pa",
+               "force_mN": "force_n", "area_um2": "area_m2"}
+
+
 def _check_device(device: str) -> None:
     if device not in ("cpu", "cuda", "auto"):
         raise _cs.InputError(f"device '{device}' is not one of cpu, cuda, auto")
@@ -522,15 +527,22 @@ def _write_sweep(out: Any, results: "_SweepResults", modulus: float,
 
 class _SweepResults(Results):
     def to_pandas(self):
+        """One row per ramp and load with the columns of ``sweep.csv`` in SI units (``model``,
+        ``k_pa_per_m`` or ``hardness_pa`` where ``sweep.csv`` has ``k_MPa_per_nm`` or
+        ``hardness_MPa``, ``force_n``, ``area_m2``, ``edge_contact``, ``error``)."""
         import pandas as pd
 
         records = []
         for r in self["rows"]:
+            name, _ = _parameter_column(r["family"])
             areas = r["areas_m2"] if r["areas_m2"] is not None else [math.nan] * len(r["loads_n"])
             for f, a in zip(r["loads_n"], areas):
-                records.append({"surface": r["surface"], "seed": r["seed"], "family": r["family"],
-                                "parameter": r["parameter"], "force_n": f, "area_m2": a,
-                                "edge_contact": r["edge_contact"], "error": r["error"]})
+                record = {"surface": r["surface"], "seed": r["seed"], "model": r["family"]}
+                if name is not None:
+                    record[_SI_COLUMNS[name]] = r["parameter"]
+                record.update({"force_n": f, "area_m2": a, "edge_contact": r["edge_contact"],
+                               "error": r["error"]})
+                records.append(record)
         return pd.DataFrame(records)
 
 

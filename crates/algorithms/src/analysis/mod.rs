@@ -255,7 +255,7 @@ fn choose_thresholds<S: PlaneSource + ?Sized>(
     }
     let pixels = pooled.total();
     let series_threshold = match method {
-        Method::GlobalOtsu => Some(Threshold::otsu(&pooled, "the series")?),
+        Method::GlobalOtsu => Some(Threshold::otsu(&pooled, &series_label(source))?),
         Method::Manual(t) => Some(Threshold::manual(t, &empty_samples(source.sample_type()))),
         Method::PerImageOtsu => None,
     };
@@ -264,6 +264,19 @@ fn choose_thresholds<S: PlaneSource + ?Sized>(
         .map(|(own, _)| own.or(series_threshold).expect("one of the two is set"))
         .collect();
     Ok((thresholds, series_threshold, pixels))
+}
+
+/// The series in messages: its one image's label, or "the series of N images (LABEL … LABEL)".
+fn series_label<S: PlaneSource + ?Sized>(source: &S) -> String {
+    match source.len() {
+        0 => "the series".into(),
+        1 => source.label(0),
+        n => format!(
+            "the series of {n} images ({} … {})",
+            source.label(0),
+            source.label(n - 1)
+        ),
+    }
 }
 
 fn float_series_histogram<S: PlaneSource + ?Sized>(
@@ -279,7 +292,7 @@ fn float_series_histogram<S: PlaneSource + ?Sized>(
         });
     if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return Err(Error::ConstantData {
-            what: "the series".into(),
+            what: series_label(source),
             value: if lo.is_finite() { lo } else { f64::NAN },
         });
     }

@@ -202,6 +202,30 @@ pub fn isotropic_blur(data: &[f64], width: usize, height: usize, sigma_px: f64) 
     gaussian_blur(data, width, height, (sigma_px, sigma_px), Edges::Mirror)
 }
 
+/// Check, before anything is allocated, that resampling a `width × height` grid of `from`
+/// pixels (x, y, m) onto `to` pixels gives a plane within the limits (each side, and the plane
+/// as a whole: each side alone may pass while their product does not).
+pub fn check_resample(
+    (width, height): (usize, usize),
+    from: (f64, f64),
+    to: (f64, f64),
+) -> Result<()> {
+    let limit = |source| Error::Limit {
+        what: "resampling".into(),
+        source,
+    };
+    let nx = Limits::DEFAULT
+        .samples(width as f64 * from.0, to.0)
+        .map_err(limit)?;
+    let ny = Limits::DEFAULT
+        .samples(height as f64 * from.1, to.1)
+        .map_err(limit)?;
+    Limits::DEFAULT
+        .plane_bytes(nx.max(1), ny.max(1), 8)
+        .map_err(limit)?;
+    Ok(())
+}
+
 /// Area-fraction resampling of `grid` onto pixels of `dx_m × dy_m` whose first pixel starts at
 /// the grid's corner: each output value is the area-weighted mean of the input over the output
 /// pixel (the covered fraction for a binary map). Conserves [`Grid::integral`] exactly.
@@ -211,17 +235,11 @@ pub fn resample_area(grid: &Grid, dx_m: f64, dy_m: f64) -> Result<Grid> {
             "target pixel size {dx_m:e} × {dy_m:e} m is not positive"
         )));
     }
-    for (n, d_in, d_out) in [
-        (grid.width, grid.dx_m, dx_m),
-        (grid.height, grid.dy_m, dy_m),
-    ] {
-        Limits::DEFAULT
-            .samples(n as f64 * d_in, d_out)
-            .map_err(|source| Error::Limit {
-                what: "resampling".into(),
-                source,
-            })?;
-    }
+    check_resample(
+        (grid.width, grid.height),
+        (grid.dx_m, grid.dy_m),
+        (dx_m, dy_m),
+    )?;
     let wx = overlap_weights(grid.width, grid.dx_m, dx_m);
     let wy = overlap_weights(grid.height, grid.dy_m, dy_m);
     let (out_w, out_h) = (wx.len(), wy.len());
@@ -330,6 +348,16 @@ impl IntensityScale {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_resampled_plane_beyond_the_limits_is_refused_though_each_side_passes() {
+        // 50,000 × 50,000 output pixels: each side within 65,536, the plane 18.6 GiB.
+        let e = check_resample((500, 500), (1e-7, 1e-7), (1e-9, 1e-9))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("resampling"), "{e}");
+        assert!(check_resample((500, 500), (1e-7, 1e-7), (2e-7, 2e-7)).is_ok());
+    }
 
     fn disk(n: usize, radius_px: f64, centre: (f64, f64)) -> Vec<f64> {
         (0..n * n)

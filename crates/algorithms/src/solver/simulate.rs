@@ -172,6 +172,21 @@ pub fn sweep_each(
 }
 
 fn check_setup(setup: &Setup) -> Result<()> {
+    // Every array of the solver holds at most one f64 per point of its FFT grid: the map itself
+    // when periodic, the map padded to twice its size along each axis on a free boundary
+    // (Hockney's zero padding). Checked before any is allocated.
+    let (nx, ny) = (setup.topography.nx(), setup.topography.ny());
+    let (gx, gy, what) = match setup.boundary {
+        Boundary::Free => (
+            nx.saturating_mul(2),
+            ny.saturating_mul(2),
+            format!("the solver's grid (a free boundary pads the {nx}×{ny} map to twice its size)"),
+        ),
+        Boundary::Periodic => (nx, ny, format!("the solver's grid ({nx}×{ny}, periodic)")),
+    };
+    crate::limits::Limits::DEFAULT
+        .plane_bytes(gx, gy, 8)
+        .map_err(|source| Error::Limit { what, source })?;
     let positive = |v: f64| v.is_finite() && v > 0.0;
     if !positive(setup.e_star_pa) {
         return Err(Error::not_positive(
@@ -500,6 +515,26 @@ fn describe(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_grid_beyond_the_limits_is_refused_before_the_solver_allocates() {
+        // 40,000 × 2 points: a free boundary pads the x side to 80,000 > 65,536; periodic fits.
+        let heights = ndarray::Array2::zeros((2, 40_000));
+        let topo = Topography::new(heights, 1e-7, 1e-7).unwrap();
+        let setup = |boundary| Setup {
+            topography: &topo,
+            e_star_pa: 1e9,
+            boundary,
+            model: Model::Elastic,
+            options: SolverOptions::default(),
+        };
+        let e = check_setup(&setup(Boundary::Free)).unwrap_err().to_string();
+        assert!(
+            e.contains("the solver's grid (a free boundary pads the 40000×2 map"),
+            "{e}"
+        );
+        assert!(check_setup(&setup(Boundary::Periodic)).is_ok());
+    }
 
     #[test]
     fn conserving_increment_sums_to_zero() {

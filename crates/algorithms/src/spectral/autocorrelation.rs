@@ -50,6 +50,15 @@ pub fn autocorrelation(values: &[f64], width: usize, height: usize) -> Result<Au
             values.len()
         )));
     }
+    // The zero-padded FFT grid (2h × 2w), the largest array, before any is allocated.
+    crate::limits::Limits::DEFAULT
+        .plane_bytes(width.saturating_mul(2), height.saturating_mul(2), 8)
+        .map_err(|source| Error::Limit {
+            what: format!(
+                "the autocorrelation of a {width}×{height} image (padded to twice its size)"
+            ),
+            source,
+        })?;
     let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     if finite.len() < 2 {
         return Err(Error::InvalidArgument(
@@ -208,6 +217,14 @@ impl AcfCurve {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_image_whose_padded_grid_is_beyond_the_limits_is_refused() {
+        let e = autocorrelation(&vec![1.0; 40_000 * 2], 40_000, 2)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("autocorrelation of a 40000×2 image"), "{e}");
+    }
     use rand::{Rng, SeedableRng};
 
     #[test]

@@ -150,6 +150,16 @@ fn check(p: &BeadParams) -> Result<()> {
         && p.background >= 0.0
         && p.rayleigh_planes > 0.0;
     if ok {
+        // One f64 working plane, and the stack of 16-bit planes kept.
+        let limits = crate::limits::Limits::DEFAULT;
+        let limit = |source| Error::Limit {
+            what: "synthetic beads".into(),
+            source,
+        };
+        limits.plane_bytes(p.width, p.height, 8).map_err(limit)?;
+        limits
+            .plane_bytes(p.width, p.height, p.planes.saturating_mul(2))
+            .map_err(limit)?;
         Ok(())
     } else {
         Err(Error::InvalidArgument(format!(

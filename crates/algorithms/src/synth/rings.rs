@@ -176,6 +176,14 @@ fn check(p: &NewtonSynthParams) -> Result<()> {
             "synthetic Newton rings need at least 8×8 pixels and positive lengths and index".into(),
         ));
     }
+    let limits = crate::limits::Limits::DEFAULT;
+    let limit = |source| Error::Limit {
+        what: "synthetic Newton rings".into(),
+        source,
+    };
+    limits.plane_bytes(p.width, p.height, 8).map_err(limit)?;
+    let sigma_px = p.psf_fwhm_m / (8.0 * 2f64.ln()).sqrt() / p.pixel_size_m;
+    limits.kernel_radius(sigma_px).map_err(limit)?;
     Ok(())
 }
 

@@ -94,6 +94,34 @@ pub struct SynthImage {
 }
 
 impl SynthParams {
+    /// The working planes of one image (f64) and the series kept in memory (a 16-bit image and
+    /// a truth mask per force) against the limits, before any is allocated.
+    fn check_memory(&self) -> Result<()> {
+        let limits = crate::limits::Limits::DEFAULT;
+        limits
+            .plane_bytes(self.width, self.height, 8)
+            .map_err(|source| Error::Limit {
+                what: "a synthetic image".into(),
+                source,
+            })?;
+        let total = (self.width * self.height).checked_mul(3 * self.forces_n.len());
+        match total {
+            Some(bytes) if bytes <= limits.max_plane_bytes => Ok(()),
+            _ => Err(Error::InvalidArgument(format!(
+                "{} images of {}×{} px would hold {:.1} GiB in memory (the limit is {} GiB); \
+                 give fewer forces ({}) or a smaller size ({})",
+                self.forces_n.len(),
+                self.width,
+                self.height,
+                (self.width * self.height) as f64 * 3.0 * self.forces_n.len() as f64
+                    / (1u64 << 30) as f64,
+                limits.max_plane_bytes >> 30,
+                contactscope_formats::param::Param::Forces,
+                contactscope_formats::param::Param::Size
+            ))),
+        }
+    }
+
     fn check(&self) -> Result<()> {
         let ok = self.width >= 8
             && self.height >= 8
@@ -105,6 +133,7 @@ impl SynthParams {
             && !self.forces_n.is_empty()
             && self.forces_n.iter().all(|f| f.is_finite() && *f > 0.0);
         if ok {
+            self.check_memory()?;
             // The widest blur: the coarse roughness (1.5 µm) or the PSF, in pixels.
             let widest = (1.5e-6f64).max(self.psf_fwhm_m / 2.3548) / self.pixel_size_m;
             crate::limits::Limits::DEFAULT

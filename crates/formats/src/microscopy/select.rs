@@ -3,22 +3,26 @@
 //! (`--load-axis t|z|series`) along which one file holds a whole load series (`docs/formats.md`).
 //!
 //! Rules ([`Selection::planes`]): an axis of length 1 defaults to 0; an axis longer than 1 must
-//! be selected unless it is the load axis, otherwise the error names the axis, its length and
-//! the flag ("FILE: 3 channels; choose one with --channel 0..2"). Extra axes (Airyscan phases
+//! be selected unless it is the load axis, otherwise one error names every such axis, its length
+//! and its flag ("FILE: 2 channels and 10 z planes; choose one of each with --channel 0..1 or a
+//! name (0 'TL', 1 'AF488') and --z 0..9"). A channel is chosen by index or by the name the
+//! file's metadata gives it ([`ChannelChoice`], case-insensitive). Extra axes (Airyscan phases
 //! `H`, colour samples `S`, spectral sweeps, …) are chosen by name (`--axis H=0`,
-//! [`Selection::extra`]); one longer than 1 and not chosen is refused the same way, naming it
-//! (`info` lists them).
+//! [`Selection::extra`]); one longer than 1 and not chosen is named in the same error (`info`
+//! lists them).
 //!
 //! TIFF files keep their own model (every page of the chosen channel is one image, see
 //! `contactscope_jobs::series`): on a TIFF only `--channel` applies, and a non-zero `--series`, `--z`
 //! or `--t` is refused.
 
 use std::collections::BTreeMap;
+use std::fmt;
 use std::path::{Path, PathBuf};
+use std::str::FromStr;
 
 use serde::Serialize;
 
-use super::{MicroscopyFile, MicroscopyFormat, PlaneIndex, SeriesInfo};
+use super::{ChannelInfo, MicroscopyFile, MicroscopyFormat, PlaneIndex, SeriesInfo};
 use crate::error::{Error, Location, Result};
 use crate::image::{pixel_size_or, Image, PixelSize, PixelSizeSource};
 use crate::param::Param;
@@ -28,14 +32,143 @@ use crate::param::Param;
 pub struct Selection {
     /// `--series`: CZI scene, LIF image (ND2 and TIFF have one series).
     pub series: Option<usize>,
-    /// `--channel`.
-    pub channel: Option<usize>,
+    /// `--channel`: an index or a name.
+    pub channel: Option<ChannelChoice>,
     /// `--z`: focal plane.
     pub z: Option<usize>,
     /// `--t`: time point.
     pub t: Option<usize>,
     /// `--axis NAME=INDEX`: indices along extra axes (`H`, `S`, `lambda_emission`, …).
     pub extra: BTreeMap<String, usize>,
+}
+
+/// `--channel`: an index, or a channel's name as the file's metadata gives it (`AF488`, `TL
+/// Brightfield`; compared without regard to case).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(untagged)]
+pub enum ChannelChoice {
+    /// Zero-based index.
+    Index(usize),
+    /// Name.
+    Name(String),
+}
+
+impl FromStr for ChannelChoice {
+    type Err = String;
+
+    /// Digits are an index, anything else a name.
+    fn from_str(text: &str) -> std::result::Result<Self, String> {
+        let t = text.trim();
+        if t.is_empty() {
+            return Err("the channel is empty: give an index (0, 1, …) or a name".into());
+        }
+        if t.parse::<i64>().is_ok_and(|i| i < 0) {
+            return Err(format!("channel index {t} is negative"));
+        }
+        if t.bytes().all(|b| b.is_ascii_digit()) {
+            return t
+                .parse()
+                .map(ChannelChoice::Index)
+                .map_err(|_| format!("channel index {t} is too large"));
+        }
+        Ok(ChannelChoice::Name(t.to_string()))
+    }
+}
+
+impl fmt::Display for ChannelChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ChannelChoice::Index(i) => write!(f, "{i}"),
+            ChannelChoice::Name(n) => write!(f, "{n:?}"),
+        }
+    }
+}
+
+impl From<usize> for ChannelChoice {
+    fn from(i: usize) -> Self {
+        ChannelChoice::Index(i)
+    }
+}
+
+impl ChannelChoice {
+    /// The index this choice names among `channels` (names compared without regard to case).
+    pub fn resolve(&self, path: &Path, channels: &[ChannelInfo]) -> Result<usize> {
+        match self {
+            ChannelChoice::Index(i) => Ok(*i),
+            ChannelChoice::Name(name) => {
+                let found = channels.iter().position(|c| {
+                    c.name
+                        .as_deref()
+                        .is_some_and(|n| n.trim().eq_ignore_ascii_case(name))
+                });
+                found.ok_or_else(|| {
+                    let listed = channel_names(channels);
+                    Error::bad_input(
+                        Location::file(path),
+                        match listed {
+                            Some(names) => format!(
+                                "{}: no channel has that name; the channels are {names}",
+                                Param::Channel.with_value(name)
+                            ),
+                            None => format!(
+                                "{}: the file's {} channel(s) have no names; choose by index (0..{})",
+                                Param::Channel.with_value(name),
+                                channels.len(),
+                                channels.len().saturating_sub(1)
+                            ),
+                        },
+                    )
+                })
+            }
+        }
+    }
+
+    /// The index of a choice on a file whose channels have no names (TIFF): a name is refused.
+    pub fn index_only(&self, path: &Path) -> Result<usize> {
+        match self {
+            ChannelChoice::Index(i) => Ok(*i),
+            ChannelChoice::Name(name) => Err(Error::bad_input(
+                Location::file(path),
+                format!(
+                    "{}: a TIFF's channels are chosen by index (0, 1, …); names are read from CZI, ND2 and LIF files",
+                    Param::Channel.with_value(name)
+                ),
+            )),
+        }
+    }
+}
+
+/// `0 'TL', 1 'AF488'` (at most eight, then a count), or `None` when no channel has a name.
+fn channel_names(channels: &[ChannelInfo]) -> Option<String> {
+    if channels
+        .iter()
+        .all(|c| c.name.as_deref().is_none_or(|n| n.trim().is_empty()))
+    {
+        return None;
+    }
+    Some(listing(channels.iter().map(|c| c.name.as_deref())))
+}
+
+/// `0 'a', 1 'b', 2` for labelled items (at most eight, names cut at 40 characters).
+fn listing<'a>(names: impl ExactSizeIterator<Item = Option<&'a str>>) -> String {
+    let n = names.len();
+    let mut parts: Vec<String> = names
+        .take(8)
+        .enumerate()
+        .map(
+            |(i, name)| match name.map(str::trim).filter(|t| !t.is_empty()) {
+                Some(t) if t.chars().count() > 40 => {
+                    format!("{i} '{}…'", t.chars().take(40).collect::<String>())
+                }
+                Some(t) => format!("{i} '{t}'"),
+                None => i.to_string(),
+            },
+        )
+        .collect();
+    if n > 8 {
+        parts.push(format!("… ({} more)", n - 8));
+    }
+    parts.join(", ")
 }
 
 /// The axis along which one file holds the loads of a series, in order.
@@ -88,12 +221,20 @@ impl SelectedPlane {
 }
 
 impl Selection {
-    /// Only a channel (the older `--channel` of TIFF commands).
+    /// Only a channel index (the older `--channel` of TIFF commands).
     pub fn channel(channel: Option<usize>) -> Self {
         Selection {
-            channel,
+            channel: channel.map(ChannelChoice::Index),
             ..Selection::default()
         }
+    }
+
+    /// The channel index on a TIFF (whose channels have no names).
+    pub fn tiff_channel(&self, path: &Path) -> Result<Option<usize>> {
+        self.channel
+            .as_ref()
+            .map(|c| c.index_only(path))
+            .transpose()
     }
 
     /// Refuse flags that do not apply to a TIFF file (a non-zero series, z or t).
@@ -129,6 +270,9 @@ impl Selection {
         if n_series == 0 {
             return Err(bad("the file holds no image series".into()));
         }
+        if let Some(reason) = self.unchosen(file, along) {
+            return Err(bad(reason));
+        }
         let series: Vec<usize> = if along == Some(LoadAxis::Series) {
             if self.series.is_some() {
                 return Err(Error::InvalidArgument(format!(
@@ -150,7 +294,11 @@ impl Selection {
                 1 => axis.to_string(),
                 _ => format!("{axis} in series {s}"),
             };
-            let c = pick(path, &what("channels"), Param::Channel, self.channel, a.c)?;
+            let channel = match &self.channel {
+                Some(choice) => Some(choice.resolve(path, &info.channels)?),
+                None => None,
+            };
+            let c = pick(path, &what("channels"), Param::Channel, channel, a.c)?;
             let zs = along_or_pick(
                 path,
                 &what("z planes"),
@@ -188,6 +336,90 @@ impl Selection {
             }
         }
         Ok(out)
+    }
+}
+
+impl Selection {
+    /// Every axis longer than 1 that is neither chosen nor the load axis, in one message
+    /// (`None` when there is none): the series, then the channels (with their names), z, t and
+    /// the extra axes of the chosen series (series 0 when the series is not chosen either).
+    fn unchosen(&self, file: &MicroscopyFile, along: Option<LoadAxis>) -> Option<String> {
+        let n_series = file.series.len();
+        // (what, flag and values)
+        let mut items: Vec<(String, String)> = Vec::new();
+        if n_series > 1 && self.series.is_none() && along != Some(LoadAxis::Series) {
+            let names = listing(file.series.iter().map(|s| Some(s.name.as_str())));
+            let names = if file.series.iter().any(|s| !s.name.trim().is_empty()) {
+                format!(" ({names})")
+            } else {
+                String::new()
+            };
+            items.push((
+                format!("{n_series} series"),
+                format!(
+                    "{}{names}",
+                    Param::Series.with_value(format!("0..{}", n_series - 1))
+                ),
+            ));
+        }
+        let index = self.series.filter(|s| *s < n_series).unwrap_or(0);
+        let info = file.series.get(index)?;
+        let a = &info.axes;
+        let of = if n_series > 1 && self.series.is_none() {
+            format!(" in series {index}")
+        } else {
+            String::new()
+        };
+        if a.c > 1 && self.channel.is_none() {
+            let flag = Param::Channel.with_value(format!("0..{}", a.c - 1));
+            let flag = match channel_names(&info.channels) {
+                Some(names) => format!("{flag} or a name ({names})"),
+                None => flag,
+            };
+            items.push((format!("{} channels{of}", a.c), flag));
+        }
+        for (n, chosen, axis, what, flag) in [
+            (a.z, self.z, LoadAxis::Z, "z planes", Param::Z),
+            (a.t, self.t, LoadAxis::T, "time points", Param::T),
+        ] {
+            if n > 1 && chosen.is_none() && along != Some(axis) {
+                items.push((
+                    format!("{n} {what}{of}"),
+                    flag.with_value(format!("0..{}", n - 1)),
+                ));
+            }
+        }
+        for (axis, &n) in &info.axes.extra {
+            if n > 1 && !self.extra.contains_key(axis) {
+                let meaning = axis_meaning(axis);
+                items.push((
+                    format!("{n} planes along axis {axis}{meaning}{of}"),
+                    Param::axis_value(axis, format!("0..{}", n - 1)),
+                ));
+            }
+        }
+        let and = |parts: Vec<&str>| match parts.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            Some((last, _)) => last.to_string(),
+            None => String::new(),
+        };
+        let whats = and(items.iter().map(|(w, _)| w.as_str()).collect());
+        let flags = and(items.iter().map(|(_, f)| f.as_str()).collect());
+        match items.len() {
+            0 => None,
+            1 => Some(format!("{whats}; choose one with {flags}")),
+            _ => Some(format!("{whats}; choose one of each with {flags}")),
+        }
+    }
+}
+
+/// What an extra axis holds, for messages (` (Airyscan detector phases)`), or nothing.
+fn axis_meaning(axis: &str) -> &'static str {
+    match axis {
+        "H" => " (Airyscan detector phases)",
+        "S" => " (colour samples of an RGB pixel: 0 blue, 1 green, 2 red)",
+        "P" => " (stage positions)",
+        _ => "",
     }
 }
 
@@ -238,12 +470,7 @@ impl Selection {
         let bad = |reason: String| Error::bad_input(Location::file(path), reason);
         let mut out = BTreeMap::new();
         for (axis, &n) in &info.axes.extra {
-            let meaning = match axis.as_str() {
-                "H" => " (Airyscan detector phases)",
-                "S" => " (colour samples of an RGB pixel: 0 blue, 1 green, 2 red)",
-                "P" => " (stage positions)",
-                _ => "",
-            };
+            let meaning = axis_meaning(axis);
             match self.extra.get(axis) {
                 Some(&i) if i < n => {
                     out.insert(axis.clone(), i);
@@ -323,7 +550,7 @@ pub fn read_images(
 ) -> Result<Vec<Image>> {
     if is_tiff(path) {
         selection.check_tiff(path)?;
-        return crate::tiff::read_pages(path, selection.channel, pixel_size_m);
+        return crate::tiff::read_pages(path, selection.tiff_channel(path)?, pixel_size_m);
     }
     let mut file = MicroscopyFile::open(path)?;
     let planes = selection.planes(&file, along)?;
@@ -354,7 +581,7 @@ pub fn read_one_image(
 ) -> Result<Image> {
     if is_tiff(path) {
         selection.check_tiff(path)?;
-        return crate::tiff::read_image(path, selection.channel, pixel_size_m);
+        return crate::tiff::read_image(path, selection.tiff_channel(path)?, pixel_size_m);
     }
     let mut images = read_images(path, selection, None, pixel_size_m)?;
     Ok(images.remove(0))

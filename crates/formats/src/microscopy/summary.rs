@@ -47,6 +47,9 @@ pub struct SeriesSummary {
     pub axes: Axes,
     /// Sample type (`uint8`, `uint16`, `int16`, `float32`).
     pub dtype: String,
+    /// One entry per channel: its name (`null` where the file gives none), by which
+    /// `--channel` can choose it.
+    pub channels: Vec<ChannelSummary>,
     /// Voxel size in µm, `null` where the file does not state it.
     pub pixel_size_um: PixelSizeUm,
     /// The metadata element the x/y size came from (`null` when absent).
@@ -61,6 +64,17 @@ pub struct SeriesSummary {
     /// Per-plane statistics, with `--stats` only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub planes: Option<Vec<PlaneStats>>,
+}
+
+/// One channel of [`SeriesSummary`].
+#[derive(Debug, Clone, Serialize)]
+pub struct ChannelSummary {
+    /// Name as the acquisition software wrote it.
+    pub name: Option<String>,
+    /// Emission wavelength, m.
+    pub emission_m: Option<f64>,
+    /// Excitation wavelength, m.
+    pub excitation_m: Option<f64>,
 }
 
 /// Voxel size in µm.
@@ -153,8 +167,12 @@ pub fn info_summary_selected(
             continue;
         }
         let a = &info.axes;
+        let channel = match &selection.channel {
+            Some(choice) => Some(choice.resolve(path, &info.channels)?),
+            None => None,
+        };
         for (flag, value, n) in [
-            (Param::Channel, selection.channel, a.c),
+            (Param::Channel, channel, a.c),
             (Param::Z, selection.z, a.z),
             (Param::T, selection.t, a.t),
         ] {
@@ -170,7 +188,7 @@ pub fn info_summary_selected(
             }
         }
         let wanted = |i: &PlaneIndex| {
-            selection.channel.is_none_or(|c| c == i.c)
+            channel.is_none_or(|c| c == i.c)
                 && selection.z.is_none_or(|z| z == i.z)
                 && selection.t.is_none_or(|t| t == i.t)
                 && selection.extra.iter().all(|(a, &k)| i.get(a) == k)
@@ -198,6 +216,15 @@ pub fn info_summary_selected(
             name: info.name.clone(),
             axes: info.axes.clone(),
             dtype: info.dtype.name().to_string(),
+            channels: info
+                .channels
+                .iter()
+                .map(|c| ChannelSummary {
+                    name: c.name.clone(),
+                    emission_m: c.emission_wavelength_m,
+                    excitation_m: c.excitation_wavelength_m,
+                })
+                .collect(),
             pixel_size_um: PixelSizeUm {
                 x: um(info.pixel_size.x_m),
                 y: um(info.pixel_size.y_m),

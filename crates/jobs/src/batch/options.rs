@@ -18,7 +18,7 @@ use contactscope::solver::gpu::DeviceChoice;
 use contactscope::surface::fill::FillInvalid;
 use contactscope::surface::Detrend;
 use contactscope::threshold::Method;
-use contactscope_formats::microscopy::select::{LoadAxis, Selection};
+use contactscope_formats::microscopy::select::{ChannelChoice, LoadAxis, Selection};
 use contactscope_formats::ranges::Quantity;
 use contactscope_formats::units::{self, Dimension};
 
@@ -190,7 +190,8 @@ impl Opt {
         };
         Ok(match self {
             Opt::Forces => json!(units::parse_forces(text).map_err(|e| err(&e))?),
-            Opt::Series | Opt::Channel | Opt::Z | Opt::T => index(text)?,
+            Opt::Series | Opt::Z | Opt::T => index(text)?,
+            Opt::Channel => json!(text.parse::<ChannelChoice>()?),
             Opt::Axis => json!(parse_axes(text)?),
             Opt::LoadAxis => json!(load_axis(text)?.name()),
             Opt::Threshold => match Method::parse(text).map_err(|e| err(&e))? {
@@ -400,7 +401,7 @@ impl SeriesOptions {
         };
         let selection = Selection {
             series: index(Opt::Series),
-            channel: index(Opt::Channel),
+            channel: self.get(Opt::Channel).and_then(|t| t.parse().ok()),
             z: index(Opt::Z),
             t: index(Opt::T),
             extra: self

@@ -108,11 +108,7 @@ impl Sheet {
             Error::bad_input(at(), "not UTF-8 text (save the samplesheet as CSV UTF-8)")
         })?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let first_line = text.lines().find(|l| !l.trim_start().starts_with('#'));
-        let delimiter = match first_line {
-            Some(l) if l.contains(';') && !l.contains(',') => b';',
-            _ => b',',
-        };
+        let delimiter = crate::table::sniff_delimiter(text);
         let mut reader = csv::ReaderBuilder::new()
             .delimiter(delimiter)
             .trim(csv::Trim::All)

@@ -87,6 +87,14 @@ impl BodyRequest {
     /// The model body, with notes on the heights.
     pub fn build(&self, progress: Option<ProgressHook>) -> Result<(ModelBody, Vec<String>)> {
         let (topography, notes) = self.heights.read_with_notes()?;
+        if let Some(i) = self.imaging {
+            // The micrograph each simulated map becomes, checked before any load is solved.
+            contactscope::optics::blur::check_resample(
+                (topography.nx(), topography.ny()),
+                (topography.dx_m, topography.dy_m),
+                i.pixel_m,
+            )?;
+        }
         let options = SolverOptions {
             tolerance: self.tolerance,
             max_iterations: self.max_iterations,

@@ -12,7 +12,7 @@ use serde::{Serialize, Serializer};
 
 use contactscope_formats::microscopy::select::Selection;
 use contactscope_formats::microscopy::summary::{
-    info_summary_selected, InfoSummary, SeriesSummary,
+    info_summary_selected, ChannelSummary, InfoSummary, SeriesSummary,
 };
 use contactscope_formats::tiff::{TiffInfo, TiffReader};
 
@@ -72,6 +72,20 @@ impl Serialize for VoxelJson<'_> {
     }
 }
 
+/// One channel: its name (what `--channel NAME` matches) and wavelengths in nm (SI: m).
+struct ChannelJson<'a>(&'a ChannelSummary);
+
+impl Serialize for ChannelJson<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        let c = self.0;
+        let mut m = s.serialize_map(Some(3))?;
+        m.serialize_entry("name", &c.name)?;
+        m.serialize_entry("emission_nm", &OptQ(c.emission_m, Unit::MAsNm))?;
+        m.serialize_entry("excitation_nm", &OptQ(c.excitation_m, Unit::MAsNm))?;
+        m.end()
+    }
+}
+
 impl Serialize for SeriesJson<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
         let series = self.0;
@@ -80,6 +94,8 @@ impl Serialize for SeriesJson<'_> {
         m.serialize_entry("name", &series.name)?;
         m.serialize_entry("axes", &series.axes)?;
         m.serialize_entry("dtype", &series.dtype)?;
+        let channels: Vec<ChannelJson<'_>> = series.channels.iter().map(ChannelJson).collect();
+        m.serialize_entry("channels", &channels)?;
         m.serialize_entry("pixel_size_um", &VoxelJson(series))?;
         m.serialize_entry("pixel_size_source", &series.pixel_size_source)?;
         if !series.rows.is_y() {

@@ -12,7 +12,7 @@ pub mod files;
 use serde::Serialize;
 
 use contactscope::optics::newton::{analyse, ring_gap, NewtonAnalysis, NewtonOptions};
-use contactscope_formats::microscopy::select::Selection;
+use contactscope_formats::microscopy::select::{ChannelChoice, Selection};
 use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
 
@@ -88,7 +88,10 @@ impl NewtonRequest {
     /// The selection of the fluorescence image: the reflection's, with the contact channel.
     fn fluorescence_selection(&self) -> Selection {
         Selection {
-            channel: self.contact_channel.or(self.selection.channel),
+            channel: self
+                .contact_channel
+                .map(ChannelChoice::Index)
+                .or_else(|| self.selection.channel.clone()),
             ..self.selection.clone()
         }
     }

@@ -38,7 +38,7 @@ pub use pixel::{
 use crate::error::{Error, Location, Result};
 use contactscope::analysis::PlaneSource;
 use contactscope::image::{Plane, SampleType};
-use contactscope_formats::microscopy::select::{LoadAxis, SelectedPlane, Selection};
+use contactscope_formats::microscopy::select::{ChannelChoice, LoadAxis, SelectedPlane, Selection};
 use contactscope_formats::microscopy::MicroscopyFile;
 use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
@@ -267,7 +267,7 @@ impl FileTable {
         let file = if contactscope_formats::microscopy::select::is_tiff(path) {
             self.selection.check_tiff(path)?;
             let info = TiffReader::open(path)?.info().clone();
-            tiff_channel(&info, self.selection.channel)?;
+            tiff_channel(&info, self.selection.tiff_channel(path)?)?;
             SeriesFile::from_tiff(info)
         } else {
             SeriesFile::from_vendor(path, &self.selection, self.load_axis)?
@@ -278,8 +278,18 @@ impl FileTable {
         Ok(self.files.last().expect("just pushed"))
     }
 
+    /// The channel index read: the chosen index; for a channel chosen by name (CZI, ND2, LIF
+    /// only: a TIFF refuses names in [`FileTable::get`]) the index it named in the first file.
     fn channel(&self) -> usize {
-        self.selection.channel.unwrap_or(0)
+        match &self.selection.channel {
+            None => 0,
+            Some(ChannelChoice::Index(i)) => *i,
+            Some(ChannelChoice::Name(_)) => self
+                .files
+                .iter()
+                .find_map(|f| f.planes.first().map(|p| p.index.c))
+                .unwrap_or(0),
+        }
     }
 
     fn into_series(self, images: Vec<ImageRef>, manifest: Option<PathBuf>) -> Series {
@@ -364,6 +374,7 @@ fn manifest_number(
     column: Option<usize>,
     name: &str,
     at: &Location,
+    delimiter: u8,
 ) -> Result<Option<f64>> {
     let Some(text) = column.and_then(|c| row.get(c)).map(str::trim) else {
         return Ok(None);
@@ -371,9 +382,8 @@ fn manifest_number(
     if text.is_empty() {
         return Ok(None);
     }
-    let value: f64 = text
-        .parse()
-        .map_err(|_| Error::bad_input(at.clone(), format!("{name} '{text}' is not a number")))?;
+    let value = crate::table::parse_number(text, delimiter)
+        .ok_or_else(|| Error::bad_input(at.clone(), format!("{name} '{text}' is not a number")))?;
     if !value.is_finite() || value < 0.0 {
         return Err(Error::bad_input(
             at.clone(),
@@ -399,7 +409,10 @@ pub fn from_manifest_selected(
     let at_manifest = Location::file(manifest);
     crate::staging::note_input(manifest);
     let text = std::fs::read_to_string(manifest).map_err(|e| Error::io(manifest, e))?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let delimiter = crate::table::sniff_delimiter(text);
     let mut reader = csv::ReaderBuilder::new()
+        .delimiter(delimiter)
         .trim(csv::Trim::All)
         .from_reader(text.as_bytes());
     let headers = reader
@@ -445,7 +458,7 @@ pub fn from_manifest_selected(
             return Err(Error::bad_input(at, "empty 'file'"));
         }
         let path = base.join(file);
-        let force = manifest_number(&row, Some(force_col), &force_name, &at)?
+        let force = manifest_number(&row, Some(force_col), &force_name, &at, delimiter)?
             .ok_or_else(|| Error::bad_input(at.clone(), format!("missing {force_name}")))?
             * force_unit;
         // 0 is a reference frame recorded before loading: analysed, left out of the fits.
@@ -453,7 +466,9 @@ pub fn from_manifest_selected(
             Quantity::Force.check_at(force, &at)?;
         }
         let friction = match &friction_col {
-            Some((c, name, unit)) => manifest_number(&row, Some(*c), name, &at)?.map(|f| f * unit),
+            Some((c, name, unit)) => {
+                manifest_number(&row, Some(*c), name, &at, delimiter)?.map(|f| f * unit)
+            }
             None => None,
         };
         if let Some(f) = friction.filter(|f| *f != 0.0) {

@@ -47,13 +47,21 @@ pub struct TopographySummary {
     /// Mean valid height, m.
     #[serde(rename = "height_mean_um", serialize_with = "lab::m_as_um")]
     pub height_mean_m: f64,
-    /// rms height about the mean, m.
-    #[serde(rename = "h_rms_um", serialize_with = "lab::m_as_um")]
+    /// rms height about the mean of the heights as stored (before detrending: the roughness a
+    /// simulation uses is `detrended.h_rms_nm`), m.
+    #[serde(rename = "h_rms_as_stored_um", serialize_with = "lab::m_as_um")]
     pub h_rms_m: f64,
-    /// rms slope (central differences), dimensionless; `null` without an interior point.
-    pub slope_rms: Option<f64>,
-    /// rms full Laplacian (5-point), 1/m; `null` without an interior point.
-    pub curvature_rms: Option<f64>,
+    /// rms slope h' of the heights as stored (central differences), dimensionless; `null`
+    /// without an interior point.
+    #[serde(rename = "h_prime_rms_as_stored")]
+    pub h_prime_rms: Option<f64>,
+    /// rms curvature h'' of the heights as stored (5-point Laplacian), 1/m (written per µm);
+    /// `null` without an interior point.
+    #[serde(
+        rename = "h_double_prime_rms_as_stored_per_um",
+        serialize_with = "lab::opt_per_m_as_per_um"
+    )]
+    pub h_double_prime_rms_per_m: Option<f64>,
 }
 
 /// Lateral pixel size, m (written in µm under `pixel_size_um`).
@@ -87,8 +95,8 @@ impl TopographySummary {
             height_max_m: s.max_m,
             height_mean_m: s.mean_m,
             h_rms_m: s.rms_m,
-            slope_rms: s.slope_rms,
-            curvature_rms: s.curvature_rms_per_m,
+            h_prime_rms: s.slope_rms,
+            h_double_prime_rms_per_m: s.curvature_rms_per_m,
         }
     }
 
@@ -102,8 +110,8 @@ impl TopographySummary {
             ("maximum height", Some(self.height_max_m * 1e6)),
             ("mean height", Some(self.height_mean_m * 1e6)),
             ("rms height", Some(self.h_rms_m * 1e6)),
-            ("rms slope", self.slope_rms),
-            ("rms curvature", self.curvature_rms),
+            ("rms slope", self.h_prime_rms),
+            ("rms curvature", self.h_double_prime_rms_per_m),
         ];
         match values
             .iter()
