@@ -429,6 +429,17 @@ fn messages_keep_clap_suggestions_and_point_to_the_right_command() {
         s(&out),
     ]);
     assert!(stdout(&o).contains("     0.000 "), "{}", stdout(&o));
+    // A confocal file given as a height map says what it is; an unknown extension lists the
+    // formats read by content too.
+    let czi = crate::common::czi::czi(&[]);
+    let path = dir.path().join("scan.czi");
+    std::fs::write(&path, czi).unwrap();
+    let err = stderr(&run(&["topography", s(&path)]));
+    assert!(err.contains("a CZI micrograph, not a height map"), "{err}");
+    let path = dir.path().join("scan.xyz");
+    std::fs::write(&path, "1 2 3\n").unwrap();
+    let err = stderr(&run(&["topography", s(&path)]));
+    assert!(err.contains("by content: Igor .ibw"), "{err}");
 }
 
 /// Another program's ImageJ TIFF: a length `vunit` is honoured as the heights' unit; a unit that

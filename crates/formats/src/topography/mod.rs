@@ -202,14 +202,30 @@ pub fn read_topography(
         e if e.len() == 3 && e.bytes().all(|b| b.is_ascii_digit()) => {
             read_nanoscope(path, pixel_size_m, height_unit_m)
         }
-        _ => Err(Error::Unsupported {
-            at: Location::file(path),
-            reason: format!(
-                "unknown height-map extension '{}'; supported: .{} (Nanoscope also .002, .003, …)",
-                ext,
-                SUPPORTED_EXTENSIONS.join(", .")
-            ),
-        }),
+        _ => {
+            let mut head = [0u8; 16];
+            let n = std::fs::File::open(path)
+                .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
+                .unwrap_or(0);
+            use crate::microscopy::MicroscopyFormat as M;
+            let reason = match crate::microscopy::detect(&head[..n]) {
+                Some(format @ (M::Czi | M::Nd2 | M::Lif)) => format!(
+                    "a {} micrograph, not a height map (info, threshold and analyze read it)",
+                    format.name().to_uppercase()
+                ),
+                _ => format!(
+                    "unknown height-map extension '{ext}'; supported by extension: .{} \
+                     (Nanoscope also .002, .003, …); by content: Igor .ibw, NT-MDT .nid, \
+                     Agilent .mi, Park TIFF, Gwyddion .gwy, ISO 25178 .x3p, .sdf, Wyko .opd, \
+                     Sensofar .plu, Digital Surf .sur, FRT .frt",
+                    SUPPORTED_EXTENSIONS.join(", .")
+                ),
+            };
+            Err(Error::Unsupported {
+                at: Location::file(path),
+                reason,
+            })
+        }
     }
 }
 
