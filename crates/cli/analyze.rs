@@ -147,9 +147,10 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
         AreaUnit::Pixel => "px",
     };
     println!(
-        "{:>10} {:>12} {:>8} {:>10}  image",
+        "{:>10} {:>12} {:>19} {:>8} {:>10}  image",
         "force_mN",
         format!("area_{unit}"),
+        "95 % interval",
         "patches",
         "p_MPa"
     );
@@ -161,8 +162,9 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
         let name = Path::new(&row.image)
             .file_name()
             .map_or(row.image.clone(), |n| n.to_string_lossy().into_owned());
+        let interval = format!("{:.2}…{:.2}", row.area_lo, row.area_hi);
         println!(
-            "{f:>10} {:>12.2} {:>8} {p:>10}  {name} p{}",
+            "{f:>10} {:>12.2} {interval:>19} {:>8} {p:>10}  {name} p{}",
             row.area, row.patches, row.page
         );
     }
@@ -173,10 +175,22 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
             .map_or("— (fewer than 3 distinct forces)".into(), |r| {
                 format!("{r:.4}")
             });
-        println!("power law: A ∝ N^β, β = {beta}, R² = {r2}");
+        let ci = outcome.fits.intervals.as_ref().map_or(String::new(), |i| {
+            format!(" (95 % interval {:.3}…{:.3})", i.exponent.0, i.exponent.1)
+        });
+        println!("power law: A ∝ N^β, β = {beta}{ci}, R² = {r2}");
     }
     if let Some((p, _)) = outcome.fits.proportional_mpa {
-        println!("proportional fit: A = N/p, p = {p:.1} MPa");
+        let ci = outcome
+            .fits
+            .intervals
+            .as_ref()
+            .and_then(|i| i.proportional_slope)
+            .filter(|(lo, _)| *lo > 0.0)
+            .map_or(String::new(), |(lo, hi)| {
+                format!(" (95 % interval {:.1}…{:.1} MPa)", 1e3 / hi, 1e3 / lo)
+            });
+        println!("proportional fit: A = N/p, p = {p:.1} MPa{ci}");
     }
     println!("wrote {} files to {}:", written.len(), out.display());
     for path in written.iter().filter(|p| !is_per_image(p)) {

@@ -4,5 +4,6 @@
 mod analysis;
 mod first_hour;
 mod ground_truth;
+mod intervals;
 mod real_tiff;
 mod vendor;

@@ -67,6 +67,7 @@ class AnalyzeResult(TypedDict):
     threshold: Dict[str, Any]
     area_unit: str
     fits: Dict[str, Any]
+    area_interval: Dict[str, Any]
     hertz: Optional[Dict[str, float]]
     warnings: List[str]
     rows: List[Dict[str, Any]]

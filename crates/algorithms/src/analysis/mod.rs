@@ -11,7 +11,9 @@
 //! file, and keeps decoded planes of compressed files between the passes up to a memory budget,
 //! so a 500-image series never needs 500 images in memory.
 
+pub mod bootstrap;
 pub mod fit;
+pub mod interval;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -103,6 +105,8 @@ pub struct ImageResult {
     pub threshold: Threshold,
     /// What was measured.
     pub measurement: Measurement,
+    /// The interval on its contact area ([`interval`]).
+    pub band: interval::AreaBand,
 }
 
 /// The result for a series.
@@ -154,20 +158,27 @@ pub fn analyze<S: PlaneSource + ?Sized>(
     let done = AtomicUsize::new(0);
     let measurements = source.scan(|i, plane| {
         let (m, mask) = measure(plane, &thresholds[i])?;
+        let band = interval::area_band(
+            plane,
+            &mask,
+            interval::EDGE_BAND_HALF_WIDTH,
+            interval::NOISE_WIDENING,
+        );
         sink(i, plane, &mask)?;
         progress(
             Pass::Measure,
             done.fetch_add(1, Ordering::Relaxed) + 1,
             source.len(),
         );
-        Ok(m)
+        Ok((m, band))
     })?;
     let images = thresholds
         .into_iter()
         .zip(measurements)
-        .map(|(threshold, measurement)| ImageResult {
+        .map(|(threshold, (measurement, band))| ImageResult {
             threshold,
             measurement,
+            band,
         })
         .collect();
     Ok(Analysis {

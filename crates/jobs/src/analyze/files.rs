@@ -184,6 +184,24 @@ pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
         forces.clone()
     };
     let mut curves = Vec::new();
+    // Each image's 95 % interval on the true area as a vertical bar (a non-finite vertex breaks
+    // the line between bars; an interval reaching 0 has no bar on log axes).
+    let bars: Vec<(f64, f64)> = table
+        .rows
+        .iter()
+        .filter(|r| r.on_log_axes() && r.area_lo > 0.0 && r.area_hi > r.area_lo)
+        .filter_map(|r| {
+            r.force_mn
+                .map(|f| [(f, r.area_lo), (f, r.area_hi), (f, f64::NAN)])
+        })
+        .flatten()
+        .collect();
+    if !bars.is_empty() {
+        curves.push(Curve {
+            label: "95 % interval of the true area (edge band)".into(),
+            xy: bars,
+        });
+    }
     if let Some(f) = fits.power_law {
         curves.push(Curve {
             label: format!(

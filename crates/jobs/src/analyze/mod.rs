@@ -78,6 +78,8 @@ pub struct AnalyzeOutcome {
     pub area_unit: AreaUnit,
     /// Area–load fits.
     pub fits: Fits,
+    /// How the intervals on each image's area (`area_*_lo`, `area_*_hi`) are made.
+    pub area_interval: AreaIntervalFacts,
     /// Hertz reference parameters.
     pub hertz: Option<HertzParams>,
     /// Warnings (pixel size, metadata notes, non-finite pixels, implausible pressures).
@@ -87,6 +89,36 @@ pub struct AnalyzeOutcome {
     /// The analysis itself (thresholds, measurements), for printing.
     #[serde(skip)]
     pub analysis: Analysis,
+}
+
+/// The definition of the per-image area intervals (`docs/methods.md`, "Area intervals").
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AreaIntervalFacts {
+    /// The method, in words.
+    pub method: &'static str,
+    /// The nominal coverage, percent.
+    pub level_pct: f64,
+    /// Half-width w of the band of levels, as a fraction of the contact signal.
+    pub band_half_width: f64,
+    /// Standard deviations of the noise term.
+    pub noise_sd_multiple: f64,
+    /// What the interval does not carry.
+    pub not_included: &'static str,
+}
+
+impl Default for AreaIntervalFacts {
+    fn default() -> Self {
+        use contactscope::analysis::interval::{EDGE_BAND_HALF_WIDTH, NOISE_WIDENING};
+        AreaIntervalFacts {
+            method: "edge band: pixels above b + (1/2 + w)·s (lo) and pixels above \
+                     b + (1/2 − w)·s connected to the contact (hi), b and s the image's background \
+                     and contact signal, widened by the pixel noise's spread",
+            level_pct: 95.0,
+            band_half_width: EDGE_BAND_HALF_WIDTH,
+            noise_sd_multiple: NOISE_WIDENING,
+            not_included: "the pixel size's calibration",
+        }
+    }
 }
 
 impl AnalyzeOutcome {
@@ -220,6 +252,7 @@ pub fn run_open(
         threshold: ThresholdFacts::of(&analysis, open.sample_type().is_integer()),
         area_unit: rows.unit,
         fits,
+        area_interval: AreaIntervalFacts::default(),
         hertz: request.hertz,
         warnings,
         rows,

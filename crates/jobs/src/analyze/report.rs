@@ -8,6 +8,7 @@
 use serde::ser::{SerializeMap, SerializeSeq};
 use serde::{Serialize, Serializer};
 
+use contactscope::analysis::bootstrap::{fit_intervals, FitIntervals};
 use contactscope::analysis::fit::{fit_power_law, fit_proportional, PowerLawFit};
 use contactscope::analysis::Analysis;
 use contactscope::mechanics::hertz;
@@ -45,6 +46,13 @@ pub struct Row {
     pub contact_pixels: u64,
     /// Contact area in µm² (or pixels without a pixel size).
     pub area: f64,
+    /// Lower end of the 95 % interval on the true contact area (`docs/methods.md`, "Area
+    /// intervals"), µm² (or pixels); NaN in a batch record written before intervals existed.
+    #[serde(default = "not_recorded", deserialize_with = "nan_if_null")]
+    pub area_lo: f64,
+    /// Upper end of the interval, µm² (or pixels).
+    #[serde(default = "not_recorded", deserialize_with = "nan_if_null")]
+    pub area_hi: f64,
     /// Mean intensity over contact pixels.
     pub mean_intensity: Option<f64>,
     /// Sum of intensities over contact pixels.
@@ -57,6 +65,12 @@ pub struct Row {
     pub largest_patch: f64,
     /// Force / area, MPa (only with a pixel size).
     pub mean_pressure_mpa: Option<f64>,
+    /// Force / `area_hi`: the interval's lower end on the mean pressure, MPa.
+    #[serde(default)]
+    pub mean_pressure_mpa_lo: Option<f64>,
+    /// Force / `area_lo`, MPa (`None` when `area_lo` is 0).
+    #[serde(default)]
+    pub mean_pressure_mpa_hi: Option<f64>,
     /// √(A/π), µm (or pixels).
     pub equivalent_radius: f64,
     /// Friction force, mN.
@@ -69,6 +83,16 @@ pub struct Row {
     /// of the fits ([`crate::fits`]).
     #[serde(default)]
     pub edge_contact: bool,
+}
+
+/// A value an older record does not hold.
+fn not_recorded() -> f64 {
+    f64::NAN
+}
+
+/// A number, or NaN for `null` (how JSON writes a NaN back).
+fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(<Option<f64> as serde::Deserialize>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 impl Row {
@@ -179,6 +203,8 @@ impl Serialize for RowOf<'_> {
         m.serialize_entry("threshold", &r.threshold)?;
         m.serialize_entry("contact_pixels", &r.contact_pixels)?;
         m.serialize_entry(&format!("area_{a}"), &Q(r.area, t.unit.area()))?;
+        m.serialize_entry(&format!("area_{a}_lo"), &Q(r.area_lo, t.unit.area()))?;
+        m.serialize_entry(&format!("area_{a}_hi"), &Q(r.area_hi, t.unit.area()))?;
         m.serialize_entry("mean_intensity", &r.mean_intensity)?;
         m.serialize_entry("integrated_intensity", &r.integrated_intensity)?;
         m.serialize_entry("background_mean", &r.background_mean)?;
@@ -189,6 +215,14 @@ impl Serialize for RowOf<'_> {
         )?;
         if t.unit == AreaUnit::SquareMicrometre {
             m.serialize_entry("mean_pressure_MPa", &OptQ(r.mean_pressure_mpa, Unit::Mpa))?;
+            m.serialize_entry(
+                "mean_pressure_MPa_lo",
+                &OptQ(r.mean_pressure_mpa_lo, Unit::Mpa),
+            )?;
+            m.serialize_entry(
+                "mean_pressure_MPa_hi",
+                &OptQ(r.mean_pressure_mpa_hi, Unit::Mpa),
+            )?;
         }
         m.serialize_entry(
             &format!("equivalent_radius_{l}"),
@@ -227,6 +261,9 @@ pub struct Fits {
     pub proportional_mpa: Option<(f64, usize)>,
     /// Smallest and largest mean pressure, MPa.
     pub pressure_range_mpa: Option<(f64, f64)>,
+    /// 95 % intervals on the fits' parameters by a bootstrap over the images and their area
+    /// intervals ([`contactscope::analysis::bootstrap`]).
+    pub intervals: Option<FitIntervals>,
 }
 
 impl Serialize for Fits {
@@ -235,11 +272,21 @@ impl Serialize for Fits {
         let mut m = s.serialize_map(Some(3))?;
         m.serialize_entry(
             "power_law",
-            &self.power_law.map(|f| PowerLawOf(self.unit, f, si)),
+            &self
+                .power_law
+                .map(|f| PowerLawOf(self.unit, f, si, self.intervals.as_ref())),
         )?;
+        let pressure_ci = self
+            .intervals
+            .as_ref()
+            .and_then(|i| i.proportional_slope)
+            .filter(|(lo, _)| *lo > 0.0)
+            .map(|(lo, hi)| (1e3 / hi, 1e3 / lo));
         m.serialize_entry(
             "proportional",
-            &self.proportional_mpa.map(|(p, n)| Proportional(p, n)),
+            &self
+                .proportional_mpa
+                .map(|(p, n)| Proportional(p, n, pressure_ci)),
         )?;
         m.serialize_entry(
             "mean_pressure_MPa",
@@ -249,9 +296,21 @@ impl Serialize for Fits {
     }
 }
 
-struct PowerLawOf(AreaUnit, PowerLawFit, bool);
+struct PowerLawOf<'a>(AreaUnit, PowerLawFit, bool, Option<&'a FitIntervals>);
 
-impl Serialize for PowerLawOf {
+/// An interval as a two-element list, each end in `unit`.
+struct Interval(f64, f64, Unit);
+
+impl Serialize for Interval {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut seq = s.serialize_seq(Some(2))?;
+        seq.serialize_element(&Q(self.0, self.2))?;
+        seq.serialize_element(&Q(self.1, self.2))?;
+        seq.end()
+    }
+}
+
+impl Serialize for PowerLawOf<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let (unit, f, si) = (self.0, &self.1, self.2);
         let a = unit.area_suffix();
@@ -275,6 +334,23 @@ impl Serialize for PowerLawOf {
         m.serialize_entry(&format!("prefactor_{a}_per_mN_pow_exponent"), &prefactor)?;
         m.serialize_entry("exponent", &f.exponent)?;
         m.serialize_entry("exponent_se", &f.exponent_se)?;
+        // The same conversion of the prefactor, resample by resample (it depends on each β).
+        let to_output = |c: f64, b: f64| match (si, unit) {
+            (false, _) => c,
+            (true, AreaUnit::SquareMicrometre) => c * 1e-12 * 1e3f64.powf(b),
+            (true, AreaUnit::Pixel) => c * 1e3f64.powf(b),
+        };
+        let intervals = self.3;
+        m.serialize_entry(
+            "exponent_ci95",
+            &intervals.map(|i| Interval(i.exponent.0, i.exponent.1, Unit::None)),
+        )?;
+        m.serialize_entry(
+            &format!("prefactor_{a}_per_mN_pow_exponent_ci95"),
+            &intervals
+                .and_then(|i| i.prefactor_in(to_output))
+                .map(|(lo, hi)| Interval(lo, hi, Unit::None)),
+        )?;
         m.serialize_entry("r_squared", &f.r_squared)?;
         m.serialize_entry("points", &f.points)?;
         m.serialize_entry("distinct_forces", &f.distinct_forces)?;
@@ -282,13 +358,17 @@ impl Serialize for PowerLawOf {
     }
 }
 
-struct Proportional(f64, usize);
+struct Proportional(f64, usize, Option<(f64, f64)>);
 
 impl Serialize for Proportional {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut m = s.serialize_map(Some(3))?;
+        let mut m = s.serialize_map(Some(4))?;
         m.serialize_entry("model", "area = force / pressure")?;
         m.serialize_entry("pressure_MPa", &Q(self.0, Unit::Mpa))?;
+        m.serialize_entry(
+            "pressure_MPa_ci95",
+            &self.2.map(|(lo, hi)| Interval(lo, hi, Unit::Mpa)),
+        )?;
         m.serialize_entry("points", &self.1)?;
         m.end()
     }
@@ -323,7 +403,15 @@ pub fn table_and_fits(
         .map(|(image, r)| {
             let m = &r.measurement;
             let area = m.contact_pixels as f64 * pixel_area;
+            let (area_lo, area_hi) = (
+                r.band.lo_pixels as f64 * pixel_area,
+                r.band.hi_pixels as f64 * pixel_area,
+            );
             let force_mn = image.force_n.map(|f| f * 1e3);
+            let pressure = |a: f64| match (unit, force_mn) {
+                (AreaUnit::SquareMicrometre, Some(f)) if a > 0.0 => Some(f / a * 1e3),
+                _ => None,
+            };
             let hertz_radius = match (hertz, image.force_n) {
                 (Some(h), Some(f)) => Some(hertz::contact_radius(f, h.radius_m, h.modulus_pa)),
                 _ => None,
@@ -335,15 +423,16 @@ pub fn table_and_fits(
                 threshold: r.threshold.value,
                 contact_pixels: m.contact_pixels,
                 area,
+                area_lo,
+                area_hi,
                 mean_intensity: m.mean_intensity,
                 integrated_intensity: m.integrated_intensity,
                 background_mean: m.background_mean,
                 patches: m.patches,
                 largest_patch: m.largest_patch_pixels as f64 * pixel_area,
-                mean_pressure_mpa: match (unit, force_mn) {
-                    (AreaUnit::SquareMicrometre, Some(f)) if area > 0.0 => Some(f / area * 1e3),
-                    _ => None,
-                },
+                mean_pressure_mpa: pressure(area),
+                mean_pressure_mpa_lo: pressure(area_hi),
+                mean_pressure_mpa_hi: pressure(area_lo),
                 equivalent_radius: (area / std::f64::consts::PI).sqrt(),
                 friction_mn: image.friction_n.map(|f| f * 1e3),
                 hertz_radius_um: hertz_radius.map(|a| a * 1e6),
@@ -354,6 +443,13 @@ pub fn table_and_fits(
         .collect();
     let points: Vec<LoadPoint> = rows.iter().map(Row::load_point).collect();
     let (forces, areas) = fit_points(&points);
+    // The same images as the fits, each with its area interval.
+    let in_fit: Vec<&Row> = rows.iter().filter(|r| r.load_point().in_fit()).collect();
+    let intervals = fit_intervals(
+        &in_fit.iter().filter_map(|r| r.force_mn).collect::<Vec<_>>(),
+        &in_fit.iter().map(|r| r.area_lo).collect::<Vec<_>>(),
+        &in_fit.iter().map(|r| r.area_hi).collect::<Vec<_>>(),
+    );
     let proportional_mpa = match unit {
         AreaUnit::SquareMicrometre => fit_proportional(&forces, &areas)
             .filter(|(s, _)| *s > 0.0)
@@ -369,6 +465,7 @@ pub fn table_and_fits(
         unit,
         power_law: fit_power_law(&forces, &areas),
         proportional_mpa,
+        intervals,
         pressure_range_mpa: (!pressures.is_empty()).then(|| {
             (
                 pressures.iter().copied().fold(f64::INFINITY, f64::min),

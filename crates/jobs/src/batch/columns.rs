@@ -79,6 +79,14 @@ pub fn images_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
     if any_px {
         t.float("area_px", in_unit(false, |i| i.area));
     }
+    // The area interval (empty for a series analysed before intervals existed).
+    let finite = |v: Vec<Option<f64>>| v.into_iter().map(|x| x.filter(|x| x.is_finite()));
+    t.float("area_um2_lo", finite(in_unit(true, |i| i.area_lo)));
+    t.float("area_um2_hi", finite(in_unit(true, |i| i.area_hi)));
+    if any_px {
+        t.float("area_px_lo", finite(in_unit(false, |i| i.area_lo)));
+        t.float("area_px_hi", finite(in_unit(false, |i| i.area_hi)));
+    }
     t.float("mean_intensity", rows.iter().map(|r| r.3.mean_intensity));
     t.float(
         "integrated_intensity",
@@ -93,6 +101,14 @@ pub fn images_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
     t.float(
         "mean_pressure_MPa",
         rows.iter().map(|r| r.3.mean_pressure_mpa),
+    );
+    t.float(
+        "mean_pressure_MPa_lo",
+        rows.iter().map(|r| r.3.mean_pressure_mpa_lo),
+    );
+    t.float(
+        "mean_pressure_MPa_hi",
+        rows.iter().map(|r| r.3.mean_pressure_mpa_hi),
     );
     t.float(
         "equivalent_radius_um",
