@@ -61,7 +61,10 @@ pub(crate) fn index(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<usize
     if obj.is_none() {
         return Ok(None);
     }
-    if obj.is_instance_of::<PyBool>() || !obj.is_instance_of::<PyInt>() {
+    if obj.is_instance_of::<PyBool>() {
+        return Err(wrong_type(what, "an int ≥ 0 or None", obj));
+    }
+    if !obj.is_instance_of::<PyInt>() {
         // numpy integers are not Python ints but index like them.
         if let Ok(i) = obj
             .call_method0("__index__")

@@ -50,6 +50,8 @@ def message(call):
     (lambda: cs.read_series(["a.tif"], series="one"), TypeError,
      ["series= must be an int ≥ 0 or None", "got str 'one'"]),
     (lambda: cs.read_series(["a.tif"], z=-1), ValueError, ["z= must be ≥ 0; got -1"]),
+    (lambda: cs.read_series(["a.tif"], t=True), TypeError,
+     ["t= must be an int ≥ 0 or None", "got bool True"]),
     (lambda: cs.read_series(["a.tif"], axes=["H", 0]), TypeError,
      ["axes= must be a dict of axis names to indices"]),
     (lambda: cs.read_series(3), TypeError, ["the files must be a path", "got int 3"]),

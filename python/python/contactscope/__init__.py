@@ -183,7 +183,8 @@ def read_image(path: PathLike, channel: Union[int, str, None] = None,
     axes by name, e.g. ``{"H": 3}`` for an Airyscan phase) select, or every plane along
     ``load_axis`` ("t", "z" or "series") — as the command line's selection flags: an axis
     longer than 1 must be chosen (the error lists every such axis at once), and ``channel`` is
-    an index or the channel's name as :func:`info` lists it ("AF488"). Returns ``images`` (images, rows, columns), ``pixel_size_m`` ((x, y) in m from the
+    an index or the channel's name as :func:`info` lists it ("AF488"). Returns ``images``
+    (images, rows, columns), ``pixel_size_m`` ((x, y) in m from the
     file's metadata or ``pixel_size``, m; ``None`` if unknown), ``pixel_size_source``,
     ``path`` and ``warnings``.
     """
@@ -278,7 +279,8 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
     writer (``areas.csv``, ``summary.json``, ``area_vs_load.png``/``.svg``; ``overlays`` and
     ``save_masks`` as ``--overlays`` and ``--save-masks``), all or nothing; ``summary.json``
     records ``command_line`` (a list of words, e.g. the equivalent command; by default the
-    interpreter and this call) and ``written`` lists the files. ``progress(pass, done, total)`` is called as the images are read
+    interpreter and this call) and ``written`` lists the files. ``progress(pass, done, total)``
+    is called as the images are read
     (``"histogram"``) and measured (``"measure"``), from the threads doing the work.
     """
     if isinstance(series, Series) and pixel_size is None:
@@ -286,7 +288,8 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
     forces = _opt_numbers(forces, "forces", "N")
     result = Results(_cs.analyze(_images(series), forces, pixel_size, method, radius, modulus,
                                  masks, None if out is None else os.fspath(out),
-                                 _command_line(command_line, "analyze", out), bool(overlays), bool(save_masks), progress), table="rows")
+                                 _command_line(command_line, "analyze", out), bool(overlays),
+                                 bool(save_masks), progress), table="rows")
     _warn(result)
     return result
 
@@ -301,7 +304,8 @@ def _image(image: Any) -> Any:
 def psf(beads: Any, pixel_size: Optional[PixelSize] = None,
         bead_diameter: Optional[float] = None, saturation_level: Optional[float] = None, *,
         series: Optional[int] = None, channel: Union[int, str, None] = None,
-        z: Optional[int] = None, t: Optional[int] = None, axes: Optional[Dict[str, int]] = None) -> Results:
+        z: Optional[int] = None, t: Optional[int] = None,
+        axes: Optional[Dict[str, int]] = None) -> Results:
     """The point-spread function from sub-resolution beads, the command line's ``psf``.
 
     ``beads``: a bead image or z stack as a file (TIFF: every page of ``channel``; CZI, ND2,

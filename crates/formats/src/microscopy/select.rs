@@ -362,7 +362,11 @@ impl Selection {
                 ),
             ));
         }
-        let index = self.series.filter(|s| *s < n_series).unwrap_or(0);
+        if self.series.is_some_and(|s| s >= n_series) {
+            // An index beyond the file: the range error says so first.
+            return None;
+        }
+        let index = self.series.unwrap_or(0);
         let info = file.series.get(index)?;
         let a = &info.axes;
         let of = if n_series > 1 && self.series.is_none() {
