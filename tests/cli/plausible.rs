@@ -481,3 +481,37 @@ fn a_foreign_value_unit_is_honoured_only_when_it_is_a_length() {
     ]);
     assert!((read - 0.07).abs() < 1e-9, "{read}");
 }
+
+#[test]
+fn a_flat_map_for_the_greenwood_tripp_model_names_the_file() {
+    // Found by the fuzz campaign (seed 13): the error named no file.
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("flat.txt");
+    let row = vec!["0"; 32].join(" ");
+    std::fs::write(&map, vec![row; 32].join("\n")).unwrap();
+    let out = dir.path().join("o");
+    let o = run(&[
+        "simulate",
+        "--topography",
+        s(&map),
+        "--pixel-size",
+        "200nm",
+        "--radius",
+        "20um",
+        "--modulus",
+        "3.7GPa",
+        "--model",
+        "gt",
+        "--forces",
+        "1mN",
+        "--out",
+        s(&out),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("flat.txt: Greenwood–Tripp: h_rms 0 m"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

@@ -630,7 +630,13 @@ fn run_gt(
         stats.h_rms_m,
         stats.h_double_prime_rms_per_m,
     );
-    params.validate()?;
+    // A flat map (h_rms 0) has no roughness for the model: the error names the map.
+    params.validate().map_err(|e| {
+        crate::error::Error::bad_input(
+            crate::error::Location::file(request.heights.label()),
+            format!("{e} (the map is flat after detrending: no roughness for the model)"),
+        )
+    })?;
     let total = request.loads_n.len();
     let mut rows = Vec::new();
     for (i, &force) in request.loads_n.iter().enumerate() {
