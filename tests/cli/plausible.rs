@@ -312,18 +312,19 @@ fn compare_refuses_an_oversized_rendering_before_allocating_it() {
     let o = simulate(&map, "1mN,2mN", &sim, "contact");
     assert!(sim.join("load_002_contact.tif").is_file(), "{}", stderr(&o));
     let synth = small_micrographs(dir.path());
-    let line = format!(
-        "ulimit -v 2097152; exec '{}' compare --simulation '{}' --micrographs '{}' \
-         --psf-fwhm 450nm --pixel-size 0.2nm --out '{}'",
-        env!("CARGO_BIN_EXE_contactscope"),
+    let o = run_limited(&[
+        "compare",
+        "--simulation",
         s(&sim),
+        "--micrographs",
         s(&synth),
-        s(&dir.path().join("c"))
-    );
-    let o = std::process::Command::new("sh")
-        .args(["-c", &line])
-        .output()
-        .unwrap();
+        "--psf-fwhm",
+        "450nm",
+        "--pixel-size",
+        "0.2nm",
+        "--out",
+        s(&dir.path().join("c")),
+    ]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
