@@ -119,7 +119,7 @@ fn main() {
                 // The exponent of the true areas against its bootstrap interval.
                 let forces: Vec<f64> = images.iter().map(|i| i.force_n * 1e3).collect();
                 let true_beta = fit_power_law(&forces, &truths).expect("law").exponent;
-                if let Some(f) = fit_intervals(&forces, &lo, &hi) {
+                if let Some(f) = fit_intervals(&forces, &lo, &hi, 0.0) {
                     if f.exponent.0 <= true_beta && true_beta <= f.exponent.1 {
                         beta_covered += 1;
                     }

@@ -7,6 +7,7 @@ use anyhow::{bail, Context, Result};
 
 use contactscope::analysis::Pass;
 use contactscope::threshold::Method;
+use contactscope_formats::ranges::short;
 use contactscope_formats::units::{self, Dimension};
 use contactscope_jobs::analyze::files::{run_to_folder, ImageOutputs};
 use contactscope_jobs::analyze::{AnalyzeOutcome, AnalyzeRequest, AreaUnit, HertzParams};
@@ -43,6 +44,10 @@ pub struct Args {
     threshold: String,
     #[command(flatten)]
     pixel_size: PixelSizeArg,
+    /// Relative uncertainty of the pixel size (given or the files'), as bounds: 1% or 0.01;
+    /// widens the area and fit intervals (also written --pixel-size 200nm±1%).
+    #[arg(long)]
+    pixel_size_uncertainty: Option<String>,
     /// Sphere radius for Hertz columns, e.g. 290um (needs --modulus).
     #[arg(long, requires = "modulus")]
     radius: Option<String>,
@@ -86,9 +91,13 @@ pub fn run(args: Args) -> Result<Finished> {
         }),
         _ => None,
     };
+    let (pixel_size_m, pixel_size_uncertainty) = args
+        .pixel_size
+        .metres_and_uncertainty(&args.pixel_size_uncertainty)?;
     let request = AnalyzeRequest {
         method: Method::parse(&args.threshold)?,
-        pixel_size_m: args.pixel_size.metres()?,
+        pixel_size_m,
+        pixel_size_uncertainty,
         hertz,
         memory_budget: args.memory_mib << 20,
         ..AnalyzeRequest::new(micrographs(&args)?)
@@ -135,9 +144,13 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
     }
     match a.pixel_size {
         Some(p) => println!(
-            "pixel size: {:.5} × {:.5} µm from {}",
+            "pixel size: {:.5} × {:.5} µm{} from {}",
             p.x_m * 1e6,
             p.y_m * 1e6,
+            match outcome.area_interval.pixel_size_uncertainty {
+                u if u > 0.0 => format!(" ± {} %", short(u * 100.0)),
+                _ => String::new(),
+            },
             p.source.describe()
         ),
         None => println!("pixel size: unknown, areas in pixels"),

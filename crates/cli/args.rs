@@ -18,7 +18,8 @@ use contactscope_jobs::heights::TopographySource;
 /// `--pixel-size`: overrides the files' calibration.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PixelSizeArg {
-    /// Pixel size overriding the files' metadata: 200nm, 0.2um, or 200x210nm (x × y).
+    /// Pixel size overriding the files' metadata: 200nm, 0.2um, or 200x210nm (x × y);
+    /// `analyze` also takes its uncertainty, 200nm±1%.
     #[arg(long)]
     pub pixel_size: Option<String>,
 }
@@ -27,6 +28,34 @@ impl PixelSizeArg {
     /// (x, y) in metres, if given.
     pub fn metres(&self) -> Result<Option<(f64, f64)>> {
         optional_pixel_size(&self.pixel_size, "--pixel-size")
+    }
+
+    /// (x, y) in metres, if given, and the relative uncertainty from `--pixel-size 200nm±1%`
+    /// or from `uncertainty` (`--pixel-size-uncertainty 1%`, which also serves the files' pixel
+    /// sizes); 0 without either, an error with both.
+    pub fn metres_and_uncertainty(
+        &self,
+        uncertainty: &Option<String>,
+    ) -> Result<(Option<(f64, f64)>, f64)> {
+        let (size, inline) = match self.pixel_size.as_deref() {
+            Some(text) => {
+                let (size, u) = units::parse_pixel_size_uncertain(text).context("--pixel-size")?;
+                (Some(size), u)
+            }
+            None => (None, None),
+        };
+        let flag = uncertainty
+            .as_deref()
+            .map(|t| units::parse_relative_uncertainty(t, size.map(|(x, y): (f64, f64)| x.max(y))))
+            .transpose()
+            .context("--pixel-size-uncertainty")?;
+        match (inline, flag) {
+            (Some(_), Some(_)) => bail!(
+                "the pixel size's uncertainty is given twice: in --pixel-size and in \
+                 --pixel-size-uncertainty; give it once"
+            ),
+            (u, v) => Ok((size, u.or(v).unwrap_or(0.0))),
+        }
     }
 }
 

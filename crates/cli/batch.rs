@@ -53,6 +53,10 @@ struct Defaults {
     /// QC page as a default.
     #[arg(long)]
     pixel_size: Option<String>,
+    /// Relative uncertainty of the pixel size (given or the files'), e.g. 1% (column
+    /// pixel_size_uncertainty): widens the area and fit intervals.
+    #[arg(long)]
+    pixel_size_uncertainty: Option<String>,
     /// Sphere radius, e.g. 290um (column radius): Hertz columns with --modulus; the fit's sphere.
     #[arg(long)]
     radius: Option<String>,
@@ -101,6 +105,7 @@ impl Defaults {
             (Opt::LoadAxis, &self.load_axis),
             (Opt::Threshold, &self.threshold),
             (Opt::PixelSize, &self.pixel_size),
+            (Opt::PixelSizeUncertainty, &self.pixel_size_uncertainty),
             (Opt::Radius, &self.radius),
             (Opt::Modulus, &self.modulus),
             (Opt::Topography, &self.topography),

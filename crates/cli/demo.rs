@@ -45,8 +45,11 @@ pub fn run(args: Args) -> Result<()> {
     );
     for r in &outcome.recovered {
         let recovered = contactscope_jobs::table::value_pm_or(r.recovered, r.uncertainty, 3);
+        let interval = r.interval.map_or(String::new(), |(lo, hi)| {
+            format!(" (95 % interval {lo:.3}…{hi:.3})")
+        });
         println!(
-            "{:<32} {:>12} {:>22} {:>7.1}%  {}",
+            "{:<32} {:>12} {:>22} {:>7.1}%  {}{interval}",
             r.quantity,
             format!("{:.3} {}", r.truth, r.unit),
             recovered,

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::{bail, Context, Result};
+use contactscope_formats::ranges::short;
 
 use contactscope::model_fit::{Family, Imaging, ProgressHook, RampEvent, Search};
 use contactscope_formats::units::{self, Dimension};
@@ -27,7 +28,8 @@ default_out!(Out, "contactscope-out/fit");
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Measured areas: areas.csv of `contactscope analyze` (force_mN or force_N, area_um2).
+    /// Measured areas: areas.csv of `contactscope analyze` (force_mN or force_N, area_um2; the
+    /// 95 % intervals area_um2_lo/_hi and pixel_size_uncertainty_pct when it has them).
     #[arg(long, alias = "experiment")]
     areas: PathBuf,
     #[command(flatten)]
@@ -190,7 +192,10 @@ pub fn run(args: Args) -> Result<()> {
     bar.finish_and_clear();
     let (outcome, written) = outcome?;
     print_warnings(&outcome.warnings);
-    println!("{:>10} {:>22} {:>10}", "model", "parameter", "misfit");
+    println!(
+        "{:>10} {:>22} {:>10}  95 % interval",
+        "model", "parameter", "misfit"
+    );
     for fit in outcome.fits() {
         let parameter = match (fit.family, fit.best.parameter) {
             (Family::Hardening, Some(k)) => match fit.parameter_se {
@@ -205,8 +210,17 @@ pub fn run(args: Args) -> Result<()> {
             },
             _ => "—".into(),
         };
+        let interval = match (fit.family, fit.parameter_ci95) {
+            (Family::Hardening, Some((lo, hi))) => {
+                format!("{}…{} MPa/nm", short(lo * 1e-15), short(hi * 1e-15))
+            }
+            (Family::Hardness, Some((lo, hi))) => {
+                format!("{}…{} MPa", short(lo * 1e-6), short(hi * 1e-6))
+            }
+            _ => "—".into(),
+        };
         println!(
-            "{:>10} {:>22} {:>10.4}",
+            "{:>10} {:>22} {:>10.4}  {interval}",
             fit.family.name(),
             parameter,
             fit.best.misfit

@@ -16,10 +16,12 @@ use crate::convert::outcome_dict;
 use crate::heights::{height_input, HeightsArg};
 use crate::{bad, compute, PixelArg};
 
-/// The measured curve: an `areas.csv` path, or (forces N, areas m²).
+/// The measured curve: an `areas.csv` path, (forces N, areas m²), or (forces N, areas m², lower
+/// ends m², upper ends m²) with each area's interval.
 enum MeasuredArg {
     Path(PathBuf),
     Pairs((Vec<f64>, Vec<f64>)),
+    Intervals((Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)),
 }
 
 impl<'a, 'py> FromPyObject<'a, 'py> for MeasuredArg {
@@ -29,12 +31,16 @@ impl<'a, 'py> FromPyObject<'a, 'py> for MeasuredArg {
         if let Some(p) = crate::extract::path(&obj) {
             return Ok(MeasuredArg::Path(p));
         }
-        obj.extract::<(Vec<f64>, Vec<f64>)>()
-            .map(MeasuredArg::Pairs)
+        if let Ok(pairs) = obj.extract::<(Vec<f64>, Vec<f64>)>() {
+            return Ok(MeasuredArg::Pairs(pairs));
+        }
+        obj.extract::<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)>()
+            .map(MeasuredArg::Intervals)
             .map_err(|_| {
                 crate::extract::wrong_type(
                     "the measured curve",
-                    "an areas.csv path or (forces in N, areas in m²)",
+                    "an areas.csv path, (forces in N, areas in m²) or (forces, areas, lower \
+                     ends, upper ends of the areas' intervals)",
                     &obj,
                 )
             })
@@ -53,6 +59,22 @@ fn measured_input(measured: MeasuredArg) -> PyResult<MeasuredInput> {
                 )));
             }
             MeasuredInput::Memory(forces.into_iter().zip(areas).collect())
+        }
+        MeasuredArg::Intervals((forces, areas, lo, hi)) => {
+            if [areas.len(), lo.len(), hi.len()] != [forces.len(); 3] {
+                return Err(bad(format!(
+                    "{} forces for {} areas, {} lower and {} upper ends",
+                    forces.len(),
+                    areas.len(),
+                    lo.len(),
+                    hi.len()
+                )));
+            }
+            MeasuredInput::Intervals(
+                (0..forces.len())
+                    .map(|i| (forces[i], areas[i], lo[i], hi[i]))
+                    .collect(),
+            )
         }
     })
 }

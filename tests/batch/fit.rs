@@ -17,9 +17,9 @@ fn rows_with_a_height_map_get_k_and_p_y() {
     rough_surface(&dir.join("rough.npy"), 128, "250nm", 5, &[]);
     std::fs::write(
         dir.join("sheet.csv"),
-        "id,input,topography,topography_pixel_size,radius_um,modulus,models\n\
-         s1,s1,rough.npy,250nm,290,3.7GPa,\"hardness,hardening\"\n\
-         s2,s2,,,,,\n",
+        "id,input,topography,topography_pixel_size,radius_um,modulus,models,pixel_size_uncertainty\n\
+         s1,s1,rough.npy,250nm,290,3.7GPa,\"hardness,hardening\",1%\n\
+         s2,s2,,,,,,\n",
     )
     .unwrap();
     let stdout = batch_ok(dir, &["--samplesheet", "sheet.csv", "--out", "results"]);
@@ -63,6 +63,16 @@ fn rows_with_a_height_map_get_k_and_p_y() {
         Some(v) => assert!((se[0].parse::<f64>().unwrap() - v).abs() <= 1e-12 * v.abs()),
         None => assert_eq!(se[0], ""),
     }
+    // The 95 % intervals as fit.json has them; the row's pixel-size uncertainty reached the fit.
+    for (column, end) in [("k_MPa_per_nm_lo", 0), ("k_MPa_per_nm_hi", 1)] {
+        let cell = &cells(&series, column)[0];
+        match model("hardening")["k_MPa_per_nm_ci95"][end].as_f64() {
+            Some(v) => assert!((cell.parse::<f64>().unwrap() - v).abs() <= 1e-12 * v.abs()),
+            None => assert_eq!(cell, ""),
+        }
+    }
+    assert_eq!(fit["measured"]["pixel_size_uncertainty_pct"], 1.0);
+    assert_eq!(cells(&series, "pixel_size_uncertainty_pct"), ["1", "0"]);
     let hardness = model("hardness")["hardness_MPa"].as_f64().unwrap();
     assert!((p[0].parse::<f64>().unwrap() - hardness).abs() <= 1e-12 * hardness);
     assert_eq!(cells(&series, "fit_folder"), ["fit/s1", ""]);

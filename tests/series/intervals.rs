@@ -90,3 +90,167 @@ fn area_intervals_hold_the_true_area_of_synthetic_series() {
         "the true exponent in {beta_covered} of 3 intervals"
     );
 }
+
+/// A smaller version of `cargo bench --bench k_intervals`: the reduced demo's synthetic
+/// experiment (true k = 4 MPa/nm) on 5 seeds, analysed and fitted as the demo does; the 95 %
+/// interval of k holds the truth in at least 4 of 5 and is under 60 % wide (median).
+#[test]
+fn k_intervals_hold_the_true_k_of_synthetic_experiments() {
+    use contactscope::model_fit::{fit_parameter, Family, Imaging, Measured, Search};
+    use contactscope_jobs::analyze::{run, AnalyzeRequest};
+    use contactscope_jobs::demo::{model_body, synthetic_experiment, DemoParams};
+    use contactscope_jobs::series::{Micrographs, SeriesSpec};
+    let tmp = tempfile::tempdir().unwrap();
+    let (mut covered, mut widths) = (0, Vec::new());
+    for seed in 3000..3005 {
+        let p = DemoParams {
+            seed,
+            ..DemoParams::reduced()
+        };
+        let experiment = synthetic_experiment(&p, &tmp.path().join(seed.to_string()), &|_| {})
+            .expect("the synthetic experiment");
+        let analysis = run(
+            &AnalyzeRequest::new(Micrographs::Files(SeriesSpec {
+                manifest: Some(experiment.manifest.clone()),
+                ..SeriesSpec::default()
+            })),
+            &|_, _, _| {},
+            &|_, _, _| Ok(()),
+        )
+        .unwrap();
+        let points = analysis
+            .rows
+            .rows
+            .iter()
+            .map(|r| {
+                let f = r.force_mn.unwrap() * 1e-3;
+                (f, r.area * 1e-12, r.area_lo * 1e-12, r.area_hi * 1e-12)
+            })
+            .collect();
+        let measured = Measured::with_intervals(points, 0.0).unwrap();
+        let mut body = model_body(&p, &experiment).unwrap();
+        body.imaging = Some(Imaging {
+            fwhm_m: p.psf_fwhm_m,
+            pixel_m: (p.image_pixel_m, p.image_pixel_m),
+        });
+        let search = Search {
+            grid: p.fit_grid,
+            ln_tolerance: 0.02,
+            ..Search::default_for(Family::Hardening)
+        };
+        let fit = fit_parameter(&body, Family::Hardening, &measured, search).unwrap();
+        let (lo, hi) = fit.parameter_ci95.expect("an interval");
+        let k = fit.best.parameter.unwrap();
+        assert!(lo < k && k < hi, "{lo} {k} {hi}");
+        covered += usize::from(lo <= p.k_pa_per_m && p.k_pa_per_m <= hi);
+        widths.push((hi - lo) / p.k_pa_per_m);
+    }
+    widths.sort_by(f64::total_cmp);
+    assert!(covered >= 4, "the true k in {covered} of 5 intervals");
+    assert!(widths[2] < 0.6, "median relative width {}", widths[2]);
+}
+
+/// The pixel size's uncertainty from `analyze` reaches `fit-hardening` through `areas.csv`: the
+/// fit records it, and its k interval widens; an interval that does not hold its area is
+/// refused naming the file and line.
+#[test]
+fn a_pixel_size_uncertainty_travels_from_analyze_to_the_k_interval() {
+    let tmp = tempfile::tempdir().unwrap();
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    let demo = tmp.path().join("demo");
+    run_ok(&["demo", "--small", "--out", &s(&demo), "-q"]);
+    let manifest = demo.join("data/micrographs/manifest.csv");
+    let fit = |name: &str, extra: &[&str]| -> serde_json::Value {
+        let analysis = tmp.path().join(format!("a_{name}"));
+        let mut args = vec!["analyze", "--manifest"];
+        let (m, a) = (s(&manifest), s(&analysis));
+        args.extend([m.as_str(), "--out", a.as_str(), "-q"]);
+        args.extend(extra);
+        run_ok(&args);
+        let out = tmp.path().join(format!("f_{name}"));
+        let (areas, topo, o) = (
+            s(&analysis.join("areas.csv")),
+            s(&demo.join("data/topography.npy")),
+            s(&out),
+        );
+        run_ok(&[
+            "fit-hardening",
+            "--areas",
+            &areas,
+            "--topography",
+            &topo,
+            "--pixel-size",
+            "80nm",
+            "--detrend",
+            "none",
+            "--radius",
+            "50um",
+            "--modulus",
+            "3.7GPa",
+            "--models",
+            "hardening",
+            "--psf-fwhm",
+            "450nm",
+            "--micrograph-pixel-size",
+            "200nm",
+            "--imaged-areas",
+            "--out",
+            &o,
+            "-q",
+        ]);
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap()
+    };
+    let exact = fit("exact", &[]);
+    let calibrated = fit("calibrated", &["--pixel-size", "200nm±3%"]);
+    assert_eq!(exact["measured"]["pixel_size_uncertainty_pct"], 0.0);
+    assert_eq!(calibrated["measured"]["pixel_size_uncertainty_pct"], 3.0);
+    let width = |v: &serde_json::Value| {
+        let ci = &v["models"][0]["k_MPa_per_nm_ci95"];
+        ci[1].as_f64().unwrap() - ci[0].as_f64().unwrap()
+    };
+    assert!(
+        width(&calibrated) > width(&exact),
+        "{} {}",
+        width(&calibrated),
+        width(&exact)
+    );
+    // The same k: the calibration widens the interval, it does not move the fit.
+    assert_eq!(
+        exact["models"][0]["k_MPa_per_nm"],
+        calibrated["models"][0]["k_MPa_per_nm"]
+    );
+    // An areas.csv whose interval misses its area: one line naming the file and the line.
+    let table = tmp.path().join("a_exact/areas.csv");
+    let text = std::fs::read_to_string(&table).unwrap();
+    let (header, rest) = text.split_once('\n').unwrap();
+    let cols: Vec<&str> = header.split(',').collect();
+    let at = cols.iter().position(|c| *c == "area_um2_lo").unwrap();
+    let mut lines: Vec<String> = rest.lines().map(String::from).collect();
+    let mut cells: Vec<String> = lines[1].split(',').map(String::from).collect();
+    cells[at] = "1e6".into();
+    lines[1] = cells.join(",");
+    let broken = tmp.path().join("broken.csv");
+    std::fs::write(&broken, format!("{header}\n{}\n", lines.join("\n"))).unwrap();
+    let out = crate::common::run(&[
+        "fit-hardening",
+        "--areas",
+        &s(&broken),
+        "--topography",
+        &s(&demo.join("data/topography.npy")),
+        "--pixel-size",
+        "80nm",
+        "--modulus",
+        "3.7GPa",
+        "--radius",
+        "50um",
+        "--out",
+        &s(&tmp.path().join("never")),
+    ]);
+    assert!(!out.status.success());
+    let err = crate::common::stderr(&out);
+    assert!(
+        err.contains("broken.csv:3") && err.contains("does not hold"),
+        "{err}"
+    );
+    assert!(!tmp.path().join("never").exists());
+}

@@ -97,6 +97,8 @@ macro_rules! params {
 params! {
     /// Pixel size overriding the files' metadata.
     PixelSize: "--pixel-size", "pixel_size", "the pixel size";
+    /// Relative uncertainty of the pixel size (as bounds).
+    PixelSizeUncertainty: "--pixel-size-uncertainty", "pixel_size_uncertainty", "the pixel size's uncertainty";
     /// Metres per stored height unit.
     HeightUnit: "--height-unit", "height_unit", "the height unit";
     /// Detrending of a height map.

@@ -362,6 +362,45 @@ pub fn parse_pixel_size(text: &str) -> Result<(f64, f64)> {
     Ok((x, y))
 }
 
+/// A pixel size with its uncertainty: `200nm±1%`, `200nm+-2nm`, `200x210nm±0.5%`, or a pixel
+/// size alone ([`parse_pixel_size`]; uncertainty `None`). The uncertainty is relative (0.01 for
+/// ±1 %): a percentage, or a length relative to the larger side. `+/-` and `+-` stand for `±`.
+pub fn parse_pixel_size_uncertain(text: &str) -> Result<((f64, f64), Option<f64>)> {
+    let split = ["±", "+/-", "+-"]
+        .iter()
+        .find_map(|sep| text.split_once(sep));
+    let Some((size, uncertainty)) = split else {
+        return Ok((parse_pixel_size(text)?, None));
+    };
+    let (x, y) = parse_pixel_size(size.trim())?;
+    let u = parse_relative_uncertainty(uncertainty, Some(x.max(y)))
+        .map_err(|e| Error::InvalidArgument(format!("'{text}': {e}")))?;
+    Ok(((x, y), Some(u)))
+}
+
+/// A relative uncertainty: `1%`, `0.01`, or (when `of` is given) a length such as `2nm`
+/// relative to `of` metres. Negative or non-finite values are refused.
+pub fn parse_relative_uncertainty(text: &str, of: Option<f64>) -> Result<f64> {
+    let t = text.trim();
+    let value = if let Some(pct) = t.strip_suffix('%') {
+        parse_number(pct.trim(), text)? / 100.0
+    } else if let Ok(v) = t.parse::<f64>() {
+        v
+    } else if let Some(of) = of {
+        parse_quantity(t, Dimension::Length)? / of
+    } else {
+        return Err(Error::InvalidArgument(format!(
+            "'{text}' is not a relative uncertainty: give a percentage (1%) or a fraction (0.01)"
+        )));
+    };
+    if !(value >= 0.0 && value.is_finite()) {
+        return Err(Error::InvalidArgument(format!(
+            "the uncertainty '{text}' must be 0 or positive"
+        )));
+    }
+    Ok(value)
+}
+
 /// Format a length in metres in the most readable unit (`200 nm`, `2.49 µm`).
 pub fn format_length(metres: f64) -> String {
     let abs = metres.abs();
@@ -395,6 +434,26 @@ mod tests {
         assert!(parse_value_list("1..10MPa/nm", &k).is_err());
     }
     use approx::assert_relative_eq;
+
+    #[test]
+    fn pixel_sizes_carry_an_uncertainty_in_percent_or_length() {
+        let p = parse_pixel_size_uncertain;
+        assert_eq!(p("200nm").unwrap(), ((200e-9, 200e-9), None));
+        let ((x, y), u) = p("200nm±1%").unwrap();
+        assert_eq!((x, y), (200e-9, 200e-9));
+        assert_relative_eq!(u.unwrap(), 0.01);
+        assert_relative_eq!(p("200nm +- 2nm").unwrap().1.unwrap(), 0.01);
+        assert_relative_eq!(p("200x250nm+/-0.5%").unwrap().1.unwrap(), 0.005);
+        assert_eq!(p("200x250nm±5nm").unwrap().0, (200e-9, 250e-9));
+        assert_relative_eq!(p("200x250nm±5nm").unwrap().1.unwrap(), 0.02);
+        assert!(p("200nm±").is_err());
+        assert!(p("200nm±-1%").is_err());
+        assert!(p("200±1%").is_err());
+        assert!(p("200nm±2mN").is_err());
+        assert_relative_eq!(parse_relative_uncertainty("0.5 %", None).unwrap(), 0.005);
+        assert_relative_eq!(parse_relative_uncertainty("0.02", None).unwrap(), 0.02);
+        assert!(parse_relative_uncertainty("2nm", None).is_err());
+    }
 
     #[test]
     fn parses_units_and_rejects_missing_or_unknown_ones() {

@@ -155,6 +155,16 @@ impl serde::Serialize for Qs<'_> {
     }
 }
 
+/// An interval (lo, hi) of one quantity, written as a two-element list.
+#[derive(Debug, Clone, Copy)]
+pub struct Interval(pub f64, pub f64, pub Unit);
+
+impl serde::Serialize for Interval {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq([self.2.apply(self.0), self.2.apply(self.1)])
+    }
+}
+
 macro_rules! quantities {
     ($($(#[$doc:meta])* $name:ident, $opt:ident, $each:ident: $unit:ident;)*) => {$(
         $(#[$doc])*

@@ -1,5 +1,5 @@
 //! What one command wrote, read back as the input of another: `analyze`'s `areas.csv`
-//! ([`read_areas_csv`], for `friction` and `fit-hardening`), a `simulate` output folder's contact
+//! ([`read_areas_csv`] for `friction`, [`read_measured`] with the intervals for `fit-hardening`), a `simulate` output folder's contact
 //! maps ([`simulated_maps`], for `compare`) and the FWHM in `psf`'s `psf.json`
 //! ([`fwhm_from_psf_json`]).
 
@@ -10,6 +10,7 @@ use serde_json::Value;
 use super::table::Table;
 use crate::error::{Error, Location, Result};
 use contactscope::compare::SimulatedMap;
+use contactscope::model_fit::Measured;
 use contactscope::optics::blur::Grid;
 use contactscope_formats::ranges::Quantity;
 use contactscope_formats::tiff::read_image;
@@ -19,7 +20,65 @@ use contactscope_formats::tiff::write::quantity;
 /// `area_um2`); a table in pixels is refused with a hint, as is one without rows. Rows at 0 N
 /// (reference frames recorded before loading) are left out.
 pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
+    Ok(read_area_rows(&Table::read(path)?, path)?
+        .into_iter()
+        .map(|(_, f, a)| (f, a))
+        .collect())
+}
+
+/// The measured curve of an `analyze` areas.csv ([`read_areas_csv`]) with each area's interval
+/// (`area_um2_lo`, `area_um2_hi`) where the table has them, and the pixel size's uncertainty
+/// (`pixel_size_uncertainty_pct`, the same on every row; 0 without the column), which the
+/// intervals carry and which is taken out of them here so that the fit's bootstrap can share
+/// it among the loads ([`contactscope::model_fit::interval`]).
+pub fn read_measured(path: &Path) -> Result<Measured> {
     let table = Table::read(path)?;
+    let rows = read_area_rows(&table, path)?;
+    let has = |name: &str| table.header().iter().any(|h| h == name);
+    let bad = |e: contactscope::Error| Error::bad_input(Location::file(path), e.to_string());
+    if !(has("area_um2_lo") && has("area_um2_hi")) {
+        return Measured::new(rows.into_iter().map(|(_, f, a)| (f, a)).collect()).map_err(bad);
+    }
+    let lo = table.numbers("area_um2_lo", 1e-12)?;
+    let hi = table.numbers("area_um2_hi", 1e-12)?;
+    let u = if has("pixel_size_uncertainty_pct") {
+        let values = table.numbers("pixel_size_uncertainty_pct", 0.01)?;
+        let first = values.first().copied().unwrap_or(0.0);
+        if let Some(k) = values.iter().position(|&v| v != first) {
+            return Err(Error::bad_input(
+                Location::file(format!("{}:{}", path.display(), table.line(k))),
+                "pixel_size_uncertainty_pct differs from the first row's: one series has one \
+                 pixel size",
+            ));
+        }
+        crate::analyze::check_pixel_size_uncertainty(first)
+            .map_err(|e| Error::bad_input(Location::file(path), e.to_string()))?;
+        first
+    } else {
+        0.0
+    };
+    let mut points = Vec::with_capacity(rows.len());
+    for (k, force, area) in rows {
+        let (l, h) = (lo[k] / (1.0 - u).powi(2), hi[k] / (1.0 + u).powi(2));
+        // The interval must hold the area (up to the rounding of the written digits).
+        if !(l >= 0.0 && l <= area * (1.0 + 1e-9) && h >= area * (1.0 - 1e-9)) {
+            return Err(Error::bad_input(
+                Location::file(format!("{}:{}", path.display(), table.line(k))),
+                format!(
+                    "area_um2_lo..area_um2_hi = {:e}..{:e} µm² does not hold area_um2 = {:e} µm²",
+                    lo[k] * 1e12,
+                    hi[k] * 1e12,
+                    area * 1e12
+                ),
+            ));
+        }
+        points.push((force, area, l.min(area), h.max(area)));
+    }
+    Measured::with_intervals(points, u).map_err(bad)
+}
+
+/// (data row, force N, area m²) of the rows with a positive force ([`read_areas_csv`]).
+fn read_area_rows(table: &Table, path: &Path) -> Result<Vec<(usize, f64, f64)>> {
     let force_column = table
         .one_of(&["force_mN", "force_N"])?
         .ok_or_else(|| table.missing("force", &["force_mN", "force_N"]))?;
@@ -65,7 +124,7 @@ pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
                 ),
             ));
         }
-        rows.push((force, area));
+        rows.push((k, force, area));
     }
     if rows.is_empty() {
         return Err(Error::bad_input(

@@ -258,14 +258,17 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
             modulus: Optional[float] = None, masks: bool = False,
             out: Optional[PathLike] = None, overlays: bool = False, save_masks: bool = False,
             command_line: Optional[Sequence[str]] = None,
-            progress: Optional[Any] = None) -> Results:
+            progress: Optional[Any] = None,
+            pixel_size_uncertainty: float = 0.0) -> Results:
     """The paper's series analysis, the command line's ``analyze``: one global Otsu threshold
     over all images, then each image measured. ``series``: a :class:`Series` (its files are read
     as the command line reads them, with its forces and pixel size unless given here) or
     images (2-D, 3-D stack or list, in their stored sample type). ``forces`` in N,
     ``pixel_size`` in m; ``method``: "otsu" (default), "per-image" or a fixed threshold; the
     Hertz reference columns with ``radius`` (m) and ``modulus`` (Pa); ``masks``: also return the
-    contact masks (images, rows, columns) as ``masks``.
+    contact masks (images, rows, columns) as ``masks``. ``pixel_size_uncertainty``: the pixel
+    size's relative uncertainty as bounds (0.01 for ±1 %, the command line's
+    ``--pixel-size-uncertainty``); it widens ``area_m2_lo``/``_hi`` and the fit intervals.
 
     Returns the outcome the command line writes as ``summary.json`` and ``areas.csv``, in SI
     units: ``rows`` (per image: ``image``, ``page``, ``force_n``, ``threshold``,
@@ -289,7 +292,9 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
     result = Results(_cs.analyze(_images(series), forces, pixel_size, method, radius, modulus,
                                  masks, None if out is None else os.fspath(out),
                                  _command_line(command_line, "analyze", out), bool(overlays),
-                                 bool(save_masks), progress), table="rows")
+                                 bool(save_masks), progress,
+                                 _number(pixel_size_uncertainty, "pixel_size_uncertainty",
+                                         "fraction (0.01 for ±1 %)")), table="rows")
     _warn(result)
     return result
 
@@ -612,6 +617,15 @@ class FitResults(Results):
         return b.get("k_pa_per_m_se", b.get("hardness_pa_se"))
 
     @property
+    def parameter_ci95(self) -> Optional["tuple[float, float]"]:
+        """The 95 % interval (lo, hi) of k (Pa/m) or p_Y (Pa) of the best model, from the
+        measured areas' intervals and the scatter about the fit; ``None`` where it cannot be
+        estimated."""
+        b = self.best
+        ci = b.get("k_pa_per_m_ci95", b.get("hardness_pa_ci95"))
+        return None if ci is None else (ci[0], ci[1])
+
+    @property
     def misfit(self) -> float:
         return self.best["misfit_rms_ln_area"]
 
@@ -637,10 +651,13 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
                   imaging_pixel_size: Optional[PixelSize] = None, client: Any = None, *,
                   detrend: str = "plane", periodic: bool = False,
                   height_unit: Optional[float] = None, channel: Optional[str] = None,
-                  fill_invalid: Optional[str] = None, device: str = "cpu") -> FitResults:
+                  fill_invalid: Optional[str] = None, device: str = "cpu",
+                  area_intervals: Optional[Any] = None) -> FitResults:
     """Fit contact models to a measured area–load curve: the command line's ``fit-hardening``,
-    with its defaults, checks and warnings. The curve: ``forces`` (N) and ``areas`` (m²), or
-    ``forces`` an ``areas.csv`` written by ``analyze`` (``areas`` None). The rough sphere:
+    with its defaults, checks and warnings. The curve: ``forces`` (N) and ``areas`` (m²), with
+    each area's interval as ``area_intervals`` = (lower ends, upper ends) in m² when known (the
+    ``area_m2_lo``, ``area_m2_hi`` of :func:`analyze`), or ``forces`` an ``areas.csv`` written by
+    ``analyze`` (``areas`` None; its intervals are read from it). The rough sphere:
     ``heights`` (a height-map file, or an array in m with ``pixel_size`` in m; detrended by
     ``detrend``), sphere ``radius`` (m), E* ``modulus`` (Pa). ``family``: one model or a list
     ("elastic", "gt", "hardness", "hardening"); "hardening" fits k (Pa/m; default range
@@ -650,8 +667,9 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
     file is read as the command line reads ``--topography`` (``height_unit``, ``channel``,
     ``fill_invalid``). ``device`` as :func:`simulate` (``device`` in ``fit.json`` says which ran).
 
-    Returns a :class:`FitResults` (``parameter``, ``parameter_se``, ``misfit``, ``areas_m2``,
-    ``trace`` of the best model; the whole ``fit.json`` in SI units). With a
+    Returns a :class:`FitResults` (``parameter``, ``parameter_se``, ``parameter_ci95`` (the 95 %
+    interval), ``misfit``, ``areas_m2``, ``trace`` of the best model; the whole ``fit.json`` in SI
+    units). With a
     ``dask.distributed`` ``client``, the model evaluations run as Dask tasks
     (:func:`contactscope.distributed.fit_hardening`).
     """
@@ -669,13 +687,19 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
                                          imaging_pixel_size=imaging_pixel_size, client=client,
                                          device=device)
     if isinstance(forces, (str, os.PathLike)):
-        if areas is not None:
+        if areas is not None or area_intervals is not None:
             raise InputError("give forces and areas, or an areas.csv alone")
         measured: Any = os.fspath(forces)
     else:
         if areas is None:
             raise InputError("areas (m²) are needed with forces (N)")
         measured = (_numbers(forces, "forces", "N"), _numbers(areas, "areas", "m²"))
+        if area_intervals is not None:
+            if not (isinstance(area_intervals, (tuple, list)) and len(area_intervals) == 2):
+                raise InputError("area_intervals= must be (lower ends, upper ends) in m²; got "
+                                 f"{type(area_intervals).__name__}")
+            measured = measured + (_numbers(area_intervals[0], "area_intervals", "m²"),
+                                   _numbers(area_intervals[1], "area_intervals", "m²"))
     result = FitResults(_cs.fit_hardening(measured, _heights(heights), pixel_size,
                                           _number(modulus, "modulus", "Pa"), radius, families,
                                           range, grid, ln_tolerance, tolerance, max_iterations,

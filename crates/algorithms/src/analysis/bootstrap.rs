@@ -11,6 +11,11 @@
 //! proportional law are refitted to each resample; the interval is the 2.5th and 97.5th
 //! percentiles of the refitted values. The generator is seeded: the same inputs give the same
 //! interval.
+//!
+//! The pixel size's calibration (a relative uncertainty u, taken as bounds: the true pixel size
+//! lies within ±u of the stated one) is shared by every image of a series: each resample draws
+//! one factor (1 + u·t)², t uniform on [−1, 1], and multiplies every area by it. It moves the
+//! prefactor and the mean pressure; it cannot move the exponent.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -48,9 +53,15 @@ impl FitIntervals {
 }
 
 /// The intervals from `forces` and each image's area interval [`lo`, `hi`] (same units as the
-/// fits), over the images given (the caller leaves out those the fits leave out). `None` with
-/// fewer than three images or two distinct forces, or when too few resamples can be fitted.
-pub fn fit_intervals(forces: &[f64], lo: &[f64], hi: &[f64]) -> Option<FitIntervals> {
+/// fits; without the calibration), over the images given (the caller leaves out those the fits
+/// leave out), and the pixel size's relative uncertainty `calibration` (0 for none). `None`
+/// with fewer than three images or two distinct forces, or when too few resamples can be fitted.
+pub fn fit_intervals(
+    forces: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+    calibration: f64,
+) -> Option<FitIntervals> {
     let n = forces.len();
     if n < 3 || lo.len() != n || hi.len() != n {
         return None;
@@ -66,11 +77,12 @@ pub fn fit_intervals(forces: &[f64], lo: &[f64], hi: &[f64]) -> Option<FitInterv
     let mut laws = Vec::new();
     let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
     for _ in 0..RESAMPLES {
+        let scale = calibration_factor(&mut rng, calibration);
         for k in 0..n {
             let i = rng.random_range(0..n);
             let u: f64 = rng.random();
             x[k] = forces[i];
-            y[k] = lo[i] + u * (hi[i] - lo[i]);
+            y[k] = scale * (lo[i] + u * (hi[i] - lo[i]));
         }
         if let Some(f) = fit_power_law(&x, &y) {
             exponents.push(f.exponent);
@@ -93,8 +105,19 @@ pub fn fit_intervals(forces: &[f64], lo: &[f64], hi: &[f64]) -> Option<FitInterv
     })
 }
 
+/// The factor on every area of one resample from a pixel size known to within ±`u` (relative):
+/// (1 + u·t)², t uniform on [−1, 1]; exactly 1 when `u` is 0 (and no number is drawn).
+pub fn calibration_factor(rng: &mut impl Rng, u: f64) -> f64 {
+    if u > 0.0 {
+        let t: f64 = rng.random_range(-1.0..=1.0);
+        (1.0 + u * t).powi(2)
+    } else {
+        1.0
+    }
+}
+
 /// The 2.5th and 97.5th percentiles (nearest rank).
-fn percentiles(v: &mut [f64]) -> Option<(f64, f64)> {
+pub fn percentiles(v: &mut [f64]) -> Option<(f64, f64)> {
     if v.is_empty() {
         return None;
     }
@@ -111,7 +134,7 @@ mod tests {
     fn exact_points_with_point_intervals_give_the_exponent_itself() {
         let forces = [1.0, 2.0, 4.0, 8.0, 16.0];
         let areas: Vec<f64> = forces.iter().map(|f: &f64| 3.0 * f.powf(0.8)).collect();
-        let i = fit_intervals(&forces, &areas, &areas).unwrap();
+        let i = fit_intervals(&forces, &areas, &areas, 0.0).unwrap();
         assert!((i.exponent.0 - 0.8).abs() < 1e-12 && (i.exponent.1 - 0.8).abs() < 1e-12);
         assert!((i.prefactor.0 - 3.0).abs() < 1e-9, "{i:?}");
     }
@@ -123,7 +146,7 @@ mod tests {
         let truth: Vec<f64> = forces.iter().map(|f: &f64| 10.0 * f.powf(0.8)).collect();
         let lo: Vec<f64> = truth.iter().map(|a| a * 0.93).collect();
         let hi: Vec<f64> = truth.iter().map(|a| a * 1.03).collect();
-        let i = fit_intervals(&forces, &lo, &hi).unwrap();
+        let i = fit_intervals(&forces, &lo, &hi, 0.0).unwrap();
         assert!(i.exponent.0 < 0.8 && 0.8 < i.exponent.1, "{i:?}");
         assert!(i.exponent.1 - i.exponent.0 < 0.05, "{i:?}");
         assert!(i.prefactor.0 < 10.0 && 10.0 < i.prefactor.1, "{i:?}");
@@ -132,15 +155,43 @@ mod tests {
         // In other units, converted resample by resample: the identity gives the same interval.
         assert_eq!(i.prefactor_in(|c, _| c), Some(i.prefactor));
         // Deterministic: the same inputs give the same interval.
-        assert_eq!(fit_intervals(&forces, &lo, &hi), Some(i));
+        assert_eq!(fit_intervals(&forces, &lo, &hi, 0.0), Some(i));
     }
 
     #[test]
     fn too_few_images_give_no_interval() {
-        assert_eq!(fit_intervals(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 2.0]), None);
         assert_eq!(
-            fit_intervals(&[2.0, 2.0, 2.0], &[1.0, 1.0, 1.0], &[2.0, 2.0, 2.0]),
+            fit_intervals(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 2.0], 0.0),
             None
         );
+        assert_eq!(
+            fit_intervals(&[2.0, 2.0, 2.0], &[1.0, 1.0, 1.0], &[2.0, 2.0, 2.0], 0.0),
+            None
+        );
+    }
+
+    #[test]
+    fn a_shared_calibration_widens_the_prefactor_not_the_exponent() {
+        let forces = [4.0, 6.0, 10.0, 16.0, 25.0, 40.0, 63.0, 100.0];
+        let lo: Vec<f64> = forces.iter().map(|f: &f64| 9.5 * f.powf(0.8)).collect();
+        let hi: Vec<f64> = forces.iter().map(|f: &f64| 10.5 * f.powf(0.8)).collect();
+        let exact = fit_intervals(&forces, &lo, &hi, 0.0).unwrap();
+        let calibrated = fit_intervals(&forces, &lo, &hi, 0.05).unwrap();
+        let width = |(a, b): (f64, f64)| b - a;
+        // ±5 % in the pixel size is about ±10 % in every area at once.
+        assert!(
+            width(calibrated.prefactor) > 1.5 * width(exact.prefactor),
+            "{exact:?} {calibrated:?}"
+        );
+        assert!(calibrated.prefactor.0 < 9.5 && calibrated.prefactor.1 > 10.5);
+        // A factor shared by all areas leaves the exponent where it was (to the resampling's
+        // noise: the uniform draws within each interval are the same stream shifted by one).
+        assert!((width(calibrated.exponent) - width(exact.exponent)).abs() < 0.01);
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        assert_eq!(calibration_factor(&mut rng, 0.0), 1.0);
+        for _ in 0..100 {
+            let f = calibration_factor(&mut rng, 0.01);
+            assert!((0.99f64.powi(2)..=1.01f64.powi(2)).contains(&f));
+        }
     }
 }

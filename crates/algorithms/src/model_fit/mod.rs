@@ -7,9 +7,12 @@
 //! paper; penetration hardness p_Y) are fitted by a log-spaced grid evaluated in parallel, then
 //! Brent's method (`argmin`) on ln(parameter) around the best grid point. The standard error comes from
 //! the Gauss–Newton approximation at the optimum: var(ln p) = s²/ΣJ², with J = ∂ ln A_sim/∂ ln p by
-//! central differences and s² = Σr²/(n − 1). The parameter-free models (elastic, GT) are evaluated
+//! central differences and s² = Σr²/(n − 1); the 95 % interval by a bootstrap on the same
+//! linearisation ([`interval`]). The parameter-free models (elastic, GT) are evaluated
 //! once. Hardening and hardness runs load in increasing force order, carrying the plastic
 //! deformation from load to load, as an experiment's load ramp does.
+
+pub mod interval;
 
 use std::sync::{Arc, Mutex};
 
@@ -106,6 +109,13 @@ pub struct ModelFit {
     pub best: Evaluation,
     /// Standard error of the parameter (same unit), when it can be estimated.
     pub parameter_se: Option<f64>,
+    /// 95 % interval of the parameter (same unit) from the measured areas' intervals and the
+    /// scatter about the fit ([`interval::parameter_interval`]), when it can be estimated.
+    pub parameter_ci95: Option<(f64, f64)>,
+    /// J_i = ∂ ln A_sim,i/∂ ln p at the optimum per measured load (central differences 5 %
+    /// either side), when they could be computed: what the standard error and the interval
+    /// are made from.
+    pub sensitivities: Option<Vec<f64>>,
     /// Every (parameter, misfit) evaluated, in order of evaluation.
     pub trace: Vec<(f64, f64)>,
     /// The optimum lies at an end of the search range.
@@ -206,6 +216,11 @@ pub struct Measured {
     pub forces_n: Vec<f64>,
     /// Contact areas, m².
     pub areas_m2: Vec<f64>,
+    /// Each area's interval (lo, hi), m², without the pixel size's calibration (`analyze`'s
+    /// edge band); `None` when the measured curve carries none.
+    pub intervals_m2: Option<Vec<(f64, f64)>>,
+    /// Relative uncertainty (bounds) of the micrographs' pixel size, shared by every area.
+    pub pixel_size_uncertainty: f64,
 }
 
 impl Measured {
@@ -230,7 +245,36 @@ impl Measured {
         Ok(Measured {
             forces_n: points.iter().map(|p| p.0).collect(),
             areas_m2: points.iter().map(|p| p.1).collect(),
+            intervals_m2: None,
+            pixel_size_uncertainty: 0.0,
         })
+    }
+
+    /// Points (force N, area m², lo m², hi m²) with each area's interval, sorted by force, and
+    /// the pixel size's relative uncertainty; errors as [`Measured::new`], for an interval
+    /// that does not hold its area, or for an uncertainty outside [0, 0.5).
+    pub fn with_intervals(
+        mut points: Vec<(f64, f64, f64, f64)>,
+        pixel_size_uncertainty: f64,
+    ) -> Result<Self> {
+        if let Some(&(f, a, lo, hi)) = points
+            .iter()
+            .find(|(_, a, lo, hi)| !(*lo >= 0.0 && lo <= a && a <= hi && hi.is_finite()))
+        {
+            return Err(Error::InvalidArgument(format!(
+                "the interval {lo:e}..{hi:e} m² of the area {a:e} m² at {f} N does not hold it"
+            )));
+        }
+        if !(0.0..0.5).contains(&pixel_size_uncertainty) {
+            return Err(Error::InvalidArgument(format!(
+                "the pixel size's relative uncertainty {pixel_size_uncertainty} must lie in [0, 0.5)"
+            )));
+        }
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut measured = Measured::new(points.iter().map(|p| (p.0, p.1)).collect())?;
+        measured.intervals_m2 = Some(points.iter().map(|p| (p.2, p.3)).collect());
+        measured.pixel_size_uncertainty = pixel_size_uncertainty;
+        Ok(measured)
     }
 
     /// RMS of ln(A_sim/A_exp); a load without simulated contact counts as a hundredth of the
@@ -497,11 +541,29 @@ pub fn fit_parameter(
     })?;
     let trace = trace.into_inner().expect("trace");
     let best_eval = body.score(family, Some(ln_best.exp()), measured, false)?;
-    let (parameter_se, undetermined) = standard_error(body, family, measured, ln_best, &best_eval)?;
+    let jacobian = sensitivity(body, family, measured, ln_best)?;
+    let undetermined = jacobian
+        .as_ref()
+        .is_some_and(|j| j.iter().all(|&v| v == 0.0));
+    let (parameter_se, parameter_ci95) = match (&jacobian, undetermined) {
+        (Some(j), false) => (
+            standard_error(measured, ln_best, j, &best_eval),
+            interval::parameter_interval(
+                ln_best,
+                j,
+                &best_eval.areas_m2,
+                measured,
+                body.imaging.is_some(),
+            ),
+        ),
+        _ => (None, None),
+    };
     Ok(ModelFit {
         family,
         best: best_eval,
         parameter_se,
+        parameter_ci95,
+        sensitivities: jacobian,
         trace,
         at_range_edge,
         undetermined,
@@ -542,42 +604,52 @@ fn brent_minimum(lo: f64, hi: f64, width: f64, f: &(dyn Fn(f64) -> f64 + Sync)) 
 /// log ratios, of order 1).
 const INFEASIBLE_MISFIT: f64 = 1e6;
 
-/// Gauss–Newton standard error of the parameter at `ln_best` (see the module docs), and whether
-/// the response is flat there (the parameter undetermined). No standard error with a single load,
-/// next to an infeasible region or with a flat response.
-fn standard_error(
+/// J = ∂ ln A_sim/∂ ln p at `ln_best` for each measured load, by central differences 5 % either
+/// side (see the module docs); all zero when the response is flat there (the parameter is
+/// undetermined). `None` with a single load or next to an infeasible region (no two-sided
+/// derivative).
+fn sensitivity(
     body: &ModelBody,
     family: Family,
     measured: &Measured,
     ln_best: f64,
-    best: &Evaluation,
-) -> Result<(Option<f64>, bool)> {
-    let n = measured.areas_m2.len();
-    if n < 2 {
-        return Ok((None, false));
+) -> Result<Option<Vec<f64>>> {
+    if measured.areas_m2.len() < 2 {
+        return Ok(None);
     }
     let h = 0.05;
     let sides: Result<Vec<Vec<f64>>> = [ln_best - h, ln_best + h]
         .par_iter()
         .map(|&x| Ok(body.score(family, Some(x.exp()), measured, false)?.areas_m2))
         .collect();
-    // Next to an infeasible region there is no two-sided derivative.
     let Ok(sides) = sides else {
-        return Ok((None, false));
+        return Ok(None);
     };
-    let jacobian: Vec<f64> = sides[0]
-        .iter()
-        .zip(&sides[1])
-        .map(|(lo, hi)| (hi.max(1e-300).ln() - lo.max(1e-300).ln()) / (2.0 * h))
-        .collect();
+    Ok(Some(
+        sides[0]
+            .iter()
+            .zip(&sides[1])
+            .map(|(lo, hi)| (hi.max(1e-300).ln() - lo.max(1e-300).ln()) / (2.0 * h))
+            .collect(),
+    ))
+}
+
+/// Gauss–Newton standard error of the parameter at `ln_best` from the sensitivities `jacobian`
+/// (see the module docs); `None` when they are all zero.
+fn standard_error(
+    measured: &Measured,
+    ln_best: f64,
+    jacobian: &[f64],
+    best: &Evaluation,
+) -> Option<f64> {
+    let n = measured.areas_m2.len();
     let jtj: f64 = jacobian.iter().map(|j| j * j).sum();
-    if jtj <= 0.0 {
-        // The areas are the same on both sides: the data do not fix the parameter.
-        return Ok((None, true));
+    if jtj <= 0.0 || n < 2 {
+        return None;
     }
     let residuals = measured.log_residuals(&best.areas_m2);
     let s2 = residuals.iter().map(|r| r * r).sum::<f64>() / (n - 1) as f64;
-    Ok((Some(ln_best.exp() * (s2 / jtj).sqrt()), false))
+    Some(ln_best.exp() * (s2 / jtj).sqrt())
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@ pub use report::{AreaTable, AreaUnit, Fits, HertzParams, InputFacts, Row, Thresh
 
 use crate::error::Result;
 use crate::fits::{self, Source};
+use crate::lab;
 use crate::series::{self, Micrographs, OpenSeries, Series, DEFAULT_MEMORY_BUDGET};
 
 /// Everything `analyze` needs. SI units.
@@ -32,6 +33,9 @@ pub struct AnalyzeRequest {
     /// Pixel size (x, y), m, overriding the files' metadata (needed for areas in µm² of
     /// planes in memory).
     pub pixel_size_m: Option<(f64, f64)>,
+    /// Relative uncertainty of the pixel size (given or from the files), as bounds: 0.01 for
+    /// ±1 %. 0 takes it as exact. Widens the area intervals and the fit intervals.
+    pub pixel_size_uncertainty: f64,
     /// Hertz reference columns.
     pub hertz: Option<HertzParams>,
     /// Bytes of decoded planes of compressed files kept between the two passes.
@@ -45,6 +49,7 @@ impl AnalyzeRequest {
             micrographs,
             method: Method::GlobalOtsu,
             pixel_size_m: None,
+            pixel_size_uncertainty: 0.0,
             hertz: None,
             memory_budget: DEFAULT_MEMORY_BUDGET,
         }
@@ -57,6 +62,7 @@ impl AnalyzeRequest {
             Quantity::PixelSize.check(x, Param::PixelSize)?;
             Quantity::PixelSize.check(y, Param::PixelSize)?;
         }
+        check_pixel_size_uncertainty(self.pixel_size_uncertainty)?;
         if let Some(h) = self.hertz {
             Quantity::Radius.check(h.radius_m, Param::Radius)?;
             Quantity::Modulus.check(h.modulus_pa, Param::Modulus)?;
@@ -66,6 +72,23 @@ impl AnalyzeRequest {
 }
 
 pub use crate::fits::IMPLAUSIBLE_PRESSURE_PA;
+
+/// The largest relative uncertainty of a pixel size that is taken (beyond it the calibration is
+/// not a calibration).
+pub const MAX_PIXEL_SIZE_UNCERTAINTY: f64 = 0.2;
+
+/// A pixel size's relative uncertainty in [0, [`MAX_PIXEL_SIZE_UNCERTAINTY`]].
+pub fn check_pixel_size_uncertainty(u: f64) -> Result<()> {
+    if (0.0..=MAX_PIXEL_SIZE_UNCERTAINTY).contains(&u) {
+        return Ok(());
+    }
+    Err(crate::error::Error::InvalidArgument(format!(
+        "{}: the pixel size's uncertainty {} % must lie between 0 and {} %",
+        Param::PixelSizeUncertainty,
+        short(u * 100.0),
+        short(MAX_PIXEL_SIZE_UNCERTAINTY * 100.0)
+    )))
+}
 
 /// What `analyze` found: `summary.json` (without `rows`, which is `areas.csv`).
 #[derive(Debug, Clone, Serialize)]
@@ -102,8 +125,39 @@ pub struct AreaIntervalFacts {
     pub band_half_width: f64,
     /// Standard deviations of the noise term.
     pub noise_sd_multiple: f64,
+    /// The pixel size's relative uncertainty (bounds) the interval carries, 0 when the pixel
+    /// size is taken as exact (or areas are in pixels).
+    #[serde(
+        rename = "pixel_size_uncertainty_pct",
+        serialize_with = "lab::fraction_as_pct"
+    )]
+    pub pixel_size_uncertainty: f64,
+    /// How the pixel size's uncertainty enters.
+    pub calibration: &'static str,
     /// What the interval does not carry.
     pub not_included: &'static str,
+}
+
+impl AreaIntervalFacts {
+    /// The facts of intervals carrying the pixel size's relative uncertainty `u` (0: none).
+    pub fn with_calibration(u: f64) -> Self {
+        AreaIntervalFacts {
+            pixel_size_uncertainty: u,
+            calibration: if u > 0.0 {
+                "the pixel size within ±u of its value: lo × (1 − u)², hi × (1 + u)²; in the fit \
+                 intervals one factor (1 + u·t)², t uniform on [−1, 1], shared by all images"
+            } else {
+                "none: the pixel size is taken as exact (give its uncertainty as \
+                 --pixel-size 200nm±1% or --pixel-size-uncertainty 1%)"
+            },
+            not_included: if u > 0.0 {
+                "the forces' calibration"
+            } else {
+                "the pixel size's calibration; the forces' calibration"
+            },
+            ..AreaIntervalFacts::default()
+        }
+    }
 }
 
 impl Default for AreaIntervalFacts {
@@ -116,7 +170,9 @@ impl Default for AreaIntervalFacts {
             level_pct: 95.0,
             band_half_width: EDGE_BAND_HALF_WIDTH,
             noise_sd_multiple: NOISE_WIDENING,
-            not_included: "the pixel size's calibration",
+            pixel_size_uncertainty: 0.0,
+            calibration: "none: the pixel size is taken as exact",
+            not_included: "the pixel size's calibration; the forces' calibration",
         }
     }
 }
@@ -210,7 +266,18 @@ pub fn run_open(
         sink,
     )?;
     warnings.append(&mut analysis.warnings);
-    let (rows, fits) = report::table_and_fits(series, &analysis, request.hertz);
+    let (rows, fits) = report::table_and_fits(
+        series,
+        &analysis,
+        request.hertz,
+        request.pixel_size_uncertainty,
+    );
+    if request.pixel_size_uncertainty > 0.0 && rows.unit == AreaUnit::Pixel {
+        warnings.push(format!(
+            "{} is ignored: without a pixel size the areas are in pixels",
+            Param::PixelSizeUncertainty
+        ));
+    }
     for (row, image) in rows.rows.iter().zip(&series.images) {
         let (Some(p), Some(f)) = (row.mean_pressure_mpa, row.force_mn) else {
             continue;
@@ -252,7 +319,7 @@ pub fn run_open(
         threshold: ThresholdFacts::of(&analysis, open.sample_type().is_integer()),
         area_unit: rows.unit,
         fits,
-        area_interval: AreaIntervalFacts::default(),
+        area_interval: AreaIntervalFacts::with_calibration(rows.pixel_size_uncertainty),
         hertz: request.hertz,
         warnings,
         rows,

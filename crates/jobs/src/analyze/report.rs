@@ -15,7 +15,7 @@ use contactscope::mechanics::hertz;
 use contactscope_formats::microscopy::select::{LoadAxis, Selection};
 
 use crate::fits::{fit_points, Exclusion, LoadPoint};
-use crate::lab::{self, OptQ, Unit, Q};
+use crate::lab::{self, Interval, OptQ, Unit, Q};
 use crate::series::Series;
 
 /// Sphere radius and contact modulus for the Hertz reference columns.
@@ -185,6 +185,10 @@ pub struct AreaTable {
     pub has_friction: bool,
     /// Whether the Hertz columns are written.
     pub has_hertz: bool,
+    /// Relative uncertainty (bounds) of the pixel size, carried by `area_*_lo`/`_hi`; written
+    /// as the column `pixel_size_uncertainty_pct` when it is not 0 (so that `fit-hardening`
+    /// can tell the part every image shares from each image's own).
+    pub pixel_size_uncertainty: f64,
     /// One row per image, in input order.
     pub rows: Vec<Row>,
 }
@@ -205,6 +209,12 @@ impl Serialize for RowOf<'_> {
         m.serialize_entry(&format!("area_{a}"), &Q(r.area, t.unit.area()))?;
         m.serialize_entry(&format!("area_{a}_lo"), &Q(r.area_lo, t.unit.area()))?;
         m.serialize_entry(&format!("area_{a}_hi"), &Q(r.area_hi, t.unit.area()))?;
+        if t.pixel_size_uncertainty > 0.0 {
+            m.serialize_entry(
+                "pixel_size_uncertainty_pct",
+                &Q(t.pixel_size_uncertainty, Unit::FractionAsPct),
+            )?;
+        }
         m.serialize_entry("mean_intensity", &r.mean_intensity)?;
         m.serialize_entry("integrated_intensity", &r.integrated_intensity)?;
         m.serialize_entry("background_mean", &r.background_mean)?;
@@ -298,18 +308,6 @@ impl Serialize for Fits {
 
 struct PowerLawOf<'a>(AreaUnit, PowerLawFit, bool, Option<&'a FitIntervals>);
 
-/// An interval as a two-element list, each end in `unit`.
-struct Interval(f64, f64, Unit);
-
-impl Serialize for Interval {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut seq = s.serialize_seq(Some(2))?;
-        seq.serialize_element(&Q(self.0, self.2))?;
-        seq.serialize_element(&Q(self.1, self.2))?;
-        seq.end()
-    }
-}
-
 impl Serialize for PowerLawOf<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let (unit, f, si) = (self.0, &self.1, self.2);
@@ -385,15 +383,23 @@ impl Serialize for MinMax {
     }
 }
 
-/// The rows and fits of an analysis of `series`, image by image.
+/// The rows and fits of an analysis of `series`, image by image. `pixel_size_uncertainty` (the
+/// pixel size's relative uncertainty, as bounds) widens each area's interval by the factors
+/// (1 ∓ u)² and enters the fit intervals as a factor shared by all images; it is ignored for
+/// areas in pixels.
 pub fn table_and_fits(
     series: &Series,
     analysis: &Analysis,
     hertz: Option<HertzParams>,
+    pixel_size_uncertainty: f64,
 ) -> (AreaTable, Fits) {
     let unit = match analysis.pixel_size {
         Some(_) => AreaUnit::SquareMicrometre,
         None => AreaUnit::Pixel,
+    };
+    let u = match unit {
+        AreaUnit::SquareMicrometre => pixel_size_uncertainty,
+        AreaUnit::Pixel => 0.0,
     };
     let pixel_area = analysis.pixel_size.map_or(1.0, |p| p.area_um2());
     let rows: Vec<Row> = series
@@ -404,8 +410,8 @@ pub fn table_and_fits(
             let m = &r.measurement;
             let area = m.contact_pixels as f64 * pixel_area;
             let (area_lo, area_hi) = (
-                r.band.lo_pixels as f64 * pixel_area,
-                r.band.hi_pixels as f64 * pixel_area,
+                r.band.lo_pixels as f64 * pixel_area * (1.0 - u).powi(2),
+                r.band.hi_pixels as f64 * pixel_area * (1.0 + u).powi(2),
             );
             let force_mn = image.force_n.map(|f| f * 1e3);
             let pressure = |a: f64| match (unit, force_mn) {
@@ -445,10 +451,18 @@ pub fn table_and_fits(
     let (forces, areas) = fit_points(&points);
     // The same images as the fits, each with its area interval.
     let in_fit: Vec<&Row> = rows.iter().filter(|r| r.load_point().in_fit()).collect();
+    // The bands alone: the calibration enters the bootstrap as one factor for all images.
     let intervals = fit_intervals(
         &in_fit.iter().filter_map(|r| r.force_mn).collect::<Vec<_>>(),
-        &in_fit.iter().map(|r| r.area_lo).collect::<Vec<_>>(),
-        &in_fit.iter().map(|r| r.area_hi).collect::<Vec<_>>(),
+        &in_fit
+            .iter()
+            .map(|r| r.area_lo / (1.0 - u).powi(2))
+            .collect::<Vec<_>>(),
+        &in_fit
+            .iter()
+            .map(|r| r.area_hi / (1.0 + u).powi(2))
+            .collect::<Vec<_>>(),
+        u,
     );
     let proportional_mpa = match unit {
         AreaUnit::SquareMicrometre => fit_proportional(&forces, &areas)
@@ -477,6 +491,7 @@ pub fn table_and_fits(
         unit,
         has_friction: rows.iter().any(|r| r.friction_mn.is_some()),
         has_hertz: hertz.is_some(),
+        pixel_size_uncertainty: u,
         rows,
     };
     (table, fits)

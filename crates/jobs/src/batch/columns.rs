@@ -182,6 +182,10 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
             })
         }),
     );
+    t.float(
+        "pixel_size_uncertainty_pct",
+        r().map(|x| x.map(|x| x.pixel_size_uncertainty * 100.0)),
+    );
     t.text("area_unit", r().map(|x| x.map(|x| x.area_unit.clone())));
     fn max_force(x: &SeriesResult) -> Option<(f64, &ImageResult)> {
         x.images
@@ -211,6 +215,14 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
     t.float(
         "power_law_exponent_se",
         law().map(|p| p.and_then(|p| p.exponent_se)),
+    );
+    t.float(
+        "power_law_exponent_lo",
+        law().map(|p| p.and_then(|p| p.exponent_ci95).map(|c| c.0)),
+    );
+    t.float(
+        "power_law_exponent_hi",
+        law().map(|p| p.and_then(|p| p.exponent_ci95).map(|c| c.1)),
     );
     let prefactor = |want_um: bool| {
         r().map(move |x| {
@@ -264,6 +276,14 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
             fit().map(|f| f.and_then(|f| f.k_se_pa_per_m).map(|k| k * 1e-15)),
         );
         t.float(
+            "k_MPa_per_nm_lo",
+            fit().map(|f| f.and_then(|f| f.k_ci95_pa_per_m).map(|k| k.0 * 1e-15)),
+        );
+        t.float(
+            "k_MPa_per_nm_hi",
+            fit().map(|f| f.and_then(|f| f.k_ci95_pa_per_m).map(|k| k.1 * 1e-15)),
+        );
+        t.float(
             "hardening_misfit",
             fit().map(|f| f.and_then(|f| f.k_misfit)),
         );
@@ -274,6 +294,14 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
         t.float(
             "hardness_se_MPa",
             fit().map(|f| f.and_then(|f| f.hardness_se_pa).map(|p| p * 1e-6)),
+        );
+        t.float(
+            "hardness_MPa_lo",
+            fit().map(|f| f.and_then(|f| f.hardness_ci95_pa).map(|p| p.0 * 1e-6)),
+        );
+        t.float(
+            "hardness_MPa_hi",
+            fit().map(|f| f.and_then(|f| f.hardness_ci95_pa).map(|p| p.1 * 1e-6)),
         );
         t.float(
             "hardness_misfit",

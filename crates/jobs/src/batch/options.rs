@@ -101,6 +101,8 @@ options! {
     Threshold: "threshold", Analyze, "--threshold", "", None;
     /// Pixel size overriding the files' metadata.
     PixelSize: "pixel_size", Analyze, "--pixel-size", "", Some(Dimension::Length);
+    /// Relative uncertainty of the pixel size (`1%`), given or the files'.
+    PixelSizeUncertainty: "pixel_size_uncertainty", Analyze, "--pixel-size-uncertainty", "", None;
     /// Sphere radius (Hertz columns; the sphere of the fit).
     Radius: "radius", Both, "--radius", "--radius", Some(Dimension::Length);
     /// Contact modulus E* (Hertz columns; the fit's material).
@@ -198,6 +200,11 @@ impl Opt {
                 Method::Manual(t) => json!(t),
                 m => json!(m.name()),
             },
+            Opt::PixelSizeUncertainty => {
+                let u = units::parse_relative_uncertainty(text, None).map_err(|e| err(&e))?;
+                crate::analyze::check_pixel_size_uncertainty(u).map_err(|e| e.to_string())?;
+                json!(u)
+            }
             Opt::PixelSize | Opt::TopographyPixelSize => {
                 let (x, y) = units::parse_pixel_size(text).map_err(|e| err(&e))?;
                 json!([x, y])
@@ -427,6 +434,10 @@ impl SeriesOptions {
             pixel_size_m: self
                 .get(Opt::PixelSize)
                 .and_then(|t| units::parse_pixel_size(t).ok()),
+            pixel_size_uncertainty: self
+                .get(Opt::PixelSizeUncertainty)
+                .and_then(|t| units::parse_relative_uncertainty(t, None).ok())
+                .unwrap_or(0.0),
             hertz,
             memory_budget: settings.memory_mib << 20,
             ..AnalyzeRequest::new(Micrographs::Files(SeriesSpec {

@@ -165,6 +165,10 @@ pub struct PowerLaw {
     pub exponent: f64,
     /// Standard error of β (none for two points).
     pub exponent_se: Option<f64>,
+    /// 95 % interval of β (bootstrap over the images and their area intervals); none for
+    /// fewer than three images or in a record written before intervals existed.
+    #[serde(default)]
+    pub exponent_ci95: Option<(f64, f64)>,
     /// R² in log–log (none from fewer than three distinct forces, or identical areas).
     pub r_squared: Option<f64>,
     /// Points fitted.
@@ -194,6 +198,9 @@ pub struct SeriesResult {
     pub pixel_size_given: bool,
     /// The batch's own default gave the pixel size (no cell of the row, no file metadata used).
     pub pixel_size_from_default: bool,
+    /// The pixel size's relative uncertainty the intervals carry (0: taken as exact).
+    #[serde(default)]
+    pub pixel_size_uncertainty: f64,
     /// The first file's metadata pixel size, µm (x, y), when it has one.
     pub metadata_pixel_size_um: Option<(f64, f64)>,
     /// The power-law fit.
@@ -215,12 +222,18 @@ pub struct FitSummary {
     pub k_pa_per_m: Option<f64>,
     /// Its standard error.
     pub k_se_pa_per_m: Option<f64>,
+    /// Its 95 % interval, Pa/m.
+    #[serde(default)]
+    pub k_ci95_pa_per_m: Option<(f64, f64)>,
     /// Misfit (RMS of ln A_sim/A_exp) of the hardening model.
     pub k_misfit: Option<f64>,
     /// Penetration hardness p_Y, Pa.
     pub hardness_pa: Option<f64>,
     /// Its standard error.
     pub hardness_se_pa: Option<f64>,
+    /// Its 95 % interval, Pa.
+    #[serde(default)]
+    pub hardness_ci95_pa: Option<(f64, f64)>,
     /// Misfit of the hardness model.
     pub hardness_misfit: Option<f64>,
     /// Misfit of the elastic model.

@@ -355,6 +355,7 @@ fn series_result(task: &SeriesTask, open: &OpenSeries, outcome: &AnalyzeOutcome)
         pixel_size_source: pixel.map(|p| p.source.describe().to_string()),
         pixel_size_given: task.options.get(super::options::Opt::PixelSize).is_some(),
         pixel_size_from_default: task.pixel_size_from_default && pixel.is_some(),
+        pixel_size_uncertainty: outcome.area_interval.pixel_size_uncertainty,
         metadata_pixel_size_um: first
             .and_then(|f| f.pixel_size)
             .map(|p| (p.x_m * 1e6, p.y_m * 1e6)),
@@ -362,6 +363,7 @@ fn series_result(task: &SeriesTask, open: &OpenSeries, outcome: &AnalyzeOutcome)
             prefactor: f.prefactor,
             exponent: f.exponent,
             exponent_se: f.exponent_se,
+            exponent_ci95: outcome.fits.intervals.as_ref().map(|i| i.exponent),
             r_squared: f.r_squared,
             points: f.points,
         }),
@@ -387,11 +389,13 @@ fn fit_summary(fit: &FitOutcome) -> FitSummary {
             Family::Hardening => {
                 summary.k_pa_per_m = model.best.parameter;
                 summary.k_se_pa_per_m = model.parameter_se;
+                summary.k_ci95_pa_per_m = model.parameter_ci95;
                 summary.k_misfit = misfit;
             }
             Family::Hardness => {
                 summary.hardness_pa = model.best.parameter;
                 summary.hardness_se_pa = model.parameter_se;
+                summary.hardness_ci95_pa = model.parameter_ci95;
                 summary.hardness_misfit = misfit;
             }
             Family::Elastic => summary.elastic_misfit = misfit,

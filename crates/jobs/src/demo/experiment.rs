@@ -225,7 +225,7 @@ fn write_micrographs(p: &DemoParams, maps: &[Grid], data: &Path) -> Result<PathB
                     corner_px: corner,
                     background: 300.0,
                     contact_level: 2400.0,
-                    counts_per_photon: 4.0,
+                    counts_per_photon: p.counts_per_photon,
                     seed: p.seed + i as u64,
                 },
             )

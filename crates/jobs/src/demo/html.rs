@@ -22,6 +22,8 @@ pub(super) struct Facts<'a> {
     pub recovered: &'a [Recovered],
     pub comparisons: &'a [(String, Comparison)],
     pub measured: &'a [(f64, f64)],
+    /// Each measured area's 95 % interval (lo, hi), m².
+    pub measured_intervals: &'a [(f64, f64)],
     pub truth_areas_m2: &'a [f64],
     pub fits: &'a [ModelFit],
 }
@@ -169,9 +171,11 @@ fn demo_json(facts: &Facts) -> serde_json::Value {
         "recovered": facts.recovered,
         "true_shift_x_px": MICROGRAPH_OFFSET_PX.0,
         "true_shift_y_px": MICROGRAPH_OFFSET_PX.1,
-        "areas": facts.measured.iter().zip(facts.truth_areas_m2).map(|(&(f, a), t)| json!({
+        "areas": facts.measured.iter().zip(facts.measured_intervals).zip(facts.truth_areas_m2).map(|((&(f, a), &(lo, hi)), t)| json!({
             "force_mN": f * 1e3,
             "measured_area_um2": a * 1e12,
+            "measured_area_um2_lo": lo * 1e12,
+            "measured_area_um2_hi": hi * 1e12,
             "true_area_um2": t * 1e12,
         })).collect::<Vec<_>>(),
         "models": facts.comparisons.iter().map(|(name, c)| json!({
@@ -369,12 +373,23 @@ fn inputs_table(s: &mut String, p: &DemoParams) {
 }
 
 fn recovered_table(s: &mut String, recovered: &[Recovered]) {
-    s.push_str("<h2>Recovered</h2>\n<table>\n<tr><th>quantity</th><th>truth</th><th>recovered</th><th>error</th><th>by</th></tr>\n");
+    s.push_str("<h2>Recovered</h2>\n<table>\n<tr><th>quantity</th><th>truth</th><th>recovered</th><th>95 % interval</th><th>error</th><th>by</th></tr>\n");
     for r in recovered {
         let recovered = crate::table::value_pm_or(r.recovered, r.uncertainty, 3);
+        let interval = match r.interval {
+            Some((lo, hi)) => {
+                let holds = if lo <= r.truth && r.truth <= hi {
+                    "holds"
+                } else {
+                    "misses"
+                };
+                format!("{lo:.3}…{hi:.3} {} ({holds} the truth)", escape(&r.unit))
+            }
+            None => "—".into(),
+        };
         let _ = writeln!(
             s,
-            "<tr><td>{}</td><td>{:.3} {u}</td><td>{recovered} {u}</td><td>{:+.1} %</td><td><code>{}</code></td></tr>",
+            "<tr><td>{}</td><td>{:.3} {u}</td><td>{recovered} {u}</td><td>{interval}</td><td>{:+.1} %</td><td><code>{}</code></td></tr>",
             escape(&r.quantity),
             r.truth,
             100.0 * r.relative_error(),
@@ -430,7 +445,7 @@ fn dice_table(s: &mut String, facts: &Facts) {
 }
 
 fn fits_table(s: &mut String, fits: &[ModelFit]) {
-    s.push_str("<table>\n<tr><th>model</th><th>fitted parameter</th><th>misfit (RMS of ln A<sub>sim</sub>/A<sub>exp</sub>)</th></tr>\n");
+    s.push_str("<table>\n<tr><th>model</th><th>fitted parameter</th><th>95 % interval</th><th>misfit (RMS of ln A<sub>sim</sub>/A<sub>exp</sub>)</th></tr>\n");
     for fit in fits {
         let parameter = match (fit.family, fit.best.parameter) {
             (Family::Hardening, Some(k)) => format!(
@@ -443,9 +458,16 @@ fn fits_table(s: &mut String, fits: &[ModelFit]) {
             ),
             _ => "none".into(),
         };
+        let interval = match (fit.family, fit.parameter_ci95) {
+            (Family::Hardening, Some((lo, hi))) => {
+                format!("{:.2}…{:.2} MPa/nm", lo * 1e-15, hi * 1e-15)
+            }
+            (Family::Hardness, Some((lo, hi))) => format!("{:.0}…{:.0} MPa", lo * 1e-6, hi * 1e-6),
+            _ => "—".into(),
+        };
         let _ = writeln!(
             s,
-            "<tr><td>{}</td><td>{}</td><td>{:.3}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{interval}</td><td>{:.3}</td></tr>",
             fit.family.name(),
             parameter,
             fit.best.misfit
@@ -455,13 +477,25 @@ fn fits_table(s: &mut String, fits: &[ModelFit]) {
 }
 
 fn areas_table(s: &mut String, facts: &Facts) {
-    s.push_str("<table>\n<tr><th>force (mN)</th><th>measured area (µm²)</th><th>true area, g = 0 (µm²)</th></tr>\n");
-    for (&(f, a), t) in facts.measured.iter().zip(facts.truth_areas_m2) {
+    s.push_str("<table>\n<tr><th>force (mN)</th><th>measured area (µm²)</th><th>its 95 % interval (µm²)</th><th>true area, g = 0 (µm²)</th></tr>\n");
+    for ((&(f, a), &(lo, hi)), t) in facts
+        .measured
+        .iter()
+        .zip(facts.measured_intervals)
+        .zip(facts.truth_areas_m2)
+    {
+        let holds = if lo <= *t && *t <= hi {
+            ""
+        } else {
+            " (misses the truth)"
+        };
         let _ = writeln!(
             s,
-            "<tr><td>{:.4}</td><td>{:.2}</td><td>{:.2}</td></tr>",
+            "<tr><td>{:.4}</td><td>{:.2}</td><td>{:.2}…{:.2}{holds}</td><td>{:.2}</td></tr>",
             f * 1e3,
             a * 1e12,
+            lo * 1e12,
+            hi * 1e12,
             t * 1e12
         );
     }

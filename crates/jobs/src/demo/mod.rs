@@ -78,6 +78,9 @@ pub struct DemoParams {
     pub image_size: usize,
     /// PSF FWHM, m.
     pub psf_fwhm_m: f64,
+    /// Detector grey levels per photon of the micrographs (their shot noise: 4 gives a standard
+    /// deviation of about 2·√I grey levels).
+    pub counts_per_photon: f64,
     /// Interfacial shear strength τ, Pa.
     pub tau_pa: f64,
     /// Detection gap of the rigidochromic layer, m.
@@ -110,6 +113,7 @@ impl DemoParams {
             image_pixel_m: 200e-9,
             image_size: 432,
             psf_fwhm_m: 450e-9,
+            counts_per_photon: 4.0,
             tau_pa: 50e6,
             detection_gap_m: 9e-9,
             fit_grid: 5,
@@ -154,6 +158,8 @@ pub struct Recovered {
     pub recovered: f64,
     /// Its uncertainty (standard error or spread), when known.
     pub uncertainty: Option<f64>,
+    /// Its 95 % interval (lo, hi), in `unit`, when the command gives one.
+    pub interval: Option<(f64, f64)>,
     /// Which command recovered it.
     pub by: String,
 }
@@ -247,7 +253,7 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
     let mut recovered = Vec::new();
 
     progress("analyze: global Otsu threshold, contact areas");
-    let measured = analyze(work, &experiment.manifest)?;
+    let (measured, measured_intervals) = analyze(work, &experiment.manifest)?;
 
     progress("psf: beads");
     recovered.push(psf(work, &data, p)?);
@@ -276,6 +282,7 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
         recovered: &recovered,
         comparisons: &comparisons,
         measured: &measured,
+        measured_intervals: &measured_intervals,
         truth_areas_m2: &experiment.truth_areas_m2,
         fits: &fit.fits,
     };
@@ -288,8 +295,10 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
     })
 }
 
-/// Measured (force N, area m²) from `analyze`.
-fn analyze(work: &Path, manifest: &Path) -> Result<Vec<(f64, f64)>> {
+/// Measured (force N, area m²) from `analyze`, and each area's 95 % interval (lo, hi), m².
+type MeasuredCurve = (Vec<(f64, f64)>, Vec<(f64, f64)>);
+
+fn analyze(work: &Path, manifest: &Path) -> Result<MeasuredCurve> {
     let request = AnalyzeRequest {
         memory_budget: 64 << 20,
         ..AnalyzeRequest::new(Micrographs::Files(SeriesSpec {
@@ -307,12 +316,15 @@ fn analyze(work: &Path, manifest: &Path) -> Result<Vec<(f64, f64)>> {
         },
         &|_, _, _| {},
     )?;
-    Ok(outcome
-        .rows
-        .rows
-        .iter()
-        .map(|r| (r.force_mn.unwrap_or(f64::NAN) * 1e-3, r.area * 1e-12))
-        .collect())
+    let rows = &outcome.rows.rows;
+    Ok((
+        rows.iter()
+            .map(|r| (r.force_mn.unwrap_or(f64::NAN) * 1e-3, r.area * 1e-12))
+            .collect(),
+        rows.iter()
+            .map(|r| (r.area_lo * 1e-12, r.area_hi * 1e-12))
+            .collect(),
+    ))
 }
 
 fn psf(work: &Path, data: &Path, p: &DemoParams) -> Result<Recovered> {
@@ -343,6 +355,7 @@ fn psf(work: &Path, data: &Path, p: &DemoParams) -> Result<Recovered> {
             .sigma_m
             .sd
             .map(|sd| sd * contactscope::optics::blur::FWHM_PER_SIGMA * 1e9),
+        interval: None,
         by: "psf".into(),
     })
 }
@@ -379,6 +392,7 @@ fn newton(work: &Path, data: &Path, p: &DemoParams) -> Result<Vec<Recovered>> {
         truth: p.detection_gap_m * 1e9,
         recovered: a.detection_gap_m.mean * 1e9,
         uncertainty: a.detection_gap_m.sd.map(|s| s * 1e9),
+        interval: None,
         by: "newton".into(),
     }])
 }
@@ -415,6 +429,7 @@ fn hertz(work: &Path, data: &Path, p: &DemoParams) -> Result<Recovered> {
         truth: p.e_star_pa * 1e-9,
         recovered: outcome.fit.e_star_pa * 1e-9,
         uncertainty: Some(outcome.fit.e_star_se_pa * 1e-9),
+        interval: None,
         by: "hertz".into(),
     })
 }
@@ -476,6 +491,7 @@ fn friction(
         truth: p.tau_pa * 1e-6,
         recovered: shear.tau_pa * 1e-6,
         uncertainty: shear.tau_se_pa.map(|s| s * 1e-6),
+        interval: None,
         by: "friction".into(),
     })
 }
@@ -534,11 +550,15 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
         outcome
             .fits()
             .find(|f| f.family == family)
-            .and_then(|f| f.best.parameter.map(|v| (v, f.parameter_se)))
+            .and_then(|f| {
+                f.best
+                    .parameter
+                    .map(|v| (v, f.parameter_se, f.parameter_ci95))
+            })
             .ok_or_else(|| Error::InvalidArgument(format!("no {} fit", family.name())))
     };
-    let (k, k_se) = parameter(Family::Hardening)?;
-    let (hardness, _) = parameter(Family::Hardness)?;
+    let (k, k_se, k_ci) = parameter(Family::Hardening)?;
+    let (hardness, _, _) = parameter(Family::Hardness)?;
     Ok(FitResult {
         k: Recovered {
             quantity: "hardening coefficient k".into(),
@@ -546,6 +566,7 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
             truth: p.k_pa_per_m * 1e-15,
             recovered: k * 1e-15,
             uncertainty: k_se.map(|s| s * 1e-15),
+            interval: k_ci.map(|(lo, hi)| (lo * 1e-15, hi * 1e-15)),
             by: "fit-hardening".into(),
         },
         k_pa_per_m: k,

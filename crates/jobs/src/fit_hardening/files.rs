@@ -32,10 +32,7 @@ pub fn run_to_folder(
         inputs.push(source.path.clone());
     }
     let staging = Staging::new(out_dir, &inputs)?;
-    let measured = Measured {
-        forces_n: outcome.measured.forces_n.clone(),
-        areas_m2: outcome.measured.areas_m2.clone(),
-    };
+    let measured = outcome.measured.0.clone();
     let fits: Vec<ModelFit> = outcome.fits().cloned().collect();
     staging.write("fit_areas.csv", fit_csv(&measured, &fits)?.as_bytes())?;
     #[cfg(feature = "plots")]
@@ -82,7 +79,15 @@ fn model_label(fit: &ModelFit) -> String {
             display(Family::Hardening, fit.best.parameter.unwrap_or(f64::NAN))
         ),
     };
-    format!("{name} (misfit {:.3})", fit.best.misfit)
+    let interval = match (fit.family, fit.parameter_ci95) {
+        (Family::Hardening | Family::Hardness, Some((lo, hi))) => format!(
+            ", 95 % {:.2}…{:.2}",
+            display(fit.family, lo),
+            display(fit.family, hi)
+        ),
+        _ => String::new(),
+    };
+    format!("{name}{interval} (misfit {:.3})", fit.best.misfit)
 }
 
 fn fit_csv(measured: &Measured, fits: &[ModelFit]) -> Result<String> {
@@ -149,6 +154,45 @@ fn measured_points(measured: &Measured) -> PointSet {
 #[cfg(feature = "plots")]
 /// Fig. 3a: measured areas and every model's best curve, log-log.
 pub fn fit_chart(measured: &Measured, fits: &[ModelFit]) -> Chart {
+    let mut curves: Vec<Curve> = fits
+        .iter()
+        .map(|fit| Curve {
+            label: model_label(fit),
+            xy: measured
+                .forces_n
+                .iter()
+                .zip(&fit.best.areas_m2)
+                .map(|(f, a)| (f * 1e3, a * 1e12))
+                .collect(),
+        })
+        .collect();
+    // Each measured area's 95 % interval (calibration included) as a vertical bar; a
+    // non-finite vertex breaks the line between bars.
+    if let Some(intervals) = &measured.intervals_m2 {
+        let u = measured.pixel_size_uncertainty;
+        let bars: Vec<(f64, f64)> = measured
+            .forces_n
+            .iter()
+            .zip(intervals)
+            .filter(|(_, (lo, hi))| *lo > 0.0 && hi > lo)
+            .flat_map(|(f, (lo, hi))| {
+                [
+                    (f * 1e3, lo * (1.0 - u).powi(2) * 1e12),
+                    (f * 1e3, hi * (1.0 + u).powi(2) * 1e12),
+                    (f * 1e3, f64::NAN),
+                ]
+            })
+            .collect();
+        if !bars.is_empty() {
+            curves.insert(
+                0,
+                Curve {
+                    label: "95 % interval of the measured area".into(),
+                    xy: bars,
+                },
+            );
+        }
+    }
     Chart {
         title: "Contact area vs load: experiment and models".into(),
         x_label: "normal force N (mN)".into(),
@@ -156,18 +200,7 @@ pub fn fit_chart(measured: &Measured, fits: &[ModelFit]) -> Chart {
         axes: Axes::LogLog,
         legend: Legend::UpperLeft,
         points: vec![measured_points(measured)],
-        curves: fits
-            .iter()
-            .map(|fit| Curve {
-                label: model_label(fit),
-                xy: measured
-                    .forces_n
-                    .iter()
-                    .zip(&fit.best.areas_m2)
-                    .map(|(f, a)| (f * 1e3, a * 1e12))
-                    .collect(),
-            })
-            .collect(),
+        curves,
         ..Chart::default()
     }
 }

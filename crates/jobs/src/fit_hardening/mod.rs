@@ -25,10 +25,10 @@ use contactscope_formats::ranges::{short, Quantity};
 
 pub use sweep::{Sweep, SweepMicrographs, SweepRow};
 
-use crate::error::{Error, Location, Result};
+use crate::error::{Error, Result};
 use crate::heights::{HeightInput, Roughness};
-use crate::lab::{self, OptQ, Qs, Unit, Q};
-use crate::results::read_areas_csv;
+use crate::lab::{self, Interval, OptQ, Qs, Unit, Q};
+use crate::results::read_measured;
 use crate::simulate::{check_loads, check_solver, DeviceChoice, SimulateRequest};
 
 /// The rough sphere of a fit or a ramp: heights, sphere, material, solver limits, imaging.
@@ -117,6 +117,9 @@ pub enum MeasuredInput {
     File(PathBuf),
     /// (force N, area m²) per load.
     Memory(Vec<(f64, f64)>),
+    /// (force N, area m², lo m², hi m²) per load: each area with its interval (without the
+    /// pixel size's calibration).
+    Intervals(Vec<(f64, f64, f64, f64)>),
 }
 
 impl MeasuredInput {
@@ -124,18 +127,23 @@ impl MeasuredInput {
         match self {
             MeasuredInput::File(p) => p.display().to_string(),
             MeasuredInput::Memory(_) => "forces and areas (arrays)".into(),
+            MeasuredInput::Intervals(_) => "forces, areas and their intervals (arrays)".into(),
         }
     }
 
     /// The measured curve, checked: forces within their range, at least two loads.
     pub fn read(&self) -> Result<Measured> {
         match self {
-            MeasuredInput::File(path) => Measured::new(read_areas_csv(path)?)
-                .map_err(|e| Error::bad_input(Location::file(path), e.to_string())),
+            MeasuredInput::File(path) => read_measured(path),
             MeasuredInput::Memory(points) => {
                 let forces: Vec<f64> = points.iter().map(|p| p.0).collect();
                 check_loads(&forces, Param::Forces)?;
                 Ok(Measured::new(points.clone())?)
+            }
+            MeasuredInput::Intervals(points) => {
+                let forces: Vec<f64> = points.iter().map(|p| p.0).collect();
+                check_loads(&forces, Param::Forces)?;
+                Ok(Measured::with_intervals(points.clone(), 0.0)?)
             }
         }
     }
@@ -287,15 +295,28 @@ fn parameter_quantity(family: Family) -> (Quantity, Param) {
     }
 }
 
-/// The measured curve as a summary records it.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct MeasuredFacts {
-    /// Forces, N.
-    #[serde(rename = "force_mN", serialize_with = "lab::each_n_as_mn")]
-    pub forces_n: Vec<f64>,
-    /// Areas, m².
-    #[serde(rename = "area_um2", serialize_with = "lab::each_m2_as_um2")]
-    pub areas_m2: Vec<f64>,
+/// The measured curve as a summary records it: forces and areas, and, where the curve carries
+/// them, each area's interval as `areas.csv` gives it (calibration included) and the pixel
+/// size's uncertainty.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredFacts(pub Measured);
+
+impl Serialize for MeasuredFacts {
+    fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        let m = &self.0;
+        let mut map = s.serialize_map(None)?;
+        map.serialize_entry("force_mN", &Qs(&m.forces_n, Unit::NAsMn))?;
+        map.serialize_entry("area_um2", &Qs(&m.areas_m2, Unit::M2AsUm2))?;
+        if let Some(intervals) = &m.intervals_m2 {
+            let u = m.pixel_size_uncertainty;
+            let lo: Vec<f64> = intervals.iter().map(|i| i.0 * (1.0 - u).powi(2)).collect();
+            let hi: Vec<f64> = intervals.iter().map(|i| i.1 * (1.0 + u).powi(2)).collect();
+            map.serialize_entry("area_um2_lo", &Qs(&lo, Unit::M2AsUm2))?;
+            map.serialize_entry("area_um2_hi", &Qs(&hi, Unit::M2AsUm2))?;
+            map.serialize_entry("pixel_size_uncertainty_pct", &Q(u, Unit::FractionAsPct))?;
+        }
+        map.end()
+    }
 }
 
 /// How the simulated areas were counted.
@@ -343,6 +364,10 @@ impl Serialize for FittedModel {
             };
             m.serialize_entry(key, &Q(p, unit))?;
             m.serialize_entry(&format!("{key}_se"), &OptQ(fit.parameter_se, unit))?;
+            m.serialize_entry(
+                &format!("{key}_ci95"),
+                &fit.parameter_ci95.map(|(lo, hi)| Interval(lo, hi, unit)),
+            )?;
             m.serialize_entry("undetermined", &fit.undetermined)?;
         }
         m.end()
@@ -476,10 +501,7 @@ pub fn run(request: &FitRequest, progress: Option<ProgressHook>) -> Result<FitOu
         radius_m: request.body.radius_m,
         contact_modulus_pa: request.body.e_star_pa,
         roughness: Roughness::from(&body.stats),
-        measured: MeasuredFacts {
-            forces_n: measured.forces_n.clone(),
-            areas_m2: measured.areas_m2.clone(),
-        },
+        measured: MeasuredFacts(measured.clone()),
         simulated_areas: Counting(request.body.imaging),
         method: METHOD,
         device: contactscope::solver::gpu::describe(body.options.gpu),
@@ -505,6 +527,8 @@ fn fit_family(
             trace: Vec::new(),
             best,
             parameter_se: None,
+            parameter_ci95: None,
+            sensitivities: None,
             at_range_edge: false,
             undetermined: false,
         });
