@@ -151,15 +151,21 @@ class _Progress(QObject):
 
 
 def table_rows(result: Dict[str, Any]) -> List[List[str]]:
-    """The area-vs-load table as shown: image, force (mN), area (µm² or px), patches, p (MPa)."""
+    """The area-vs-load table as shown: image, force (mN), area (µm² or px), its 95 % interval,
+    patches, p (MPa)."""
     rows = []
     for r in result["rows"]:
         f = r.get("force_n")
         area = r.get("area_m2")
         p = r.get("mean_pressure_pa")
+        if area is not None:
+            shown = f"{area * 1e12:.2f}"
+            interval = f"{r['area_m2_lo'] * 1e12:.2f}…{r['area_m2_hi'] * 1e12:.2f}"
+        else:
+            shown = f"{r.get('area_px', 0)} px"
+            interval = f"{r.get('area_px_lo', 0):g}…{r.get('area_px_hi', 0):g} px"
         rows.append([f"{os.path.basename(str(r['image']))} p{r['page']}",
-                     "-" if f is None else f"{f * 1e3:g}",
-                     f"{area * 1e12:.2f}" if area is not None else f"{r.get('area_px', 0)} px",
+                     "-" if f is None else f"{f * 1e3:g}", shown, interval,
                      str(r["patches"]),
                      "-" if p is None else f"{p * 1e-6:.1f}"])
     return rows
@@ -201,7 +207,7 @@ class LoadSeriesWidget(QWidget):
         self.bar = QProgressBar()
         self.status = QLabel("")
         self.status.setWordWrap(True)
-        self.table = QTableWidget(0, 5)
+        self.table = QTableWidget(0, 6)
         self.table.setHorizontalHeaderLabels(["image", "force (mN)", "area (µm²)", "patches",
                                               "p (MPa)"])
 
@@ -428,7 +434,7 @@ class LoadSeriesWidget(QWidget):
         unit = "µm²" if result.get("area_unit") == "um2" or any(
             r.get("area_m2") is not None for r in result["rows"]) else "px"
         self.table.setHorizontalHeaderLabels(["image", "force (mN)", f"area ({unit})",
-                                              "patches", "p (MPa)"])
+                                              "95 % interval", "patches", "p (MPa)"])
         for i, row in enumerate(rows):
             for j, text in enumerate(row):
                 self.table.setItem(i, j, QTableWidgetItem(text))
@@ -437,19 +443,25 @@ class LoadSeriesWidget(QWidget):
     def _plot(self, result: Dict[str, Any]) -> None:
         self.figure.clear()
         ax = self.figure.add_subplot(111)
-        pts = [(r["force_n"] * 1e3, r["area_m2"] * 1e12) for r in result["rows"]
+        pts = [(r["force_n"] * 1e3, r["area_m2"] * 1e12, r["area_m2_lo"] * 1e12,
+                r["area_m2_hi"] * 1e12) for r in result["rows"]
                if r.get("force_n") and r.get("area_m2")]
         if pts:
-            f, a = np.array(pts).T
-            ax.loglog(f, a, "o", color="tab:blue", label="measured (Otsu)")
+            f, a, lo, hi = np.array(pts).T
+            ax.errorbar(f, a, yerr=[a - lo, hi - a], fmt="o", color="tab:blue", capsize=3,
+                        label="measured (Otsu), 95 % interval")
+            ax.set_xscale("log")
+            ax.set_yscale("log")
             fit = (result.get("fits") or {}).get("power_law")
             if fit and len(f) > 1:
                 # SI: area_m2 = prefactor · force_n^exponent; drawn in mN and µm².
                 grid = np.geomspace(f.min(), f.max(), 40)
                 area_um2 = 1e12 * fit["prefactor_m2_per_n_pow_exponent"] \
                     * (grid * 1e-3) ** fit["exponent"]
+                ci = fit.get("exponent_ci95")
+                span = "" if ci is None else f" ({ci[0]:.3f}…{ci[1]:.3f})"
                 ax.loglog(grid, area_um2, "-", color="tab:orange",
-                          label=f"A ∝ N^β, β = {fit['exponent']:.3f}")
+                          label=f"A ∝ N^β, β = {fit['exponent']:.3f}{span}")
             ax.legend(loc="best", fontsize=8)
         else:
             ax.text(0.5, 0.5, "no forces or no contact: nothing on log axes",
