@@ -24,9 +24,9 @@
 use std::time::Instant;
 
 use contactscope::model_fit::interval::parameter_interval;
-use contactscope::model_fit::{fit_parameter, Family, Imaging, Measured, Search};
+use contactscope::model_fit::{fit_parameter, Family, Measured};
 use contactscope_jobs::analyze::{run as analyze, AnalyzeRequest};
-use contactscope_jobs::demo::{model_body, synthetic_experiment, DemoParams};
+use contactscope_jobs::demo::{fit_search, imaging, model_body, synthetic_experiment, DemoParams};
 use contactscope_jobs::series::{Micrographs, SeriesSpec};
 
 fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
@@ -64,26 +64,10 @@ fn experiment(p: &DemoParams, dir: &std::path::Path) -> Result<Outcome, String> 
         ..SeriesSpec::default()
     }));
     let outcome = analyze(&request, &|_, _, _| {}, &|_, _, _| Ok(())).map_err(|x| e(&x))?;
-    let points: Vec<(f64, f64, f64, f64)> = outcome
-        .rows
-        .rows
-        .iter()
-        .filter_map(|r| {
-            let f = r.force_mn? * 1e-3;
-            Some((f, r.area * 1e-12, r.area_lo * 1e-12, r.area_hi * 1e-12))
-        })
-        .collect();
-    let measured = Measured::with_intervals(points, 0.0).map_err(|x| e(&x))?;
+    let measured = outcome.measured_curve().ok_or("no measured curve")?;
     let mut body = model_body(p, &experiment).map_err(|x| e(&x))?;
-    body.imaging = Some(Imaging {
-        fwhm_m: p.psf_fwhm_m,
-        pixel_m: (p.image_pixel_m, p.image_pixel_m),
-    });
-    let search = Search {
-        grid: p.fit_grid,
-        ln_tolerance: 0.02,
-        ..Search::default_for(Family::Hardening)
-    };
+    body.imaging = Some(imaging(p));
+    let search = fit_search(p, Family::Hardening);
     let started = Instant::now();
     let fit = fit_parameter(&body, Family::Hardening, &measured, search).map_err(|x| e(&x))?;
     let fit_s = started.elapsed().as_secs_f64();

@@ -96,9 +96,11 @@ fn area_intervals_hold_the_true_area_of_synthetic_series() {
 /// interval of k holds the truth in at least 4 of 5 and is under 60 % wide (median).
 #[test]
 fn k_intervals_hold_the_true_k_of_synthetic_experiments() {
-    use contactscope::model_fit::{fit_parameter, Family, Imaging, Measured, Search};
+    use contactscope::model_fit::{fit_parameter, Family};
     use contactscope_jobs::analyze::{run, AnalyzeRequest};
-    use contactscope_jobs::demo::{model_body, synthetic_experiment, DemoParams};
+    use contactscope_jobs::demo::{
+        fit_search, imaging, model_body, synthetic_experiment, DemoParams,
+    };
     use contactscope_jobs::series::{Micrographs, SeriesSpec};
     let tmp = tempfile::tempdir().unwrap();
     let (mut covered, mut widths) = (0, Vec::new());
@@ -118,26 +120,10 @@ fn k_intervals_hold_the_true_k_of_synthetic_experiments() {
             &|_, _, _| Ok(()),
         )
         .unwrap();
-        let points = analysis
-            .rows
-            .rows
-            .iter()
-            .map(|r| {
-                let f = r.force_mn.unwrap() * 1e-3;
-                (f, r.area * 1e-12, r.area_lo * 1e-12, r.area_hi * 1e-12)
-            })
-            .collect();
-        let measured = Measured::with_intervals(points, 0.0).unwrap();
+        let measured = analysis.measured_curve().expect("a measured curve");
         let mut body = model_body(&p, &experiment).unwrap();
-        body.imaging = Some(Imaging {
-            fwhm_m: p.psf_fwhm_m,
-            pixel_m: (p.image_pixel_m, p.image_pixel_m),
-        });
-        let search = Search {
-            grid: p.fit_grid,
-            ln_tolerance: 0.02,
-            ..Search::default_for(Family::Hardening)
-        };
+        body.imaging = Some(imaging(&p));
+        let search = fit_search(&p, Family::Hardening);
         let fit = fit_parameter(&body, Family::Hardening, &measured, search).unwrap();
         let (lo, hi) = fit.parameter_ci95.expect("an interval");
         let k = fit.best.parameter.unwrap();

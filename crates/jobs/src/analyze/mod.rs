@@ -178,6 +178,32 @@ impl Default for AreaIntervalFacts {
 }
 
 impl AnalyzeOutcome {
+    /// The measured curve as `fit-hardening` reads it from this analysis's `areas.csv`: the
+    /// images the fits use (a positive force, contact, none at the border), each area with its
+    /// interval less the pixel size's calibration, and that calibration; `None` for areas in
+    /// pixels or with fewer than two such images.
+    pub fn measured_curve(&self) -> Option<contactscope::model_fit::Measured> {
+        if self.area_unit != AreaUnit::SquareMicrometre {
+            return None;
+        }
+        let u = self.rows.pixel_size_uncertainty;
+        let points = self
+            .rows
+            .rows
+            .iter()
+            .filter(|r| r.load_point().in_fit() && r.force_mn.is_some_and(|f| f > 0.0))
+            .map(|r| {
+                (
+                    r.force_mn.unwrap_or(f64::NAN) * 1e-3,
+                    r.area * 1e-12,
+                    r.area_lo / (1.0 - u).powi(2) * 1e-12,
+                    r.area_hi / (1.0 + u).powi(2) * 1e-12,
+                )
+            })
+            .collect();
+        contactscope::model_fit::Measured::with_intervals(points, u).ok()
+    }
+
     /// Whether the series has loaded images and none of them can enter a fit (no contact, or
     /// contact cut off by the border, in every one): the command line exits with status 4.
     pub fn nothing_valid(&self) -> bool {

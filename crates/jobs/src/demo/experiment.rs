@@ -11,7 +11,7 @@ use contactscope::compare::SimulatedMap;
 use contactscope::compare::{
     compare_maps, CompareSettings, Comparison, Micrographs as MicrographSet,
 };
-use contactscope::model_fit::{Family, ModelBody};
+use contactscope::model_fit::{Family, Imaging, ModelBody, Search};
 use contactscope::optics::blur::{microscope_image, Grid};
 use contactscope::solver::cg::SolverOptions;
 use contactscope::solver::halfspace::Boundary;
@@ -88,6 +88,24 @@ pub(super) fn solver_options(p: &DemoParams) -> Result<SolverOptions<'static>> {
         gpu: p.device.open()?,
         ..SolverOptions::default()
     })
+}
+
+/// The search of the demo's one-parameter fits: a log grid of `p.fit_grid` points, then Brent's
+/// method to 2 % in ln(parameter).
+pub fn fit_search(p: &DemoParams, family: Family) -> Search {
+    Search {
+        grid: p.fit_grid,
+        ln_tolerance: 0.02,
+        ..Search::default_for(family)
+    }
+}
+
+/// How the demo's fits count simulated areas: as imaged by the micrographs' PSF and pixels.
+pub fn imaging(p: &DemoParams) -> Imaging {
+    Imaging {
+        fwhm_m: p.psf_fwhm_m,
+        pixel_m: (p.image_pixel_m, p.image_pixel_m),
+    }
 }
 
 /// The models' rigid body: the experiment's roughness on the sphere.

@@ -19,7 +19,8 @@ mod experiment;
 mod html;
 
 pub use experiment::{
-    compare_model, model_body, synthetic_experiment, Experiment, MICROGRAPH_OFFSET_PX,
+    compare_model, fit_search, imaging, model_body, synthetic_experiment, Experiment,
+    MICROGRAPH_OFFSET_PX,
 };
 
 use std::path::{Path, PathBuf};
@@ -43,7 +44,7 @@ use crate::simulate::DeviceChoice;
 use crate::staging::write_atomic;
 use contactscope::compare::Comparison;
 use contactscope::mechanics::friction::{SlipOptions, XAxis};
-use contactscope::model_fit::{Family, Imaging, Search};
+use contactscope::model_fit::Family;
 use contactscope::synth::beads::{synth_beads, BeadParams};
 use contactscope::synth::rings::{synth_newton, NewtonSynthParams};
 use contactscope::synth::traces::{synthetic_trace, trace_csv, CsvLayout, TraceParams};
@@ -505,17 +506,10 @@ struct FitResult {
 }
 
 fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
-    let search = |family| Search {
-        grid: p.fit_grid,
-        ln_tolerance: 0.02,
-        ..Search::default_for(family)
-    };
+    let search = |family| fit_search(p, family);
     let body = BodyRequest {
         radius_m: Some(p.radius_m),
-        imaging: Some(Imaging {
-            fwhm_m: p.psf_fwhm_m,
-            pixel_m: (p.image_pixel_m, p.image_pixel_m),
-        }),
+        imaging: Some(imaging(p)),
         device: p.device,
         ..BodyRequest::new(
             HeightInput::File(TopographySource {
