@@ -19,6 +19,8 @@
 //! Noise levels are detector counts per photon (4 is the demo's: photon shot noise of about
 //! 2·√I counts; 16 quadruples the variance); PSF widths are FWHM in nm (450 nm is the demo's).
 
+#[path = "support.rs"]
+mod support;
 use contactscope::analysis::bootstrap::fit_intervals;
 use contactscope::analysis::fit::fit_power_law;
 use contactscope::analysis::interval::{area_band, EDGE_BAND_HALF_WIDTH, NOISE_WIDENING};
@@ -27,20 +29,7 @@ use contactscope::image::Plane;
 use contactscope::measure::Mask;
 use contactscope::synth::{generate, SynthParams};
 use std::sync::Mutex;
-
-fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
+use support::{arg, median};
 
 fn main() {
     let seeds: u64 = arg("--seeds", 100);

@@ -21,27 +21,16 @@
 //! Noise levels are detector counts per photon (4 is the demo's); PSF widths FWHM in nm (450 is
 //! the demo's).
 
+#[path = "support.rs"]
+mod support;
 use std::time::Instant;
+use support::{arg, median};
 
 use contactscope::model_fit::interval::parameter_interval;
 use contactscope::model_fit::{fit_parameter, Family, Measured};
 use contactscope_jobs::analyze::{run as analyze, AnalyzeRequest};
 use contactscope_jobs::demo::{fit_search, imaging, model_body, synthetic_experiment, DemoParams};
 use contactscope_jobs::series::{Micrographs, SeriesSpec};
-
-fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
 
 /// One experiment's intervals on k, Pa/m: (with the area intervals, k̂ ± 1.96 SE, loads alone),
 /// and k̂.

@@ -22,7 +22,7 @@
 //! the coverage of the true area is measured on synthetic series with known truth over seeds,
 //! noise levels and PSF widths (`docs/validation.md` B25, `cargo bench --bench intervals`).
 
-use crate::image::Plane;
+use crate::image::{Plane, Samples};
 use crate::measure::Mask;
 
 /// Half-width w of the band of levels, as a fraction of the contact signal s (module docs);
@@ -33,8 +33,10 @@ pub const EDGE_BAND_HALF_WIDTH: f64 = 0.05;
 /// on the other side of the ramp's middle (module docs): 1.96, two-sided 95 %.
 pub const NOISE_WIDENING: f64 = 1.96;
 
-/// At most this many pixels are sorted for a median; larger classes are sampled evenly.
-const MEDIAN_SAMPLES: usize = 1 << 20;
+/// At most about this many pixels are sampled (every k-th pixel, evenly) for the levels'
+/// medians and the noise estimate: a 256² image uses every pixel (the images the coverage was
+/// measured on), a 1024² one every 16th.
+const MEDIAN_SAMPLES: usize = 1 << 16;
 
 /// The interval on one image's contact area, in pixels, and the levels it came from.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,24 +102,22 @@ pub fn area_band(plane: &Plane, mask: &Mask, w: f64, z: f64) -> AreaBand {
     }
     let mid = b + 0.5 * s;
     let (upper, lower) = (mid + w * s, mid - w * s);
-    let surely = (0..n).filter(|&i| plane.value(i) > upper).count() as u64;
     let possibly = grown(plane, mask, lower);
-    // Pixel noise: each pixel is on the other side of the ramp's middle with probability
+    // One pass over the pixels: those surely in contact (above `upper`), and the pixel noise:
+    // each pixel is on the other side of the ramp's middle with probability
     // p = Φ(−|v − mid|/σ); the count of such pixels has variance Σ p(1 − p).
-    let spread = match noise_sd(plane, mask) {
-        Some(sd) if sd > 0.0 => {
-            let var: f64 = (0..n)
-                .map(|i| plane.value(i))
-                .filter(|v| v.is_finite() && (v - mid).abs() < 6.0 * sd)
-                .map(|v| {
-                    let p = normal_tail((v - mid).abs() / sd);
-                    p * (1.0 - p)
-                })
-                .sum();
-            (z * var.sqrt()).round() as u64
+    let sd = noise_sd(plane, mask).filter(|&sd| sd > 0.0);
+    let (mut surely, mut var) = (0u64, 0.0f64);
+    for_each_level(plane, |v, count| {
+        surely += u64::from(v > upper) * count;
+        if let Some(sd) = sd {
+            if v.is_finite() && (v - mid).abs() < 6.0 * sd {
+                let p = normal_tail((v - mid).abs() / sd);
+                var += count as f64 * p * (1.0 - p);
+            }
         }
-        _ => 0,
-    };
+    });
+    let spread = (z * var.sqrt()).round() as u64;
     AreaBand {
         lo_pixels: surely.min(measured).saturating_sub(spread),
         hi_pixels: possibly.max(measured) + spread,
@@ -148,27 +148,75 @@ fn noise_sd(plane: &Plane, mask: &Mask) -> Option<f64> {
     Some(((b * b + c * c) / 2.0).sqrt())
 }
 
+/// Calls `f(value, pixels)` for every value the plane holds with the number of its pixels: for
+/// integer samples once per grey level present (from a histogram of the codes: the erfc of the
+/// noise term is then evaluated once per level, not once per pixel), for float samples once per
+/// pixel.
+fn for_each_level(plane: &Plane, mut f: impl FnMut(f64, u64)) {
+    match &plane.samples {
+        Samples::Int { codes, offset } => {
+            let mut counts = vec![0u32; 1 << 16];
+            for &c in codes {
+                counts[usize::from(c)] += 1;
+            }
+            for (c, &n) in counts.iter().enumerate().filter(|(_, &n)| n > 0) {
+                // c < 2^16: the code itself.
+                f(f64::from(c as i32 + offset), u64::from(n));
+            }
+        }
+        Samples::Float(v) => v.iter().for_each(|&x| f(f64::from(x), 1)),
+    }
+}
+
 /// Pixels above `level` connected (8-neighbours, through pixels above `level`) to a contact
-/// pixel of `mask`; contact pixels count whatever their value.
+/// pixel of `mask`; contact pixels count whatever their value. The fill starts from the contact
+/// pixels on the contact's edge (a pixel inside it has no other neighbour to reach).
 fn grown(plane: &Plane, mask: &Mask, level: f64) -> u64 {
     let (w, h) = (plane.width, plane.height);
     let mut seen: Vec<bool> = mask.data.iter().map(|&m| m != 0).collect();
-    let mut stack: Vec<usize> = (0..seen.len()).filter(|&i| seen[i]).collect();
-    let mut count = stack.len() as u64;
-    while let Some(i) = stack.pop() {
+    let mut count = seen.iter().filter(|&&c| c).count() as u64;
+    let neighbours = |i: usize| {
         let (x, y) = ((i % w) as isize, (i / w) as isize);
-        for dy in -1..=1 {
-            for dx in -1..=1 {
-                let (nx, ny) = (x + dx, y + dy);
-                if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
-                    continue;
-                }
-                let j = ny as usize * w + nx as usize;
-                if !seen[j] && plane.value(j) > level {
-                    seen[j] = true;
-                    count += 1;
-                    stack.push(j);
-                }
+        (-1..=1isize)
+            .flat_map(move |dy| (-1..=1isize).map(move |dx| (x + dx, y + dy)))
+            .filter(move |&(nx, ny)| nx >= 0 && ny >= 0 && nx < w as isize && ny < h as isize)
+            .map(move |(nx, ny)| ny as usize * w + nx as usize)
+    };
+    // The contact pixels with a non-contact 8-neighbour, or on the image's border, row by row
+    // (direct offsets: this scan touches every pixel).
+    let mut stack = Vec::new();
+    for y in 0..h {
+        let row = y * w;
+        for x in 0..w {
+            let i = row + x;
+            if !seen[i] {
+                continue;
+            }
+            let inner = x > 0 && y > 0 && x + 1 < w && y + 1 < h;
+            if !inner
+                || [
+                    i - w - 1,
+                    i - w,
+                    i - w + 1,
+                    i - 1,
+                    i + 1,
+                    i + w - 1,
+                    i + w,
+                    i + w + 1,
+                ]
+                .iter()
+                .any(|&j| !seen[j])
+            {
+                stack.push(i);
+            }
+        }
+    }
+    while let Some(i) = stack.pop() {
+        for j in neighbours(i) {
+            if !seen[j] && plane.value(j) > level {
+                seen[j] = true;
+                count += 1;
+                stack.push(j);
             }
         }
     }
