@@ -1,7 +1,7 @@
 //! What one command wrote, read back as the input of another: `analyze`'s `areas.csv`
-//! ([`read_areas_csv`] for `friction`, [`read_measured`] with the intervals for `fit-hardening`), a `simulate` output folder's contact
-//! maps ([`simulated_maps`], for `compare`) and the FWHM in `psf`'s `psf.json`
-//! ([`fwhm_from_psf_json`]).
+//! ([`read_areas_csv`] for `friction`, [`read_measured`] with the intervals for
+//! `fit-hardening`), a `simulate` output folder's contact maps ([`simulated_maps`], for
+//! `compare`) and the FWHM in `psf`'s `psf.json` ([`fwhm_from_psf_json`]).
 
 use std::path::Path;
 

@@ -267,7 +267,8 @@ impl Measured {
         }
         if !(0.0..0.5).contains(&pixel_size_uncertainty) {
             return Err(Error::InvalidArgument(format!(
-                "the pixel size's relative uncertainty {pixel_size_uncertainty} must lie in [0, 0.5)"
+                "the pixel size's relative uncertainty {pixel_size_uncertainty} must lie in \
+                 [0, 0.5)"
             )));
         }
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
