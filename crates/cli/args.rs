@@ -49,13 +49,25 @@ impl PixelSizeArg {
             .map(|t| units::parse_relative_uncertainty(t, size.map(|(x, y): (f64, f64)| x.max(y))))
             .transpose()
             .context("--pixel-size-uncertainty")?;
-        match (inline, flag) {
+        let (u, from) = match (inline, flag) {
             (Some(_), Some(_)) => bail!(
                 "the pixel size's uncertainty is given twice: in --pixel-size and in \
                  --pixel-size-uncertainty; give it once"
             ),
-            (u, v) => Ok((size, u.or(v).unwrap_or(0.0))),
+            (Some(u), None) => (u, "--pixel-size"),
+            (None, Some(u)) => (u, "--pixel-size-uncertainty"),
+            (None, None) => (0.0, ""),
+        };
+        if u > contactscope_jobs::analyze::MAX_PIXEL_SIZE_UNCERTAINTY {
+            bail!(
+                "{from}: the pixel size's uncertainty {} % must lie between 0 and {} %",
+                contactscope_formats::ranges::short(u * 100.0),
+                contactscope_formats::ranges::short(
+                    contactscope_jobs::analyze::MAX_PIXEL_SIZE_UNCERTAINTY * 100.0
+                )
+            );
         }
+        Ok((size, u))
     }
 }
 

@@ -64,7 +64,7 @@ pub const TEMPLATES: &[Template] = &[
             "--forces",
             "1,2,4mN",
             "--pixel-size",
-            "200x210nm",
+            "200x210nm±1%",
             "--threshold",
             "1100",
             "--overlays",

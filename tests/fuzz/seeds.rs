@@ -195,9 +195,10 @@ pub fn build(dir: &Path) {
             "series/series.tif",
             "--forces",
             "1,2,4mN",
-            // Areas of a few µm², which the 6.4 µm maps of the fit templates can hold.
+            // Areas of a few µm², which the 6.4 µm maps of the fit templates can hold; an
+            // uncertainty, so that the table has every interval column fit-hardening reads.
             "--pixel-size",
-            "40nm",
+            "40nm±2%",
             "--out",
             "an",
             "-q",

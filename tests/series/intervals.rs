@@ -240,3 +240,34 @@ fn a_pixel_size_uncertainty_travels_from_analyze_to_the_k_interval() {
     );
     assert!(!tmp.path().join("never").exists());
 }
+
+/// A pixel-size uncertainty out of range, or given twice, is refused in one line naming the flag
+/// that gave it; nothing is written.
+#[test]
+fn a_wrong_pixel_size_uncertainty_is_refused_naming_its_flag() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("a");
+    let series = crate::common::fixture_series();
+    let (series, out_s) = (series.to_str().unwrap(), out.to_str().unwrap());
+    for (args, expected) in [
+        (vec!["--pixel-size", "200nm±25%"], "--pixel-size: "),
+        (
+            vec!["--pixel-size-uncertainty", "30%"],
+            "--pixel-size-uncertainty: ",
+        ),
+        (
+            vec!["--pixel-size", "200nm±1%", "--pixel-size-uncertainty", "1%"],
+            "given twice",
+        ),
+        (vec!["--pixel-size", "200nm±abc"], "--pixel-size"),
+    ] {
+        let mut all = vec!["analyze", series, "--out", out_s, "-q"];
+        all.extend(args);
+        let o = crate::common::run(&all);
+        assert_eq!(o.status.code(), Some(1), "{all:?}");
+        let err = crate::common::stderr(&o);
+        assert!(err.contains(expected), "{all:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(!out.exists());
+    }
+}
