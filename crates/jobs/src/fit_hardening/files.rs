@@ -80,8 +80,13 @@ fn model_label(fit: &ModelFit) -> String {
         ),
     };
     let interval = match (fit.family, fit.parameter_ci95) {
-        (Family::Hardening | Family::Hardness, Some((lo, hi))) => format!(
+        (Family::Hardening, Some((lo, hi))) => format!(
             ", 95 % {:.2}…{:.2}",
+            display(fit.family, lo),
+            display(fit.family, hi)
+        ),
+        (Family::Hardness, Some((lo, hi))) => format!(
+            ", 95 % {:.0}…{:.0}",
             display(fit.family, lo),
             display(fit.family, hi)
         ),
