@@ -516,3 +516,42 @@ fn a_flat_map_for_the_greenwood_tripp_model_names_the_file() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn a_solver_that_does_not_converge_names_the_map() {
+    // Found by a fuzz campaign (seed 19, a map with its lines flipped): the non-convergence
+    // error named no file. An iteration limit of 2 reproduces it on any map.
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("rough.npy");
+    crate::common::rough_surface(&map, 64, "200nm", 3, &[]);
+    let out = dir.path().join("o");
+    let o = run(&[
+        "simulate",
+        "--topography",
+        s(&map),
+        "--pixel-size",
+        "200nm",
+        "--radius",
+        "20um",
+        "--modulus",
+        "3.7GPa",
+        "--model",
+        "elastic",
+        "--forces",
+        "0.1mN",
+        "--max-iterations",
+        "2",
+        "--out",
+        s(&out),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("rough.npy: ")
+            && err.contains("did not converge")
+            && err.contains("--max-iterations"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!out.exists());
+}

@@ -592,6 +592,17 @@ fn run_halfspace(
             step,
         };
         Ok(observer.load(i, total, maps)?)
+    })
+    .map_err(|e| match e {
+        // A solver that cannot converge on this map: the message names the map.
+        e @ contactscope::Error::NotConverged { .. } => crate::error::Error::bad_input(
+            crate::error::Location::file(request.heights.label()),
+            format!(
+                "{e} on this map ({} too low, heights in another unit, or a map with steps?)",
+                Param::MaxIterations
+            ),
+        ),
+        other => other.into(),
     })?;
     Ok(rows)
 }
