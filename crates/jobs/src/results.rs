@@ -9,6 +9,7 @@ use serde_json::Value;
 
 use super::table::Table;
 use crate::error::{Error, Location, Result};
+use contactscope::analysis::bootstrap::calibration_bounds;
 use contactscope::compare::SimulatedMap;
 use contactscope::model_fit::Measured;
 use contactscope::optics::blur::Grid;
@@ -57,9 +58,10 @@ pub fn read_measured(path: &Path) -> Result<Measured> {
     } else {
         0.0
     };
+    let (shrink, grow) = calibration_bounds(u);
     let mut points = Vec::with_capacity(rows.len());
     for (k, force, area) in rows {
-        let (l, h) = (lo[k] / (1.0 - u).powi(2), hi[k] / (1.0 + u).powi(2));
+        let (l, h) = (lo[k] / shrink, hi[k] / grow);
         // The interval must hold the area (up to the rounding of the written digits).
         if !(l >= 0.0 && l <= area * (1.0 + 1e-9) && h >= area * (1.0 - 1e-9)) {
             return Err(Error::bad_input(

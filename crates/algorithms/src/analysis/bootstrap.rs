@@ -105,6 +105,12 @@ pub fn fit_intervals(
     })
 }
 
+/// The factors on an area interval's ends from a pixel size known to within ±`u` (relative,
+/// bounds): ((1 − u)², (1 + u)²). An interval on the true area is the band's ends times these.
+pub fn calibration_bounds(u: f64) -> (f64, f64) {
+    ((1.0 - u).powi(2), (1.0 + u).powi(2))
+}
+
 /// The factor on every area of one resample from a pixel size known to within ±`u` (relative):
 /// (1 + u·t)², t uniform on [−1, 1]; exactly 1 when `u` is 0 (and no number is drawn).
 pub fn calibration_factor(rng: &mut impl Rng, u: f64) -> f64 {

@@ -21,6 +21,7 @@ use argmin::solver::brent::BrentOpt;
 
 use rayon::prelude::*;
 
+use crate::analysis::bootstrap::calibration_bounds;
 use crate::error::{Error, Result};
 use crate::optics::blur::{microscope_image, Grid};
 use crate::solver::cg::SolverOptions;
@@ -276,6 +277,15 @@ impl Measured {
         measured.intervals_m2 = Some(points.iter().map(|p| (p.2, p.3)).collect());
         measured.pixel_size_uncertainty = pixel_size_uncertainty;
         Ok(measured)
+    }
+
+    /// Each area's interval with the pixel size's calibration, m² (what `areas.csv` reports):
+    /// the ends of [`Measured::intervals_m2`] times [`calibration_bounds`].
+    pub fn reported_intervals_m2(&self) -> Option<Vec<(f64, f64)>> {
+        let (lo, hi) = calibration_bounds(self.pixel_size_uncertainty);
+        self.intervals_m2
+            .as_ref()
+            .map(|v| v.iter().map(|&(l, h)| (l * lo, h * hi)).collect())
     }
 
     /// RMS of ln(A_sim/A_exp); a load without simulated contact counts as a hundredth of the

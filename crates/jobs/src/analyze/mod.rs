@@ -187,6 +187,7 @@ impl AnalyzeOutcome {
             return None;
         }
         let u = self.rows.pixel_size_uncertainty;
+        let (shrink, grow) = contactscope::analysis::bootstrap::calibration_bounds(u);
         let points = self
             .rows
             .rows
@@ -196,8 +197,8 @@ impl AnalyzeOutcome {
                 (
                     r.force_mn.unwrap_or(f64::NAN) * 1e-3,
                     r.area * 1e-12,
-                    r.area_lo / (1.0 - u).powi(2) * 1e-12,
-                    r.area_hi / (1.0 + u).powi(2) * 1e-12,
+                    r.area_lo / shrink * 1e-12,
+                    r.area_hi / grow * 1e-12,
                 )
             })
             .collect();

@@ -8,7 +8,7 @@
 use serde::ser::{SerializeMap, SerializeSeq};
 use serde::{Serialize, Serializer};
 
-use contactscope::analysis::bootstrap::{fit_intervals, FitIntervals};
+use contactscope::analysis::bootstrap::{calibration_bounds, fit_intervals, FitIntervals};
 use contactscope::analysis::fit::{fit_power_law, fit_proportional, PowerLawFit};
 use contactscope::analysis::Analysis;
 use contactscope::mechanics::hertz;
@@ -401,6 +401,7 @@ pub fn table_and_fits(
         AreaUnit::SquareMicrometre => pixel_size_uncertainty,
         AreaUnit::Pixel => 0.0,
     };
+    let (shrink, grow) = calibration_bounds(u);
     let pixel_area = analysis.pixel_size.map_or(1.0, |p| p.area_um2());
     let rows: Vec<Row> = series
         .images
@@ -410,8 +411,8 @@ pub fn table_and_fits(
             let m = &r.measurement;
             let area = m.contact_pixels as f64 * pixel_area;
             let (area_lo, area_hi) = (
-                r.band.lo_pixels as f64 * pixel_area * (1.0 - u).powi(2),
-                r.band.hi_pixels as f64 * pixel_area * (1.0 + u).powi(2),
+                r.band.lo_pixels as f64 * pixel_area * shrink,
+                r.band.hi_pixels as f64 * pixel_area * grow,
             );
             let force_mn = image.force_n.map(|f| f * 1e3);
             let pressure = |a: f64| match (unit, force_mn) {
@@ -456,12 +457,9 @@ pub fn table_and_fits(
         &in_fit.iter().filter_map(|r| r.force_mn).collect::<Vec<_>>(),
         &in_fit
             .iter()
-            .map(|r| r.area_lo / (1.0 - u).powi(2))
+            .map(|r| r.area_lo / shrink)
             .collect::<Vec<_>>(),
-        &in_fit
-            .iter()
-            .map(|r| r.area_hi / (1.0 + u).powi(2))
-            .collect::<Vec<_>>(),
+        &in_fit.iter().map(|r| r.area_hi / grow).collect::<Vec<_>>(),
         u,
     );
     let proportional_mpa = match unit {

@@ -206,6 +206,12 @@ impl Opt {
                 json!(u)
             }
             Opt::PixelSize | Opt::TopographyPixelSize => {
+                if let Ok((_, Some(_))) = units::parse_pixel_size_uncertain(text) {
+                    return Err(format!(
+                        "'{text}': give the pixel size's uncertainty on its own, as \
+                         pixel_size_uncertainty (a column, or --pixel-size-uncertainty)"
+                    ));
+                }
                 let (x, y) = units::parse_pixel_size(text).map_err(|e| err(&e))?;
                 json!([x, y])
             }
@@ -625,6 +631,12 @@ mod tests {
     fn values_are_checked_as_the_flags_check_them() {
         assert!(Opt::PixelSize.parse("200").unwrap_err().contains("no unit"));
         assert!(Opt::PixelSize.parse("200mm").is_err(), "out of range");
+        assert!(Opt::PixelSize
+            .parse("200nm±1%")
+            .unwrap_err()
+            .contains("pixel_size_uncertainty"));
+        assert_eq!(Opt::PixelSizeUncertainty.parse("1%"), Ok(json!(0.01)));
+        assert!(Opt::PixelSizeUncertainty.parse("30%").is_err());
         assert!(Opt::Channel.parse("-1").is_err());
         assert!(Opt::LoadAxis.parse("c").is_err());
         assert_eq!(

@@ -173,8 +173,7 @@ pub fn fit_chart(measured: &Measured, fits: &[ModelFit]) -> Chart {
         .collect();
     // Each measured area's 95 % interval (calibration included) as a vertical bar; a
     // non-finite vertex breaks the line between bars.
-    if let Some(intervals) = &measured.intervals_m2 {
-        let u = measured.pixel_size_uncertainty;
+    if let Some(intervals) = measured.reported_intervals_m2() {
         let bars: Vec<(f64, f64)> = measured
             .forces_n
             .iter()
@@ -182,8 +181,8 @@ pub fn fit_chart(measured: &Measured, fits: &[ModelFit]) -> Chart {
             .filter(|(_, (lo, hi))| *lo > 0.0 && hi > lo)
             .flat_map(|(f, (lo, hi))| {
                 [
-                    (f * 1e3, lo * (1.0 - u).powi(2) * 1e12),
-                    (f * 1e3, hi * (1.0 + u).powi(2) * 1e12),
+                    (f * 1e3, lo * 1e12),
+                    (f * 1e3, hi * 1e12),
                     (f * 1e3, f64::NAN),
                 ]
             })

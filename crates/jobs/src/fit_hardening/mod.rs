@@ -307,10 +307,10 @@ impl Serialize for MeasuredFacts {
         let mut map = s.serialize_map(None)?;
         map.serialize_entry("force_mN", &Qs(&m.forces_n, Unit::NAsMn))?;
         map.serialize_entry("area_um2", &Qs(&m.areas_m2, Unit::M2AsUm2))?;
-        if let Some(intervals) = &m.intervals_m2 {
+        if let Some(intervals) = m.reported_intervals_m2() {
             let u = m.pixel_size_uncertainty;
-            let lo: Vec<f64> = intervals.iter().map(|i| i.0 * (1.0 - u).powi(2)).collect();
-            let hi: Vec<f64> = intervals.iter().map(|i| i.1 * (1.0 + u).powi(2)).collect();
+            let lo: Vec<f64> = intervals.iter().map(|i| i.0).collect();
+            let hi: Vec<f64> = intervals.iter().map(|i| i.1).collect();
             map.serialize_entry("area_um2_lo", &Qs(&lo, Unit::M2AsUm2))?;
             map.serialize_entry("area_um2_hi", &Qs(&hi, Unit::M2AsUm2))?;
             map.serialize_entry("pixel_size_uncertainty_pct", &Q(u, Unit::FractionAsPct))?;
