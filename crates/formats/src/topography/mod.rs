@@ -83,8 +83,8 @@ pub use npy::{encode_npy, read_npy};
 pub use text::read_text;
 pub use vendor::MAX_FILE_BYTES;
 pub(crate) use vendor::{
-    choose, count, grid_bytes, height_like, height_map, length_factor, length_scale, positive,
-    ChannelEntry,
+    choose, count, grid_bytes, height_like, height_map, length_factor, length_scale, line_scan,
+    positive, ChannelEntry,
 };
 pub use vendor::{detect, detect_file, read, HeightMap, TopographyFormat};
 pub use wsxm::read_wsxm;

@@ -341,6 +341,19 @@ pub(crate) fn grid_bytes(path: &Path, nx: usize, ny: usize, width: usize) -> Res
         .map_err(|reason| unsupported(path, format!("height map: {reason} (header corrupt?)")))
 }
 
+/// The refusal of a one-dimensional profile: what the file holds and what a contact calculation
+/// needs, in one line. `dx_m` is the point spacing when the file states one.
+pub(crate) fn line_scan(path: &Path, points: usize, dx_m: Option<f64>) -> crate::error::Error {
+    let spacing = dx_m.map_or(String::new(), |d| format!(" spaced {d:e} m"));
+    unsupported(
+        path,
+        format!(
+            "the file holds a line scan (one profile of {points} points{spacing}), not a height \
+             map; topography and simulate need a 2-D map of heights"
+        ),
+    )
+}
+
 /// Positive finite size or an error naming it.
 pub(crate) fn positive(path: &Path, what: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
