@@ -61,6 +61,7 @@ pub mod sur;
 mod vendor;
 pub mod x3p;
 
+mod content;
 mod gsf;
 mod nanoscope;
 mod npy;
@@ -77,22 +78,15 @@ use crate::ranges::Quantity;
 use crate::tiff::metadata::length_unit_factor;
 use crate::tiff::{TiffInfo, TiffReader};
 
+pub use content::{read_height_map, READ_FORMATS};
 pub use gsf::{encode_gsf, read_gsf};
-pub use nanoscope::read_nanoscope;
 pub use npy::{encode_npy, read_npy};
-pub use text::read_text;
 pub use vendor::MAX_FILE_BYTES;
 pub(crate) use vendor::{
     choose, count, grid_bytes, height_like, height_map, length_factor, length_scale, line_scan,
     positive, ChannelEntry,
 };
 pub use vendor::{detect, detect_file, read, HeightMap, TopographyFormat};
-pub use wsxm::read_wsxm;
-
-/// Extensions [`read_topography`] knows (Nanoscope files also use three-digit extensions).
-pub const SUPPORTED_EXTENSIONS: &[&str] = &[
-    "npy", "tif", "tiff", "gsf", "txt", "csv", "dat", "top", "di", "spm", "001",
-];
 
 /// How to read a height-map file: overrides for what the file does not say (or says wrongly).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -103,38 +97,6 @@ pub struct ReadOptions {
     pub height_unit_m: Option<f64>,
     /// Channel of a multi-channel vendor file, by name (default: its height channel).
     pub channel: Option<String>,
-}
-
-/// Read a height map of any format: a vendor format recognised by its content ([`read`]: heights
-/// as stored, invalid points NaN and counted, the pixel size overridden when given; a height
-/// unit is refused, every vendor format states its own), else by extension
-/// ([`read_topography`]: every point valid, pixel size and heights within their plausible
-/// ranges). Nothing is detrended or filled here.
-pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> {
-    if matches!(detect_file(path), Ok(Some(_))) {
-        let mut map = read(path, options.channel.as_deref())?;
-        if options.height_unit_m.is_some() {
-            return Err(bad(
-                path,
-                format!(
-                    "the {} file states its height unit; do not give another one",
-                    map.format.name()
-                ),
-            ));
-        }
-        if let Some((dx, dy)) = options.pixel_size_m {
-            map.dx_m = dx;
-            map.dy_m = dy;
-        }
-        return Ok(map);
-    }
-    if let Some(channel) = &options.channel {
-        return Err(bad(
-            path,
-            format!("channel '{channel}' asked for, but this format holds one height map"),
-        ));
-    }
-    read_topography(path, options.pixel_size_m, options.height_unit_m)
 }
 
 impl HeightMap {
@@ -157,75 +119,6 @@ impl HeightMap {
         Quantity::PixelSize.check_at(self.dx_m, &at)?;
         Quantity::PixelSize.check_at(self.dy_m, &at)?;
         plausible_heights(path, &self.heights)
-    }
-}
-
-/// The name of the extension reader [`read_topography`] uses for `path` (`npy`, `tiff`, `gsf`,
-/// `text`, `wsxm`, `nanoscope`), for summaries; `None` for an unknown extension.
-pub fn extension_format(path: &Path) -> Option<&'static str> {
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    Some(match ext.as_str() {
-        "npy" => "npy",
-        "tif" | "tiff" => "tiff",
-        "gsf" => "gsf",
-        "txt" | "csv" | "dat" => "text",
-        "top" => "wsxm",
-        "di" | "spm" => "nanoscope",
-        e if e.len() == 3 && e.bytes().all(|b| b.is_ascii_digit()) => "nanoscope",
-        _ => return None,
-    })
-}
-
-/// Read a height map by the file extension (the first table in the module docs); the vendor
-/// formats are read by [`read_height_map`].
-/// `pixel_size_m` = (x, y) in metres overrides the file's; `height_unit_m` gives metres per
-/// stored unit for formats without a unit (default 1: metres).
-pub fn read_topography(
-    path: &Path,
-    pixel_size_m: Option<(f64, f64)>,
-    height_unit_m: Option<f64>,
-) -> Result<HeightMap> {
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    match ext.as_str() {
-        "npy" => read_npy(path, pixel_size_m, height_unit_m),
-        "tif" | "tiff" => read_tiff(path, pixel_size_m, height_unit_m),
-        "gsf" => read_gsf(path, pixel_size_m, height_unit_m),
-        "txt" | "csv" | "dat" => read_text(path, pixel_size_m, height_unit_m),
-        "top" => read_wsxm(path, pixel_size_m, height_unit_m),
-        "di" | "spm" => read_nanoscope(path, pixel_size_m, height_unit_m),
-        e if e.len() == 3 && e.bytes().all(|b| b.is_ascii_digit()) => {
-            read_nanoscope(path, pixel_size_m, height_unit_m)
-        }
-        _ => {
-            let mut head = [0u8; 16];
-            let n = std::fs::File::open(path)
-                .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
-                .unwrap_or(0);
-            use crate::microscopy::MicroscopyFormat as M;
-            let reason = match crate::microscopy::detect(&head[..n]) {
-                Some(format @ (M::Czi | M::Nd2 | M::Lif)) => format!(
-                    "a {} micrograph, not a height map (info, threshold and analyze read it)",
-                    format.name().to_uppercase()
-                ),
-                _ => format!(
-                    "unknown height-map extension '{ext}'; supported by extension: .{} \
-                     (Nanoscope also .002, .003, …); by content: Igor .ibw, NT-MDT .nid, \
-                     Agilent .mi, Park TIFF, Gwyddion .gwy, ISO 25178 .x3p, .sdf, Wyko .opd, \
-                     Sensofar .plu, Digital Surf .sur, FRT .frt",
-                    SUPPORTED_EXTENSIONS.join(", .")
-                ),
-            };
-            Err(Error::Unsupported {
-                at: Location::file(path),
-                reason,
-            })
-        }
     }
 }
 
@@ -482,19 +375,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn unknown_extension_lists_the_supported_ones() {
-        let err = read_topography(Path::new("map.xyz"), None, None)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            err.contains("map.xyz") && err.contains(".gsf") && err.contains(".npy"),
-            "{err}"
-        );
-    }
-
-    #[test]
     fn missing_file_names_it() {
-        let err = read_topography(Path::new("/nonexistent/a.gsf"), None, None)
+        let err = read_height_map(Path::new("/nonexistent/a.gsf"), &ReadOptions::default())
             .unwrap_err()
             .to_string();
         assert!(err.contains("/nonexistent/a.gsf"), "{err}");

@@ -15,8 +15,8 @@ use std::path::Path;
 use super::{HeightMap, TopographyFormat};
 use crate::error::{Error, Location, Result};
 
-use super::vendor::grid_bytes;
-use super::{bad, latin1, length_unit, read_bytes, refuse_height_unit, slice, topography};
+use super::vendor::{choose, grid_bytes, height_map, ChannelEntry};
+use super::{bad, latin1, length_unit, slice};
 
 /// One `\*Ciao image list` section.
 #[derive(Debug, Default)]
@@ -32,33 +32,71 @@ struct Header {
 
 /// A channel resolved to numbers.
 struct HeightChannel {
-    name: String,
     offset: usize,
     bytes_per_pixel: usize,
     nx: usize,
     ny: usize,
     size_m: (f64, f64),
     metres_per_lsb: f64,
-    unit: String,
 }
 
-/// Read the default height channel of a Nanoscope file (module docs). Pixel size and height
-/// unit come from the header; `pixel_size_m` overrides the former, a `height_unit_m` is refused.
-pub fn read_nanoscope(
-    path: &Path,
-    pixel_size_m: Option<(f64, f64)>,
-    height_unit_m: Option<f64>,
-) -> Result<HeightMap> {
-    let bytes = read_bytes(path)?;
-    let header = parse_header(path, &bytes)?;
-    let channel = default_channel(path, &header)?;
-    refuse_height_unit(path, height_unit_m, &channel.unit)?;
-    let (nx, ny, b) = (channel.nx, channel.ny, channel.bytes_per_pixel);
+/// Read a channel of a Nanoscope file (module docs): `channel` by name, else the first height
+/// channel ([`super::vendor::choose`]). Pixel size and height unit come from the header.
+pub fn read(path: &Path, bytes: &[u8], channel: Option<&str>) -> Result<HeightMap> {
+    let header = parse_header(path, bytes)?;
+    let mut entries = Vec::with_capacity(header.channels.len());
+    let mut resolved: Vec<Result<Option<HeightChannel>>> =
+        Vec::with_capacity(header.channels.len());
+    for c in &header.channels {
+        let name = channel_name(c);
+        let r = resolve(path, &header, c, &name);
+        let length = matches!(r, Ok(Some(_)));
+        entries.push((name, c.fields.get("line direction").cloned(), length));
+        resolved.push(r);
+    }
+    let names = distinct_names(&entries);
+    let list: Vec<ChannelEntry> = names
+        .iter()
+        .zip(&entries)
+        .map(|(name, (_, _, length))| ChannelEntry {
+            name: name.clone(),
+            height: *length,
+        })
+        .collect();
+    if list.iter().all(|c| !c.height) && channel.is_none() {
+        return Err(Error::Unsupported {
+            at: Location::file(path),
+            reason: format!(
+                "no channel with a height (length) scale; channels: {}",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            ),
+        });
+    }
+    let index = choose(path, &list, channel)?;
+    let Some(chosen) = resolved.swap_remove(index)? else {
+        return Err(bad(
+            path,
+            format!(
+                "channel '{}' has no height (length) scale; choose one of {}",
+                list[index].name,
+                list.iter()
+                    .filter(|c| c.height)
+                    .map(|c| format!("'{}'", c.name))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
+    };
+    let (nx, ny, b) = (chosen.nx, chosen.ny, chosen.bytes_per_pixel);
     let data =
-        slice(path, &bytes, channel.offset, grid_bytes(path, nx, ny, b)?).map_err(|e| match e {
+        slice(path, bytes, chosen.offset, grid_bytes(path, nx, ny, b)?).map_err(|e| match e {
             Error::BadInput { at, reason } => Error::BadInput {
                 at,
-                reason: format!("channel '{}': {reason}", channel.name),
+                reason: format!("channel '{}': {reason}", list[index].name),
             },
             other => other,
         })?;
@@ -66,12 +104,36 @@ pub fn read_nanoscope(
     for row in data.chunks_exact(nx * b).rev() {
         heights.extend(
             row.chunks_exact(b)
-                .map(|c| raw_value(c) * channel.metres_per_lsb),
+                .map(|c| raw_value(c) * chosen.metres_per_lsb),
         );
     }
-    let pixel =
-        pixel_size_m.unwrap_or((channel.size_m.0 / nx as f64, channel.size_m.1 / ny as f64));
-    topography(path, TopographyFormat::Nanoscope, (ny, nx), heights, pixel)
+    height_map(
+        path,
+        TopographyFormat::Nanoscope,
+        (&list, index),
+        (ny, nx),
+        heights,
+        (chosen.size_m.0 / nx as f64, chosen.size_m.1 / ny as f64),
+    )
+}
+
+/// The channels' names as the file gives them (`Height`, `ZSensor`); a name the file uses twice
+/// gets the line direction (`Height (Retrace)`) or its position so that each can be chosen.
+fn distinct_names(entries: &[(String, Option<String>, bool)]) -> Vec<String> {
+    let mut names: Vec<String> = Vec::with_capacity(entries.len());
+    for (i, (name, direction, _)) in entries.iter().enumerate() {
+        let earlier = entries[..i].iter().any(|(n, _, _)| n == name);
+        let candidate = match direction {
+            Some(d) if earlier => format!("{name} ({d})"),
+            _ => name.clone(),
+        };
+        if names.contains(&candidate) {
+            names.push(format!("{name} ({})", i + 1));
+        } else {
+            names.push(candidate);
+        }
+    }
+    names
 }
 
 fn raw_value(c: &[u8]) -> f64 {
@@ -126,28 +188,6 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
 fn split_entry(line: &str) -> Option<(&str, &str)> {
     line.split_once(": ")
         .or_else(|| line.strip_suffix(':').map(|key| (key, "")))
-}
-
-fn default_channel(path: &Path, header: &Header) -> Result<HeightChannel> {
-    let mut names = Vec::new();
-    for channel in &header.channels {
-        let name = channel_name(channel);
-        if let Some(resolved) = resolve(path, header, channel, &name)? {
-            return Ok(resolved);
-        }
-        names.push(name);
-    }
-    Err(Error::Unsupported {
-        at: Location::file(path),
-        reason: format!(
-            "no channel with a height (length) scale; channels: {}",
-            if names.is_empty() {
-                "none".to_string()
-            } else {
-                names.join(", ")
-            }
-        ),
-    })
 }
 
 /// `S [ZSensor] "Height Sensor"` → `ZSensor`.
@@ -206,14 +246,12 @@ fn resolve(
         ));
     }
     Ok(Some(HeightChannel {
-        name: name.to_string(),
         offset: integer("data offset")?,
         bytes_per_pixel,
         nx,
         ny,
         size_m: scan_size(path, field("scan size")?)?,
         metres_per_lsb: volts_per_unit_hard / 65536.0 * binary * soft * unit_m,
-        unit,
     }))
 }
 
@@ -300,17 +338,55 @@ mod tests {
         (dir, path)
     }
 
+    fn read_nanoscope(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
+        read(path, &std::fs::read(path).unwrap(), channel)
+    }
+
     #[test]
     fn reads_the_first_height_channel_top_row_first() {
         let (_dir, path) = file(&sample(&[1, 2, 3, 4]));
-        let t = read_nanoscope(&path, None, None).unwrap();
+        let t = read_nanoscope(&path, None).unwrap();
         // 0.0001 V/LSB × 20 nm/V = 2 pm per LSB; stored bottom line first.
         let expected = [6e-12, 8e-12, 2e-12, 4e-12];
         for (a, b) in t.heights.iter().zip(expected) {
             assert!((a - b).abs() < 1e-24, "{a} vs {b}");
         }
         assert!((t.dx_m - 2e-6).abs() < 1e-18 && (t.dy_m - 1e-6).abs() < 1e-18);
-        assert!(read_nanoscope(&path, None, Some(1e-9)).is_err());
+        assert_eq!(t.channel, "Height");
+        assert_eq!(t.channels, ["Phase", "Height"]);
+        let err = read_nanoscope(&path, Some("phase"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("'Phase' has no height") && err.contains("'Height'"),
+            "{err}"
+        );
+        let err = read_nanoscope(&path, Some("Friction"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("no channel 'Friction'"), "{err}");
+    }
+
+    #[test]
+    fn a_name_used_twice_gets_the_line_direction() {
+        let e = |n: &str, d: Option<&str>| (n.to_string(), d.map(String::from), true);
+        let names = distinct_names(&[
+            e("Height", Some("Trace")),
+            e("Height", Some("Retrace")),
+            e("Phase", Some("Trace")),
+            e("Height", Some("Retrace")),
+            e("Phase", None),
+        ]);
+        assert_eq!(
+            names,
+            [
+                "Height",
+                "Height (Retrace)",
+                "Phase",
+                "Height (4)",
+                "Phase (5)"
+            ]
+        );
     }
 
     #[test]
@@ -318,23 +394,23 @@ mod tests {
         let mut bytes = sample(&[1, 2, 3, 4]);
         bytes.truncate(bytes.len() - 1);
         let (_dir, path) = file(&bytes);
-        let err = read_nanoscope(&path, None, None).unwrap_err().to_string();
+        let err = read_nanoscope(&path, None).unwrap_err().to_string();
         assert!(err.contains("truncated") && err.contains("Height"), "{err}");
         let mut bytes = sample(&[1, 2, 3, 4]);
         bytes.truncate(200);
         let (_dir, path) = file(&bytes);
-        assert!(read_nanoscope(&path, None, None)
+        assert!(read_nanoscope(&path, None)
             .unwrap_err()
             .to_string()
             .contains("File list end"));
         let (_dir, path) = file(b"\\*Something else\r\n");
-        assert!(read_nanoscope(&path, None, None)
+        assert!(read_nanoscope(&path, None)
             .unwrap_err()
             .to_string()
             .contains("not a Nanoscope"));
         let bytes = String::from_utf8_lossy(&sample(&[0; 4])).replace("nm/V", "mV/V");
         let (_dir, path) = file(bytes.as_bytes());
-        let err = read_nanoscope(&path, None, None).unwrap_err().to_string();
+        let err = read_nanoscope(&path, None).unwrap_err().to_string();
         assert!(
             err.contains("no channel with a height") && err.contains("Phase, Height"),
             "{err}"

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::{frt, gwy, ibw, mi, nid, opd, park, plu, sdf, sur, x3p};
+use super::{frt, gwy, ibw, mi, nanoscope, nid, opd, park, plu, sdf, sur, wsxm, x3p};
 
 use ndarray::Array2;
 use serde::Serialize;
@@ -47,11 +47,13 @@ pub enum TopographyFormat {
     Tiff,
     /// Gwyddion Simple Field `.gsf` (by extension).
     Gsf,
-    /// Text matrix `.txt`, `.csv`, `.dat` (by extension).
+    /// Text matrix, with or without a header (also gzip-compressed).
     Text,
-    /// WSxM `.top` (by extension).
+    /// `x y z` points on a regular grid (text).
+    Xyz,
+    /// WSxM image (`.top`, `.stp`, …).
     Wsxm,
-    /// Bruker/Veeco Nanoscope (by extension).
+    /// Bruker/Veeco Nanoscope (`.di`, `.spm`, `.001`, …).
     Nanoscope,
 }
 
@@ -74,6 +76,7 @@ impl TopographyFormat {
             TopographyFormat::Tiff => "tiff",
             TopographyFormat::Gsf => "gsf",
             TopographyFormat::Text => "text",
+            TopographyFormat::Xyz => "xyz",
             TopographyFormat::Wsxm => "wsxm",
             TopographyFormat::Nanoscope => "nanoscope",
         }
@@ -134,6 +137,10 @@ pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
         Some(TopographyFormat::Mi)
     } else if head.get(2..11) == Some(b"Directory") {
         Some(TopographyFormat::Opd)
+    } else if starts(b"\\*File list") {
+        Some(TopographyFormat::Nanoscope)
+    } else if starts(b"WSxM file copyright") {
+        Some(TopographyFormat::Wsxm)
     } else if starts(b"PK\x03\x04") {
         Some(TopographyFormat::X3p)
     } else if ibw::is_ibw(head) {
@@ -186,13 +193,14 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 TopographyFormat::Plu => plu::read(path, &bytes, channel),
                 TopographyFormat::Sur => sur::read(path, &bytes, channel),
                 TopographyFormat::Frt => frt::read(path, &bytes, channel),
+                TopographyFormat::Nanoscope => nanoscope::read(path, &bytes, channel),
+                TopographyFormat::Wsxm => wsxm::read(path, &bytes, channel),
                 TopographyFormat::X3p
                 | TopographyFormat::Npy
                 | TopographyFormat::Tiff
                 | TopographyFormat::Gsf
                 | TopographyFormat::Text
-                | TopographyFormat::Wsxm
-                | TopographyFormat::Nanoscope => unreachable!("not detected by content"),
+                | TopographyFormat::Xyz => unreachable!("not detected by content"),
             }
         }
     }

@@ -15,8 +15,8 @@ use std::path::Path;
 use super::{HeightMap, TopographyFormat};
 use crate::error::Result;
 
-use super::vendor::grid_bytes;
-use super::{bad, latin1, length_unit, read_bytes, refuse_height_unit, slice, topography};
+use super::vendor::{choose, grid_bytes, height_map, ChannelEntry};
+use super::{bad, latin1, length_unit, slice};
 
 /// Header fields keyed by (section, key).
 struct Header {
@@ -66,41 +66,34 @@ impl Header {
     }
 }
 
-/// Read a WSxM `.top` image (module docs). Pixel size and height unit come from the header;
-/// `pixel_size_m` overrides the former, a `height_unit_m` is refused.
-pub fn read_wsxm(
-    path: &Path,
-    pixel_size_m: Option<(f64, f64)>,
-    height_unit_m: Option<f64>,
-) -> Result<HeightMap> {
-    let bytes = read_bytes(path)?;
-    let (header, data_offset) = parse_header(path, &bytes)?;
-    let z_text = header.get(path, "General Info", "Z Amplitude")?;
-    refuse_height_unit(path, height_unit_m, z_text)?;
+/// Read a WSxM image (`.top`, `.stp`, …; module docs). Pixel size and height unit come from the
+/// header. The one channel is named by `[General Info] Acquisition channel` (else "Default").
+pub fn read(path: &Path, bytes: &[u8], channel: Option<&str>) -> Result<HeightMap> {
+    let (header, data_offset) = parse_header(path, bytes)?;
+    let name = header
+        .get(path, "General Info", "Acquisition channel")
+        .ok()
+        .filter(|n| !n.is_empty())
+        .unwrap_or("Default");
+    let channels = [ChannelEntry {
+        name: name.to_string(),
+        height: true,
+    }];
+    let index = choose(path, &channels, channel)?;
     let (nx, ny) = (
         header.count(path, "Number of columns")?,
         header.count(path, "Number of rows")?,
     );
-    let pixel = match pixel_size_m {
-        Some(p) => p,
-        None => (
-            header.length(path, "Control", "X Amplitude")? / nx as f64,
-            header.length(path, "Control", "Y Amplitude")? / ny as f64,
-        ),
-    };
-    let range = header.number(path, "Miscellaneous", "Maximum")?
-        - header.number(path, "Miscellaneous", "Minimum")?;
+    let pixel = (
+        header.length(path, "Control", "X Amplitude")? / nx as f64,
+        header.length(path, "Control", "Y Amplitude")? / ny as f64,
+    );
     let z_amplitude = header.length(path, "General Info", "Z Amplitude")?;
-    let scale = if range > 0.0 {
-        z_amplitude / range
-    } else {
-        1.0
-    };
     let kind = header.get(path, "General Info", "Image Data Type")?;
-    let size = match kind {
-        "short" | "integer" => 2,
-        "float" => 4,
-        "double" => 8,
+    let (size, integer) = match kind {
+        "short" | "integer" => (2, true),
+        "float" => (4, false),
+        "double" => (8, false),
         other => {
             return Err(bad(
                 path,
@@ -108,12 +101,35 @@ pub fn read_wsxm(
             ))
         }
     };
-    let data = slice(path, &bytes, data_offset, grid_bytes(path, nx, ny, size)?)?;
+    // Integers span the header's Minimum…Maximum over the Z amplitude; floating-point numbers
+    // are heights in the Z amplitude's unit (the header's Minimum and Maximum are those numbers
+    // rounded to six digits: their ratio to the amplitude is not a scale).
+    let scale = if integer {
+        let range = header.number(path, "Miscellaneous", "Maximum")?
+            - header.number(path, "Miscellaneous", "Minimum")?;
+        if range > 0.0 {
+            z_amplitude / range
+        } else {
+            1.0
+        }
+    } else {
+        let z_text = header.get(path, "General Info", "Z Amplitude")?;
+        let (_, unit) = z_text.split_once(' ').unwrap_or((z_text, ""));
+        length_unit(path, unit, "WSxM Z Amplitude")?
+    };
+    let data = slice(path, bytes, data_offset, grid_bytes(path, nx, ny, size)?)?;
     let heights = data
         .chunks_exact(size)
         .map(|c| raw_value(c) * scale)
         .collect();
-    topography(path, TopographyFormat::Wsxm, (ny, nx), heights, pixel)
+    height_map(
+        path,
+        TopographyFormat::Wsxm,
+        (&channels, index),
+        (ny, nx),
+        heights,
+        pixel,
+    )
 }
 
 fn raw_value(c: &[u8]) -> f64 {
@@ -142,7 +158,11 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<(Header, usize)> {
     if lines.next().map(str::trim) != Some("SxM Image file") {
         return Err(bad(
             path,
-            "WSxM file is not an image (second line is not 'SxM Image file')",
+            format!(
+                "a WSxM file that is not an image ('{}' instead of 'SxM Image file'): \
+                 topography and simulate need a height map",
+                lines.next().unwrap_or("").trim()
+            ),
         ));
     }
     let size_line = lines.next().unwrap_or("");
@@ -202,6 +222,10 @@ mod tests {
         out
     }
 
+    fn read_wsxm(path: &Path) -> Result<HeightMap> {
+        read(path, &std::fs::read(path).unwrap(), None)
+    }
+
     fn file(bytes: &[u8]) -> (tempfile::TempDir, std::path::PathBuf) {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.top");
@@ -216,34 +240,42 @@ mod tests {
             .flat_map(|v| v.to_le_bytes())
             .collect();
         let (_dir, path) = file(&sample("short", &payload));
-        let t = read_wsxm(&path, None, None).unwrap();
+        let t = read_wsxm(&path).unwrap();
         assert_eq!((t.ny(), t.nx()), (2, 3));
         assert!((t.dx_m - 1e-9).abs() < 1e-24 && (t.dy_m - 1e-9).abs() < 1e-24);
         assert!((t.heights[[1, 2]] - 10e-9).abs() < 1e-22);
         assert!((t.heights[[0, 1]] - 1e-9).abs() < 1e-22);
-        assert!(read_wsxm(&path, None, Some(1.0)).is_err());
+        assert_eq!(t.channel, "Default");
+        // Floating-point numbers are heights in the amplitude's unit, whatever Minimum/Maximum.
+        let payload: Vec<u8> = [0.5f64, 1.0, 2.0, 3.0, 4.0, 5.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let (_dir, path) = file(&sample("double", &payload));
+        let t = read_wsxm(&path).unwrap();
+        assert_eq!(t.heights[[0, 0]], 0.5e-9);
     }
 
     #[test]
     fn rejects_truncated_and_foreign_files() {
         let (_dir, path) = file(&sample("short", &[0u8; 7]));
-        assert!(read_wsxm(&path, None, None)
+        assert!(read_wsxm(&path)
             .unwrap_err()
             .to_string()
             .contains("truncated"));
         let (_dir, path) = file(&sample("complex", &[0u8; 12]));
-        assert!(read_wsxm(&path, None, None)
+        assert!(read_wsxm(&path)
             .unwrap_err()
             .to_string()
             .contains("complex"));
         let (_dir, path) = file(b"Hello\n");
-        assert!(read_wsxm(&path, None, None)
+        assert!(read_wsxm(&path)
             .unwrap_err()
             .to_string()
             .contains("not a WSxM"));
         let mut cut = sample("short", &[]);
         cut.truncate(60);
         let (_dir, path) = file(&cut);
-        assert!(read_wsxm(&path, None, None).is_err());
+        assert!(read_wsxm(&path).is_err());
     }
 }

@@ -6,8 +6,10 @@
 //! little-endian) and `CZ/Increment`, `CZ/Offset` the scaling `h = raw · Increment + Offset`
 //! (defaults 1 and 0); `Record3/MatrixDimension/SizeX|SizeY` the grid, x fastest. Invalid
 //! points are NaN (float data) or the 0 bits of the optional `ValidPointsLink` file (one bit per
-//! point, least significant bit first). Archives whose `main.xml` is in a sub-folder are not
-//! valid X3P and are refused.
+//! point, least significant bit first). Some writers put `main.xml` and the data in one
+//! sub-folder of the archive (`name/main.xml`, `name/bindata/data.bin`): when exactly one
+//! `main.xml` is found, the links are taken relative to its folder. A zip archive without one
+//! is refused, saying what it holds (an Office workbook, or its first entries).
 
 use std::io::Read;
 use std::path::Path;
@@ -24,9 +26,10 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
     let file = std::fs::File::open(path).map_err(|e| crate::Error::io(path, e))?;
     let mut zip = zip::ZipArchive::new(file)
         .map_err(|e| bad(path, format!("not a readable zip archive: {e}")))?;
+    let folder = main_folder(path, &zip)?;
     let mut member = |name: &str, limit: usize| -> Result<Vec<u8>> {
         let entry = zip
-            .by_name(name)
+            .by_name(&format!("{folder}{name}"))
             .map_err(|_| bad(path, format!("the X3P archive has no '{name}'")))?;
         if entry.size() > limit as u64 {
             return Err(unsupported(
@@ -134,13 +137,66 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
     )
 }
 
+/// The folder (`""` or `"name/"`) of the archive's one `main.xml`, or an error saying what the
+/// archive holds instead.
+fn main_folder<R: std::io::Read + std::io::Seek>(
+    path: &Path,
+    zip: &zip::ZipArchive<R>,
+) -> Result<String> {
+    let names: Vec<&str> = zip.file_names().collect();
+    if names.contains(&"main.xml") {
+        return Ok(String::new());
+    }
+    let nested: Vec<&str> = names
+        .iter()
+        .copied()
+        .filter(|n| n.ends_with("/main.xml"))
+        .collect();
+    if let [one] = nested.as_slice() {
+        return Ok(one.trim_end_matches("main.xml").to_string());
+    }
+    let what = if names.contains(&"[Content_Types].xml") {
+        let kind = if names.iter().any(|n| n.starts_with("xl/")) {
+            "an Excel workbook (.xlsx)"
+        } else if names.iter().any(|n| n.starts_with("word/")) {
+            "a Word document (.docx)"
+        } else {
+            "an Office Open XML document"
+        };
+        format!("{kind}, not a height map")
+    } else {
+        let mut shown: Vec<String> = names.iter().take(5).map(|n| format!("'{n}'")).collect();
+        if names.len() > 5 {
+            shown.push(format!("… ({} entries)", names.len()));
+        }
+        format!(
+            "a zip archive that is not ISO 25178-72 X3P ({}; it holds {})",
+            if nested.is_empty() {
+                "no main.xml"
+            } else {
+                "several main.xml"
+            },
+            if shown.is_empty() {
+                "nothing".to_string()
+            } else {
+                shown.join(", ")
+            }
+        )
+    };
+    Err(unsupported(path, what))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::io::Write;
 
     fn x3p(dir: &Path, with_valid: bool) -> std::path::PathBuf {
-        let path = dir.join(format!("t{with_valid}.x3p"));
+        archive(dir, "", with_valid)
+    }
+
+    fn archive(dir: &Path, folder: &str, with_valid: bool) -> std::path::PathBuf {
+        let path = dir.join(format!("t{with_valid}{}.x3p", folder.len()));
         let mut zip = zip::ZipWriter::new(std::fs::File::create(&path).unwrap());
         let opts = zip::write::SimpleFileOptions::default()
             .compression_method(zip::CompressionMethod::Stored);
@@ -157,13 +213,15 @@ mod tests {
              <SizeZ>1</SizeZ></MatrixDimension><DataLink><PointDataLink>bindata/data.bin\
              </PointDataLink>{valid}</DataLink></Record3></p:ISO5436_2>"
         );
-        zip.start_file("main.xml", opts).unwrap();
+        zip.start_file(format!("{folder}main.xml"), opts).unwrap();
         zip.write_all(xml.as_bytes()).unwrap();
-        zip.start_file("bindata/data.bin", opts).unwrap();
+        zip.start_file(format!("{folder}bindata/data.bin"), opts)
+            .unwrap();
         for v in [0i16, 1, 2, 3, 4, -5] {
             zip.write_all(&v.to_le_bytes()).unwrap();
         }
-        zip.start_file("bindata/valid.bin", opts).unwrap();
+        zip.start_file(format!("{folder}bindata/valid.bin"), opts)
+            .unwrap();
         zip.write_all(&[0b0011_1011]).unwrap();
         zip.finish().unwrap();
         path
@@ -180,5 +238,37 @@ mod tests {
         let v = read(&x3p(dir.path(), true), None).unwrap();
         assert_eq!(v.invalid_points, 1);
         assert!(v.heights[[0, 2]].is_nan());
+    }
+
+    #[test]
+    fn main_xml_in_a_sub_folder_reads_and_other_zips_say_what_they_are() {
+        let dir = tempfile::tempdir().unwrap();
+        let top = read(&x3p(dir.path(), true), None).unwrap();
+        let nested = read(&archive(dir.path(), "scan 1/", true), None).unwrap();
+        assert_eq!(top.heights.iter().filter(|h| h.is_nan()).count(), 1);
+        assert_eq!(
+            format!("{:?}", top.heights),
+            format!("{:?}", nested.heights)
+        );
+        let other = |name: &str, entries: &[&str]| {
+            let path = dir.path().join(name);
+            let mut zip = zip::ZipWriter::new(std::fs::File::create(&path).unwrap());
+            for e in entries {
+                zip.start_file(*e, zip::write::SimpleFileOptions::default())
+                    .unwrap();
+            }
+            zip.finish().unwrap();
+            read(&path, None).unwrap_err().to_string()
+        };
+        let err = other("a.xlsx", &["[Content_Types].xml", "xl/workbook.xml"]);
+        assert!(
+            err.contains("Excel workbook") && err.contains("a.xlsx"),
+            "{err}"
+        );
+        let err = other("b.zip", &["index.xml", "LAYER_0.raw"]);
+        assert!(
+            err.contains("no main.xml") && err.contains("'LAYER_0.raw'"),
+            "{err}"
+        );
     }
 }
