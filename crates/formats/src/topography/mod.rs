@@ -37,6 +37,10 @@
 //! | Sensofar `.plu` | [`plu`] | (none: size check of the 2012 layout) | µm | `micrometers_per_pixel` | 1000001 |
 //! | Digital Surf `.sur` | [`sur`] | `DIGITAL SURF` | `raw·scale` in `delta_data_unit` | grid spacing | `zmin − 2` when flagged |
 //! | FRT MicroProf `.frt` | [`frt`] | `FRTM_GLIDERV1.0` | `raw·scale` (m) | block 0x67 size / pixels | raw = 1 |
+//! | Alicona `.al3d` | [`al3d`] | `AliconaImaging\0\r\n` | float32 (m) | `PixelSizeXMeter`, `PixelSizeYMeter` | `InvalidPixelValue`, NaN |
+//! | TrueMap `.tmd` | [`tmd`] | `Binary TrueMap Data File v` | float32 (mm) | lengths (mm) / points | NaN |
+//! | NanoFocus µsurf `.nms` | [`nms`] | `OM_MS_` at byte 32 | `z_low + (raw − raw_low)·Δz/Δraw` (µm) | spacings (nm) | intensity 0 |
+//! | Image Metrology `.bcr`, `.bcrf` | [`bcr`] | `fileformat = bcr` (8-bit or UTF-16LE) | int16 · `bit2nm` or float32, in `zunit` | `xlength/xpixels` in `xunit` | 32767, > 1.7e38 |
 //!
 //! **Invalid points** are stored as NaN in [`HeightMap::heights`] and counted in
 //! [`HeightMap::invalid_points`]; [`HeightMap::check_usable`] refuses a map with invalid
@@ -48,16 +52,20 @@
 //! unit, or a name with "height", "topograph" or "z-axis"). When no channel matches, the error
 //! lists them all. The chosen channel's unit must still be a length.
 
+pub mod al3d;
+pub mod bcr;
 pub mod frt;
 pub mod gwy;
 pub mod ibw;
 pub mod mi;
 pub mod nid;
+pub mod nms;
 pub mod opd;
 pub mod park;
 pub mod plu;
 pub mod sdf;
 pub mod sur;
+pub mod tmd;
 mod vendor;
 pub mod x3p;
 

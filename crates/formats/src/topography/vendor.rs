@@ -4,7 +4,9 @@
 
 use std::path::Path;
 
-use super::{frt, gwy, ibw, mi, nanoscope, nid, opd, park, plu, sdf, sur, wsxm, x3p};
+use super::{
+    al3d, bcr, frt, gwy, ibw, mi, nanoscope, nid, nms, opd, park, plu, sdf, sur, tmd, wsxm, x3p,
+};
 
 use ndarray::Array2;
 use serde::Serialize;
@@ -41,6 +43,14 @@ pub enum TopographyFormat {
     Sur,
     /// FRT MicroProf.
     Frt,
+    /// Alicona Imaging AL3D.
+    Al3d,
+    /// TrueMap TMD.
+    Tmd,
+    /// NanoFocus µsurf NMS.
+    Nms,
+    /// Image Metrology BCR-STM / BCRF.
+    Bcr,
     /// NumPy `.npy` array (by extension).
     Npy,
     /// float32/float64 TIFF (by extension).
@@ -72,6 +82,10 @@ impl TopographyFormat {
             TopographyFormat::Plu => "plu",
             TopographyFormat::Sur => "sur",
             TopographyFormat::Frt => "frt",
+            TopographyFormat::Al3d => "al3d",
+            TopographyFormat::Tmd => "tmd",
+            TopographyFormat::Nms => "nms",
+            TopographyFormat::Bcr => "bcr",
             TopographyFormat::Npy => "npy",
             TopographyFormat::Tiff => "tiff",
             TopographyFormat::Gsf => "gsf",
@@ -141,6 +155,15 @@ pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
         Some(TopographyFormat::Nanoscope)
     } else if starts(b"WSxM file copyright") {
         Some(TopographyFormat::Wsxm)
+    } else if starts(al3d::MAGIC) {
+        Some(TopographyFormat::Al3d)
+    } else if starts(tmd::MAGIC) {
+        Some(TopographyFormat::Tmd)
+    } else if head.get(nms::VERSION_AT..nms::VERSION_AT + nms::VERSION.len()) == Some(nms::VERSION)
+    {
+        Some(TopographyFormat::Nms)
+    } else if bcr::is_bcr(head) {
+        Some(TopographyFormat::Bcr)
     } else if starts(b"PK\x03\x04") {
         Some(TopographyFormat::X3p)
     } else if ibw::is_ibw(head) {
@@ -175,7 +198,7 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
         unsupported(
             path,
             "not a height-map format contactscope recognises from its content (ibw, nid, mi, \
-             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt)",
+             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf)",
         )
     })?;
     match format {
@@ -195,6 +218,10 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 TopographyFormat::Frt => frt::read(path, &bytes, channel),
                 TopographyFormat::Nanoscope => nanoscope::read(path, &bytes, channel),
                 TopographyFormat::Wsxm => wsxm::read(path, &bytes, channel),
+                TopographyFormat::Al3d => al3d::read(path, &bytes, channel),
+                TopographyFormat::Tmd => tmd::read(path, &bytes, channel),
+                TopographyFormat::Nms => nms::read(path, &bytes, channel),
+                TopographyFormat::Bcr => bcr::read(path, &bytes, channel),
                 TopographyFormat::X3p
                 | TopographyFormat::Npy
                 | TopographyFormat::Tiff
@@ -426,6 +453,24 @@ mod tests {
         assert_eq!(detect(b"GWYPGwyContainer"), Some(TopographyFormat::Gwy));
         assert_eq!(detect(b"\x01\x00Directory"), Some(TopographyFormat::Opd));
         assert_eq!(detect(b"FRTM_GLIDERV1.00"), Some(TopographyFormat::Frt));
+        assert_eq!(
+            detect(b"AliconaImaging\0\r\nVersion"),
+            Some(TopographyFormat::Al3d)
+        );
+        assert_eq!(
+            detect(b"Binary TrueMap Data File v2.0\r\n\0"),
+            Some(TopographyFormat::Tmd)
+        );
+        let mut nms = [0u8; 64];
+        nms[32..41].copy_from_slice(b"OM_MS_2.0");
+        assert_eq!(detect(&nms), Some(TopographyFormat::Nms));
+        assert_eq!(detect(b"fileformat = bcrf\n"), Some(TopographyFormat::Bcr));
+        let wide: Vec<u8> = "fileformat = bcrf_unicode"
+            .encode_utf16()
+            .flat_map(u16::to_le_bytes)
+            .collect();
+        assert_eq!(detect(&wide), Some(TopographyFormat::Bcr));
+        assert_eq!(detect(b"fileformat = other"), None);
         assert_eq!(detect(b"%PDF-1.4"), None);
         assert_eq!(length_factor("\u{e6}m"), Some(1e-6));
         assert_eq!(length_factor("V"), None);
