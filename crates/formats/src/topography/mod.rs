@@ -37,6 +37,15 @@
 //! | Sensofar `.plu` | [`plu`] | (none: size check of the 2012 layout) | µm | `micrometers_per_pixel` | 1000001 |
 //! | Digital Surf `.sur` | [`sur`] | `DIGITAL SURF` | `raw·scale` in `delta_data_unit` | grid spacing | `zmin − 2` when flagged |
 //! | FRT MicroProf `.frt` | [`frt`] | `FRTM_GLIDERV1.0` | `raw·scale` (m) | block 0x67 size / pixels | raw = 1 |
+//! | Zygo MetroPro `.dat` | [`metropro`] | `0x881B036F`, `…70`, `…71` | `phase·S·O·λ/R` (m) | camera resolution | phase ≥ 2147483640 |
+//! | NetCDF `.nc` (classic, 64-bit offset) | [`netcdf`] | `CDF\x01`, `CDF\x02`, `CDF\x05` | variable `heights` in its `unit` | `length` of the `x`/`y` variables / points | `mask`, `_FillValue` |
+//! | HDF5 `.h5` | [`hdf5`] | `\x89HDF\r\n\x1a\n` | 2-D datasets as stored, m (or the height unit given) | none: the argument is required | NaN |
+//!
+//! A file that states no pixel size (HDF5; a MetroPro file with a camera resolution of 0; a
+//! NetCDF file without `length` attributes) is read with a pixel size of NaN, and
+//! [`read_height_map`] then requires the pixel size argument. HDF5 files state no height unit
+//! either: their heights are metres unless a height unit is given
+//! ([`TopographyFormat::states_height_unit`]).
 //!
 //! **Invalid points** are stored as NaN in [`HeightMap::heights`] and counted in
 //! [`HeightMap::invalid_points`]; [`HeightMap::check_usable`] refuses a map with invalid
@@ -50,8 +59,11 @@
 
 pub mod frt;
 pub mod gwy;
+pub mod hdf5;
 pub mod ibw;
+pub mod metropro;
 pub mod mi;
+pub mod netcdf;
 pub mod nid;
 pub mod opd;
 pub mod park;
@@ -66,6 +78,9 @@ mod nanoscope;
 mod npy;
 mod text;
 mod wsxm;
+
+#[cfg(test)]
+mod test_support;
 
 use std::path::Path;
 
@@ -106,14 +121,18 @@ pub struct ReadOptions {
 }
 
 /// Read a height map of any format: a vendor format recognised by its content ([`read`]: heights
-/// as stored, invalid points NaN and counted, the pixel size overridden when given; a height
-/// unit is refused, every vendor format states its own), else by extension
+/// as stored, invalid points NaN and counted, the pixel size overridden when given and required
+/// when the file states none; a height unit is refused where the format states its own, and
+/// scales the heights where it does not (HDF5)), else by extension
 /// ([`read_topography`]: every point valid, pixel size and heights within their plausible
 /// ranges). Nothing is detrended or filled here.
 pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> {
     if matches!(detect_file(path), Ok(Some(_))) {
         let mut map = read(path, options.channel.as_deref())?;
-        if options.height_unit_m.is_some() {
+        if !map.format.states_height_unit() {
+            let convert = to_metres(unitless_scale(options.height_unit_m)?);
+            map.heights.mapv_inplace(&convert);
+        } else if options.height_unit_m.is_some() {
             return Err(bad(
                 path,
                 format!(
@@ -125,6 +144,16 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
         if let Some((dx, dy)) = options.pixel_size_m {
             map.dx_m = dx;
             map.dy_m = dy;
+        } else if map.dx_m.is_nan() || map.dy_m.is_nan() {
+            // NaN: the file states no pixel size.
+            return Err(bad(
+                path,
+                format!(
+                    "the {} file gives no pixel size; give it with {}",
+                    map.format.name(),
+                    crate::param::Param::PixelSize
+                ),
+            ));
         }
         return Ok(map);
     }
@@ -217,7 +246,8 @@ pub fn read_topography(
                     "unknown height-map extension '{ext}'; supported by extension: .{} \
                      (Nanoscope also .002, .003, …); by content: Igor .ibw, NT-MDT .nid, \
                      Agilent .mi, Park TIFF, Gwyddion .gwy, ISO 25178 .x3p, .sdf, Wyko .opd, \
-                     Sensofar .plu, Digital Surf .sur, FRT .frt",
+                     Sensofar .plu, Digital Surf .sur, FRT .frt, Zygo MetroPro .dat, NetCDF \
+                     .nc, HDF5 .h5",
                     SUPPORTED_EXTENSIONS.join(", .")
                 ),
             };
