@@ -194,6 +194,17 @@ mod tests {
         use crate::topography::{detect, read_height_map, ReadOptions};
         let data = synthetic(2, 1, &[1, 2], 0.0);
         assert_eq!(detect(&data), Some(TopographyFormat::MetroPro));
+        // Serialised as its name.
+        for f in [
+            TopographyFormat::MetroPro,
+            TopographyFormat::NetCdf,
+            TopographyFormat::Hdf5,
+        ] {
+            assert_eq!(
+                serde_json::to_string(&f).unwrap(),
+                format!("\"{}\"", f.name())
+            );
+        }
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("uncalibrated.dat");
         std::fs::write(&path, &data).unwrap();

@@ -42,8 +42,10 @@ pub enum TopographyFormat {
     /// FRT MicroProf.
     Frt,
     /// Zygo MetroPro `.dat`.
+    #[serde(rename = "metropro")]
     MetroPro,
     /// NetCDF classic / 64-bit offset (as SurfaceTopography writes height maps).
+    #[serde(rename = "netcdf")]
     NetCdf,
     /// HDF5 (datasets as channels; no pixel size, no height unit).
     Hdf5,
