@@ -1,7 +1,7 @@
 //! Which reader a height-map file goes to, decided from its content: magic bytes and headers
 //! first ([`super::detect_file`], NumPy, TIFF, Gwyddion Simple Field, gzip), then text; the
 //! extension only names what the file was expected to be in an error. A file in a format
-//! contactscope knows but does not read (HDF5, Nanonis, JPK, old Gwyddion, images, …) is refused
+//! contactscope knows but does not read (Nanonis, JPK, Keyence, old Gwyddion, images, …) is refused
 //! saying what it is.
 
 use std::io::Read;
@@ -25,10 +25,7 @@ fn known_unread(head: &[u8]) -> Option<&'static str> {
         head.windows(needle.len())
             .any(|w| w.eq_ignore_ascii_case(needle))
     };
-    Some(if starts(b"\x89HDF\r\n\x1a\n") {
-        "an HDF5 file (also Zygo .datx and NetCDF-4): not read by contactscope; export the map as \
-         Gwyddion .gsf, .npy or a text matrix"
-    } else if starts(b"GWYO") {
+    Some(if starts(b"GWYO") {
         "an old-format Gwyddion file (GWYO, before Gwyddion 2): open it in Gwyddion and save it \
          again (.gwy) to read it"
     } else if starts(b":NANONIS_VERSION:") {
@@ -56,7 +53,10 @@ fn known_unread(head: &[u8]) -> Option<&'static str> {
 pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> {
     if let Some(format) = detect_file(path)? {
         let mut map = read(path, options.channel.as_deref())?;
-        if options.height_unit_m.is_some() {
+        if !format.states_height_unit() {
+            let convert = super::to_metres(super::unitless_scale(options.height_unit_m)?);
+            map.heights.mapv_inplace(&convert);
+        } else if options.height_unit_m.is_some() {
             return Err(bad(
                 path,
                 format!(
@@ -68,6 +68,16 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
         if let Some((dx, dy)) = options.pixel_size_m {
             map.dx_m = dx;
             map.dy_m = dy;
+        } else if map.dx_m.is_nan() || map.dy_m.is_nan() {
+            // NaN: the file states no pixel size.
+            return Err(bad(
+                path,
+                format!(
+                    "the {} file states no pixel size; give it with {}",
+                    format.name(),
+                    crate::param::Param::PixelSize
+                ),
+            ));
         }
         return Ok(map);
     }
@@ -139,7 +149,8 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
 /// The formats read, for messages.
 pub const READ_FORMATS: &str = "Igor .ibw, Nanosurf .nid, Agilent .mi, Park TIFF, Gwyddion .gwy \
      and .gsf, ISO 25178 .x3p and .sdf, Wyko .opd, Sensofar .plu, Digital Surf .sur, FRT .frt, \
-     Nanoscope .di/.spm, WSxM .top/.stp, NumPy .npy, float TIFF, text matrices and x y z grids \
+     Nanoscope .di/.spm, WSxM .top/.stp, Alicona .al3d, TrueMap .tmd, NanoFocus .nms, Image \
+     Metrology .bcr/.bcrf, Zygo MetroPro .dat, NetCDF .nc, HDF5 .h5, NumPy .npy, float TIFF, text matrices and x y z grids \
      (also gzip-compressed)";
 
 /// The decompressed content of a gzip file, refused beyond [`MAX_FILE_BYTES`].
@@ -195,8 +206,7 @@ mod tests {
     #[test]
     fn known_formats_that_are_not_read_say_what_they_are() {
         for (head, needle) in [
-            (&b"\x89HDF\r\n\x1a\n\0\0"[..], "HDF5"),
-            (b"GWYOxxxx", "old-format Gwyddion"),
+            (&b"GWYOxxxx"[..], "old-format Gwyddion"),
             (b":NANONIS_VERSION:\n2", "Nanonis"),
             (b"VK4_\0\0\0\0", "Keyence"),
             (b"\x89PNG\r\n\x1a\n", "picture"),

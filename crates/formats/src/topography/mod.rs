@@ -41,6 +41,15 @@
 //! | TrueMap `.tmd` | [`tmd`] | `Binary TrueMap Data File v` | float32 (mm) | lengths (mm) / points | NaN |
 //! | NanoFocus µsurf `.nms` | [`nms`] | `OM_MS_` at byte 32 | `z_low + (raw − raw_low)·Δz/Δraw` (µm) | spacings (nm) | intensity 0 |
 //! | Image Metrology `.bcr`, `.bcrf` | [`bcr`] | `fileformat = bcr` (8-bit or UTF-16LE) | int16 · `bit2nm` or float32, in `zunit` | `xlength/xpixels` in `xunit` | 32767, > 1.7e38 |
+//! | Zygo MetroPro `.dat` | [`metropro`] | `0x881B036F`, `…70`, `…71` | `phase·S·O·λ/R` (m) | camera resolution | phase ≥ 2147483640 |
+//! | NetCDF `.nc` (classic, 64-bit offset) | [`netcdf`] | `CDF\x01`, `CDF\x02`, `CDF\x05` | variable `heights` in its `unit` | `length` of the `x`/`y` variables / points | `mask`, `_FillValue` |
+//! | HDF5 `.h5` | [`hdf5`] | `\x89HDF\r\n\x1a\n` | 2-D datasets as stored, m (or the height unit given) | none: the argument is required | NaN |
+//!
+//! A file that states no pixel size (HDF5; a MetroPro file with a camera resolution of 0; a
+//! NetCDF file without `length` attributes) is read with a pixel size of NaN, and
+//! [`read_height_map`] then requires the pixel size argument. HDF5 files state no height unit
+//! either: their heights are metres unless a height unit is given
+//! ([`TopographyFormat::states_height_unit`]).
 //!
 //! **Invalid points** are stored as NaN in [`HeightMap::heights`] and counted in
 //! [`HeightMap::invalid_points`]; [`HeightMap::check_usable`] refuses a map with invalid
@@ -56,8 +65,11 @@ pub mod al3d;
 pub mod bcr;
 pub mod frt;
 pub mod gwy;
+pub mod hdf5;
 pub mod ibw;
+pub mod metropro;
 pub mod mi;
+pub mod netcdf;
 pub mod nid;
 pub mod nms;
 pub mod opd;
@@ -75,6 +87,9 @@ mod nanoscope;
 mod npy;
 mod text;
 mod wsxm;
+
+#[cfg(test)]
+mod test_support;
 
 use std::path::Path;
 

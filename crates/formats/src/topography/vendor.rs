@@ -5,7 +5,8 @@
 use std::path::Path;
 
 use super::{
-    al3d, bcr, frt, gwy, ibw, mi, nanoscope, nid, nms, opd, park, plu, sdf, sur, tmd, wsxm, x3p,
+    al3d, bcr, frt, gwy, hdf5, ibw, metropro, mi, nanoscope, netcdf, nid, nms, opd, park, plu, sdf,
+    sur, tmd, wsxm, x3p,
 };
 
 use ndarray::Array2;
@@ -51,6 +52,14 @@ pub enum TopographyFormat {
     Nms,
     /// Image Metrology BCR-STM / BCRF.
     Bcr,
+    /// Zygo MetroPro `.dat`.
+    #[serde(rename = "metropro")]
+    MetroPro,
+    /// NetCDF classic / 64-bit offset (as SurfaceTopography writes height maps).
+    #[serde(rename = "netcdf")]
+    NetCdf,
+    /// HDF5 (datasets as channels; no pixel size, no height unit).
+    Hdf5,
     /// NumPy `.npy` array (by extension).
     Npy,
     /// float32/float64 TIFF (by extension).
@@ -86,6 +95,9 @@ impl TopographyFormat {
             TopographyFormat::Tmd => "tmd",
             TopographyFormat::Nms => "nms",
             TopographyFormat::Bcr => "bcr",
+            TopographyFormat::MetroPro => "metropro",
+            TopographyFormat::NetCdf => "netcdf",
+            TopographyFormat::Hdf5 => "hdf5",
             TopographyFormat::Npy => "npy",
             TopographyFormat::Tiff => "tiff",
             TopographyFormat::Gsf => "gsf",
@@ -94,6 +106,12 @@ impl TopographyFormat {
             TopographyFormat::Wsxm => "wsxm",
             TopographyFormat::Nanoscope => "nanoscope",
         }
+    }
+
+    /// Whether files of this format state the unit of their heights (HDF5 files do not: their
+    /// heights are in metres unless a height unit is given).
+    pub fn states_height_unit(self) -> bool {
+        !matches!(self, TopographyFormat::Hdf5)
     }
 }
 
@@ -108,9 +126,10 @@ pub struct HeightMap {
     pub channels: Vec<String>,
     /// Heights in metres, shape `(ny, nx)`; NaN where the instrument marked no valid point.
     pub heights: Array2<f64>,
-    /// Pixel size along x (columns), m.
+    /// Pixel size along x (columns), m; NaN (with `dy_m`) when the file states none, as
+    /// [`read`] returns it (`read_height_map` then requires one).
     pub dx_m: f64,
-    /// Pixel size along y (rows), m.
+    /// Pixel size along y (rows), m; NaN when the file states none.
     pub dy_m: f64,
     /// Number of NaN heights.
     pub invalid_points: usize,
@@ -168,6 +187,12 @@ pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
         Some(TopographyFormat::X3p)
     } else if ibw::is_ibw(head) {
         Some(TopographyFormat::Ibw)
+    } else if metropro::is_metropro(head) {
+        Some(TopographyFormat::MetroPro)
+    } else if netcdf::is_netcdf(head) {
+        Some(TopographyFormat::NetCdf)
+    } else if starts(hdf5::SIGNATURE) {
+        Some(TopographyFormat::Hdf5)
     } else {
         None
     }
@@ -198,7 +223,7 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
         unsupported(
             path,
             "not a height-map format contactscope recognises from its content (ibw, nid, mi, \
-             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf)",
+             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf, metropro, netcdf, hdf5)",
         )
     })?;
     match format {
@@ -222,6 +247,9 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 TopographyFormat::Tmd => tmd::read(path, &bytes, channel),
                 TopographyFormat::Nms => nms::read(path, &bytes, channel),
                 TopographyFormat::Bcr => bcr::read(path, &bytes, channel),
+                TopographyFormat::MetroPro => metropro::read(path, &bytes, channel),
+                TopographyFormat::NetCdf => netcdf::read(path, &bytes, channel),
+                TopographyFormat::Hdf5 => hdf5::read(path, &bytes, channel),
                 TopographyFormat::X3p
                 | TopographyFormat::Npy
                 | TopographyFormat::Tiff
@@ -336,7 +364,8 @@ pub(crate) fn length_scale(path: &Path, channel: &ChannelEntry, unit: &str) -> R
     })
 }
 
-/// Build a [`HeightMap`] from row-major values (NaN = invalid), checking the size.
+/// Build a [`HeightMap`] from row-major values (NaN = invalid), checking the size. A pixel size
+/// of (NaN, NaN) says the file states none.
 pub(crate) fn height_map(
     path: &Path,
     format: TopographyFormat,
@@ -348,7 +377,8 @@ pub(crate) fn height_map(
     if nx == 0 || ny == 0 {
         return Err(bad(path, format!("empty {nx}×{ny} height map")));
     }
-    if !(dx_m.is_finite() && dy_m.is_finite() && dx_m > 0.0 && dy_m > 0.0) {
+    let stated_positive = dx_m.is_finite() && dy_m.is_finite() && dx_m > 0.0 && dy_m > 0.0;
+    if !(stated_positive || dx_m.is_nan() && dy_m.is_nan()) {
         return Err(bad(
             path,
             format!("pixel size {dx_m} × {dy_m} m is not positive"),
