@@ -37,6 +37,8 @@
 //! | Sensofar `.plu` | [`plu`] | (none: size check of the 2012 layout) | µm | `micrometers_per_pixel` | 1000001 |
 //! | Digital Surf `.sur` | [`sur`] | `DIGITAL SURF` | `raw·scale` in `delta_data_unit` | grid spacing | `zmin − 2` when flagged |
 //! | FRT MicroProf `.frt` | [`frt`] | `FRTM_GLIDERV1.0` | `raw·scale` (m) | block 0x67 size / pixels | raw = 1 |
+//! | Digital Surf MountainsMap `.mnt` | [`mnt`] | OLE2 (`D0 CF 11 E0`) with a `ScopedContents` stream | `count·step + origin` of the z axis | x and y axis steps | mask value ≠ 9 |
+//! | Bruker/Veeco Vision64 `.opdx` | [`opdx`] | `VCA DATA\x01\x00\x00\x55` | float32 · `DataScale` (a 1-D profile is refused) | `Dimension2Extent`/(columns − 1), `Dimension1Extent`/(rows − 1) | NaN |
 //!
 //! **Invalid points** are stored as NaN in [`HeightMap::heights`] and counted in
 //! [`HeightMap::invalid_points`]; [`HeightMap::check_usable`] refuses a map with invalid
@@ -52,8 +54,10 @@ pub mod frt;
 pub mod gwy;
 pub mod ibw;
 pub mod mi;
+pub mod mnt;
 pub mod nid;
 pub mod opd;
+pub mod opdx;
 pub mod park;
 pub mod plu;
 pub mod sdf;
@@ -217,7 +221,8 @@ pub fn read_topography(
                     "unknown height-map extension '{ext}'; supported by extension: .{} \
                      (Nanoscope also .002, .003, …); by content: Igor .ibw, NT-MDT .nid, \
                      Agilent .mi, Park TIFF, Gwyddion .gwy, ISO 25178 .x3p, .sdf, Wyko .opd, \
-                     Sensofar .plu, Digital Surf .sur, FRT .frt",
+                     Sensofar .plu, Digital Surf .sur, FRT .frt, MountainsMap .mnt, Vision64 \
+                     .opdx",
                     SUPPORTED_EXTENSIONS.join(", .")
                 ),
             };

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::{frt, gwy, ibw, mi, nid, opd, park, plu, sdf, sur, x3p};
+use super::{frt, gwy, ibw, mi, mnt, nid, opd, opdx, park, plu, sdf, sur, x3p};
 
 use ndarray::Array2;
 use serde::Serialize;
@@ -41,6 +41,10 @@ pub enum TopographyFormat {
     Sur,
     /// FRT MicroProf.
     Frt,
+    /// Digital Surf MountainsMap studiable (OLE2 container).
+    Mnt,
+    /// Bruker/Veeco Vision64 OPDx.
+    Opdx,
     /// NumPy `.npy` array (by extension).
     Npy,
     /// float32/float64 TIFF (by extension).
@@ -70,6 +74,8 @@ impl TopographyFormat {
             TopographyFormat::Plu => "plu",
             TopographyFormat::Sur => "sur",
             TopographyFormat::Frt => "frt",
+            TopographyFormat::Mnt => "mnt",
+            TopographyFormat::Opdx => "opdx",
             TopographyFormat::Npy => "npy",
             TopographyFormat::Tiff => "tiff",
             TopographyFormat::Gsf => "gsf",
@@ -136,6 +142,11 @@ pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
         Some(TopographyFormat::Opd)
     } else if starts(b"PK\x03\x04") {
         Some(TopographyFormat::X3p)
+    } else if starts(opdx::MAGIC) {
+        Some(TopographyFormat::Opdx)
+    } else if starts(&mnt::OLE2_MAGIC) {
+        // Any OLE2 compound file: the MNT reader refuses those that are not studiables.
+        Some(TopographyFormat::Mnt)
     } else if ibw::is_ibw(head) {
         Some(TopographyFormat::Ibw)
     } else {
@@ -168,11 +179,12 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
         unsupported(
             path,
             "not a height-map format contactscope recognises from its content (ibw, nid, mi, \
-             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt)",
+             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, mnt, opdx)",
         )
     })?;
     match format {
         TopographyFormat::X3p => x3p::read(path, channel),
+        TopographyFormat::Mnt => mnt::read(path, channel),
         other => {
             let bytes = read_whole(path)?;
             match other {
@@ -186,7 +198,9 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 TopographyFormat::Plu => plu::read(path, &bytes, channel),
                 TopographyFormat::Sur => sur::read(path, &bytes, channel),
                 TopographyFormat::Frt => frt::read(path, &bytes, channel),
+                TopographyFormat::Opdx => opdx::read(path, &bytes, channel),
                 TopographyFormat::X3p
+                | TopographyFormat::Mnt
                 | TopographyFormat::Npy
                 | TopographyFormat::Tiff
                 | TopographyFormat::Gsf
@@ -418,6 +432,14 @@ mod tests {
         assert_eq!(detect(b"GWYPGwyContainer"), Some(TopographyFormat::Gwy));
         assert_eq!(detect(b"\x01\x00Directory"), Some(TopographyFormat::Opd));
         assert_eq!(detect(b"FRTM_GLIDERV1.00"), Some(TopographyFormat::Frt));
+        assert_eq!(
+            detect(b"VCA DATA\x01\x00\x00\x55"),
+            Some(TopographyFormat::Opdx)
+        );
+        assert_eq!(
+            detect(b"\xD0\xCF\x11\xE0\xA1\xB1\x1A\xE1\0\0"),
+            Some(TopographyFormat::Mnt)
+        );
         assert_eq!(detect(b"%PDF-1.4"), None);
         assert_eq!(length_factor("\u{e6}m"), Some(1e-6));
         assert_eq!(length_factor("V"), None);
