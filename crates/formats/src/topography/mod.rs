@@ -50,6 +50,8 @@
 //! [`read_height_map`] then requires the pixel size argument. HDF5 files state no height unit
 //! either: their heights are metres unless a height unit is given
 //! ([`TopographyFormat::states_height_unit`]).
+//! | Digital Surf MountainsMap `.mnt` | [`mnt`] | OLE2 (`D0 CF 11 E0`) with a `ScopedContents` stream | `count·step + origin` of the z axis | x and y axis steps | mask value ≠ 9 |
+//! | Bruker/Veeco Vision64 `.opdx` | [`opdx`] | `VCA DATA\x01\x00\x00\x55` | float32 · `DataScale` (a 1-D profile is refused) | `Dimension2Extent`/(columns − 1), `Dimension1Extent`/(rows − 1) | NaN |
 //!
 //! **Invalid points** are stored as NaN in [`HeightMap::heights`] and counted in
 //! [`HeightMap::invalid_points`]; [`HeightMap::check_usable`] refuses a map with invalid
@@ -69,10 +71,12 @@ pub mod hdf5;
 pub mod ibw;
 pub mod metropro;
 pub mod mi;
+pub mod mnt;
 pub mod netcdf;
 pub mod nid;
 pub mod nms;
 pub mod opd;
+pub mod opdx;
 pub mod park;
 pub mod plu;
 pub mod sdf;

@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use super::{
-    al3d, bcr, frt, gwy, hdf5, ibw, metropro, mi, nanoscope, netcdf, nid, nms, opd, park, plu, sdf,
-    sur, tmd, wsxm, x3p,
+    al3d, bcr, frt, gwy, hdf5, ibw, metropro, mi, mnt, nanoscope, netcdf, nid, nms, opd, opdx,
+    park, plu, sdf, sur, tmd, wsxm, x3p,
 };
 
 use ndarray::Array2;
@@ -60,6 +60,10 @@ pub enum TopographyFormat {
     NetCdf,
     /// HDF5 (datasets as channels; no pixel size, no height unit).
     Hdf5,
+    /// Digital Surf MountainsMap studiable (OLE2 container).
+    Mnt,
+    /// Bruker/Veeco Vision64 OPDx.
+    Opdx,
     /// NumPy `.npy` array (by extension).
     Npy,
     /// float32/float64 TIFF (by extension).
@@ -98,6 +102,8 @@ impl TopographyFormat {
             TopographyFormat::MetroPro => "metropro",
             TopographyFormat::NetCdf => "netcdf",
             TopographyFormat::Hdf5 => "hdf5",
+            TopographyFormat::Mnt => "mnt",
+            TopographyFormat::Opdx => "opdx",
             TopographyFormat::Npy => "npy",
             TopographyFormat::Tiff => "tiff",
             TopographyFormat::Gsf => "gsf",
@@ -185,6 +191,11 @@ pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
         Some(TopographyFormat::Bcr)
     } else if starts(b"PK\x03\x04") {
         Some(TopographyFormat::X3p)
+    } else if starts(opdx::MAGIC) {
+        Some(TopographyFormat::Opdx)
+    } else if starts(&mnt::OLE2_MAGIC) {
+        // Any OLE2 compound file: the MNT reader refuses those that are not studiables.
+        Some(TopographyFormat::Mnt)
     } else if ibw::is_ibw(head) {
         Some(TopographyFormat::Ibw)
     } else if metropro::is_metropro(head) {
@@ -223,11 +234,12 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
         unsupported(
             path,
             "not a height-map format contactscope recognises from its content (ibw, nid, mi, \
-             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf, metropro, netcdf, hdf5)",
+             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf, metropro, netcdf, hdf5, mnt, opdx)",
         )
     })?;
     match format {
         TopographyFormat::X3p => x3p::read(path, channel),
+        TopographyFormat::Mnt => mnt::read(path, channel),
         other => {
             let bytes = read_whole(path)?;
             match other {
@@ -250,7 +262,9 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 TopographyFormat::MetroPro => metropro::read(path, &bytes, channel),
                 TopographyFormat::NetCdf => netcdf::read(path, &bytes, channel),
                 TopographyFormat::Hdf5 => hdf5::read(path, &bytes, channel),
+                TopographyFormat::Opdx => opdx::read(path, &bytes, channel),
                 TopographyFormat::X3p
+                | TopographyFormat::Mnt
                 | TopographyFormat::Npy
                 | TopographyFormat::Tiff
                 | TopographyFormat::Gsf
@@ -501,6 +515,14 @@ mod tests {
             .collect();
         assert_eq!(detect(&wide), Some(TopographyFormat::Bcr));
         assert_eq!(detect(b"fileformat = other"), None);
+        assert_eq!(
+            detect(b"VCA DATA\x01\x00\x00\x55"),
+            Some(TopographyFormat::Opdx)
+        );
+        assert_eq!(
+            detect(b"\xD0\xCF\x11\xE0\xA1\xB1\x1A\xE1\0\0"),
+            Some(TopographyFormat::Mnt)
+        );
         assert_eq!(detect(b"%PDF-1.4"), None);
         assert_eq!(length_factor("\u{e6}m"), Some(1e-6));
         assert_eq!(length_factor("V"), None);
