@@ -21,7 +21,8 @@ pub struct Args {
     /// file's height channel.
     #[arg(long)]
     channel: Option<String>,
-    /// Print JSON: the stored map's summary (file, format, channel, nx, ny, pixel_size_um,
+    /// Print JSON: the stored map's summary (file, format, channel, channels, nx, ny,
+    /// pixel_size_um,
     /// valid_points, height_*_um, h_rms_as_stored_um, h_prime_rms_as_stored,
     /// h_double_prime_rms_as_stored_per_um) and, under "detrended", the roughness after
     /// --detrend (h_rms_nm, h_prime_rms, h_double_prime_rms_per_um, as simulate names them).
@@ -44,6 +45,10 @@ pub fn run(args: Args) -> Result<()> {
         "format:      {} (channel {})",
         summary.format, summary.channel
     );
+    if summary.channels.len() > 1 {
+        let others: Vec<String> = summary.channels.iter().map(|c| format!("'{c}'")).collect();
+        println!("channels:    {} (choose with --channel)", others.join(", "));
+    }
     println!(
         "size:        {} × {} px = {:.4} × {:.4} µm",
         summary.nx,

@@ -3,6 +3,7 @@
 
 mod commands;
 mod files;
+mod peer;
 mod real;
 mod synthetic;
 mod topography;

@@ -275,7 +275,23 @@ fn soft_scale(header: &Header, z_scale: &str) -> Option<(f64, String, f64)> {
     }
     let soft: f64 = parts.next()?.parse().ok()?;
     let (unit, per) = parts.next()?.split_once('/')?;
-    (per == hard_unit).then(|| (soft, unit.to_string(), hard))
+    // The hard value may be in another prefix of the soft scale's denominator (mV against nm/V).
+    let ratio = if per == hard_unit {
+        1.0
+    } else {
+        volts(hard_unit)? / volts(per)?
+    };
+    Some((soft, unit.to_string(), hard * ratio))
+}
+
+/// Volts per unit of a voltage unit (`V`, `mV`, `uV`/`µV`), else `None`.
+fn volts(unit: &str) -> Option<f64> {
+    match unit {
+        "V" => Some(1.0),
+        "mV" => Some(1e-3),
+        "uV" | "µV" | "~V" => Some(1e-6),
+        _ => None,
+    }
 }
 
 /// `10 10 ~m` (x y unit) or `10000 nm` (square) → metres.

@@ -337,16 +337,49 @@ pub(crate) fn choose(
         // A file of one channel holds nothing else to choose: its channel is read whatever its
         // name (the reader still refuses a unit that is not a length).
         None if channels.len() == 1 => Ok(0),
-        None => channels.iter().position(|c| c.height).ok_or_else(|| {
-            bad(
-                path,
-                format!(
-                    "no height channel; the file has {} (choose one by name)",
-                    list()
-                ),
-            )
-        }),
+        // A height-like name first; then any channel in a length unit that is not named as
+        // another signal (an amplitude error or a deflection can be in nm too).
+        None => channels
+            .iter()
+            .position(|c| c.height && height_like(&c.name))
+            .or_else(|| {
+                channels
+                    .iter()
+                    .position(|c| c.height && !signal_like(&c.name))
+            })
+            .ok_or_else(|| {
+                bad(
+                    path,
+                    format!(
+                        "no height channel; the file has {} (choose one by name)",
+                        list()
+                    ),
+                )
+            }),
     }
+}
+
+/// Whether a channel name names a signal other than the height (never chosen by default).
+pub(crate) fn signal_like(name: &str) -> bool {
+    let n = name.to_lowercase();
+    [
+        "deflection",
+        "amplitude",
+        "phase",
+        "error",
+        "friction",
+        "current",
+        "force",
+        "potential",
+        "adhesion",
+        "modulus",
+        "dissipation",
+        "lateral",
+        "intensity",
+        "frequency",
+    ]
+    .iter()
+    .any(|k| n.contains(k))
 }
 
 /// Whether a channel name looks like heights.
@@ -490,6 +523,11 @@ mod tests {
             "{err}"
         );
         assert!(choose(p, &entries(&[]), None).is_err());
+        // A deflection or amplitude error in nm is never the default.
+        let signals = entries(&[("Deflection", true), ("AmplitudeError", true), ("Z", true)]);
+        assert_eq!(choose(p, &signals, None).unwrap(), 2);
+        let only = entries(&[("Deflection", true), ("Phase", false)]);
+        assert!(choose(p, &only, None).is_err());
     }
 
     #[test]

@@ -27,8 +27,10 @@ pub struct TopographySummary {
     pub file: String,
     /// Format name (`ibw`, `park-tiff`, …).
     pub format: String,
-    /// Channel read.
+    /// Channel read (by `--channel`, else the file's height channel).
     pub channel: String,
+    /// Every channel of the file, as `--channel` names them.
+    pub channels: Vec<String>,
     /// Columns.
     pub nx: usize,
     /// Rows.
@@ -84,6 +86,7 @@ impl TopographySummary {
             file: file.to_string(),
             format: map.format.name().to_string(),
             channel: map.channel.clone(),
+            channels: map.channels.clone(),
             nx: map.nx(),
             ny: map.ny(),
             pixel_size: PixelSizeXy {
