@@ -438,9 +438,12 @@ fn messages_keep_clap_suggestions_and_point_to_the_right_command() {
     let err = stderr(&run(&["topography", s(&path)]));
     assert!(err.contains("a CZI micrograph, not a height map"), "{err}");
     let path = dir.path().join("scan.xyz");
-    std::fs::write(&path, "1 2 3\n").unwrap();
+    std::fs::write(&path, b"\x01\x02\x00\x03binary").unwrap();
     let err = stderr(&run(&["topography", s(&path)]));
-    assert!(err.contains("by content: Igor .ibw"), "{err}");
+    assert!(
+        err.contains("recognises from its content (named .xyz)") && err.contains("Igor .ibw"),
+        "{err}"
+    );
 }
 
 /// Another program's ImageJ TIFF: a length `vunit` is honoured as the heights' unit; a unit that

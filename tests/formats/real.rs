@@ -307,9 +307,11 @@ fn real_afm_copies_read_the_same() {
             "{a}"
         );
     }
-    // The older formats stay with their readers (tests/mechanics/surface.rs checks their numbers).
-    for old in ["di-3.di", "top-1.top"] {
-        assert_eq!(detect_file(&afm.join(old)).unwrap(), None, "{old}");
+    // Nanoscope and WSxM are recognised by their content too (tests/mechanics/surface.rs checks
+    // their numbers).
+    for (file, format) in [("di-3.di", "nanoscope"), ("top-1.top", "wsxm")] {
+        let found = detect_file(&afm.join(file)).unwrap().map(|f| f.name());
+        assert_eq!(found, Some(format), "{file}");
     }
 }
 

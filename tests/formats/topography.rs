@@ -171,9 +171,12 @@ fn channel_by_name_for_simulate_and_fit_hardening() {
         "--topography",
         s(&npy),
     ];
-    args.extend(base("Height"));
+    args.extend(base("Phase"));
     let e = one_line_error(&args);
-    assert!(e.contains("holds one height map"), "{e}");
+    assert!(
+        e.contains("no channel 'Phase'") && e.contains("holds one height map"),
+        "{e}"
+    );
     // fit-hardening takes the same flags (the channel is read before any fitting).
     let areas = tmp.path().join("areas.csv");
     std::fs::write(&areas, "force_mN,area_um2\n1,10\n2,16\n4,25\n").unwrap();

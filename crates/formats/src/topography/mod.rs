@@ -2,14 +2,20 @@
 //! counter-surface (stored values are kept as they are: an AFM map of a sphere's top already has
 //! its apex as the maximum).
 //!
-//! | extension | format | pixel size | height unit |
-//! |---|---|---|---|
-//! | `.npy` | NumPy array, float32/float64, 2-D, C or Fortran order, either byte order | argument (required) | argument (default m) |
-//! | `.tif`, `.tiff` | float32/float64 TIFF, first page ([`crate::tiff`]) | metadata, or the argument | argument (default m) |
-//! | `.gsf` | Gwyddion Simple Field | `XReal`/`YReal`, or the argument | `ZUnits` (default m) |
-//! | `.txt`, `.csv`, `.dat` | text matrix, one row per line, `#` comments | argument (required) | argument (default m) |
-//! | `.top` | WSxM (Nanotec) image | header | header |
-//! | `.di`, `.spm`, `.001`… | Bruker/Veeco Nanoscope, first channel with a length unit | header | header |
+//! Every format is recognised by its content, never by its extension ([`read_height_map`],
+//! `content.rs`): the vendor formats below by their magic bytes ([`detect_file`]), then NumPy
+//! (`\x93NUMPY`), float TIFF, Gwyddion Simple Field, gzip-compressed text, and text (`text/`:
+//! matrices with or without a Gwyddion or `h=`/`w=` header, `x y z` points on a grid; profiles
+//! are refused as line scans). Formats known but not read are refused saying what they are.
+//!
+//! | format | pixel size | height unit |
+//! |---|---|---|
+//! | NumPy `.npy`, float32/float64, 2-D, C or Fortran order, either byte order | argument (required) | argument (default m) |
+//! | float32/float64 TIFF, first page ([`crate::tiff`]) | metadata, or the argument | stated, else the argument (default m) |
+//! | Gwyddion Simple Field `.gsf` | `XReal`/`YReal`, or the argument | `ZUnits` (default m) |
+//! | text with a header | the header | the header |
+//! | text matrix without one | argument (required) | argument (default m) |
+//! | `x y z` points on a regular grid | the points' spacing | argument (default m, all three columns) |
 //!
 //! Arrays are row-major `(y, x)` as a NumPy image: rows are y, columns x. (SurfaceTopography
 //! keeps `(x, y)`: transpose its arrays before saving them.) A pixel size given as an argument
@@ -44,14 +50,16 @@
 //! | Zygo MetroPro `.dat` | [`metropro`] | `0x881B036F`, `…70`, `…71` | `phase·S·O·λ/R` (m) | camera resolution | phase ≥ 2147483640 |
 //! | NetCDF `.nc` (classic, 64-bit offset) | [`netcdf`] | `CDF\x01`, `CDF\x02`, `CDF\x05` | variable `heights` in its `unit` | `length` of the `x`/`y` variables / points | `mask`, `_FillValue` |
 //! | HDF5 `.h5` | [`hdf5`] | `\x89HDF\r\n\x1a\n` | 2-D datasets as stored, m (or the height unit given) | none: the argument is required | NaN |
+//! | Digital Surf MountainsMap `.mnt` | [`mnt`] | OLE2 (`D0 CF 11 E0`) with a `ScopedContents` stream | `count·step + origin` of the z axis | x and y axis steps | mask value ≠ 9 |
+//! | Bruker/Veeco Vision64 `.opdx` | [`opdx`] | `VCA DATA\x01\x00\x00\x55` | float32 · `DataScale` (a 1-D profile is refused) | `Dimension2Extent`/(columns − 1), `Dimension1Extent`/(rows − 1) | NaN |
+//! | Bruker/Veeco Nanoscope `.di`, `.spm`, `.001`… | `nanoscope` | `\*File list` | `raw·(V_z/65536)·S` | scan size / samples | none |
+//! | WSxM images `.top`, `.stp`, … | `wsxm` | `WSxM file copyright` | integers: `raw·Z amplitude/(max − min)`; floats as stored | X/Y amplitude / points | none |
 //!
 //! A file that states no pixel size (HDF5; a MetroPro file with a camera resolution of 0; a
 //! NetCDF file without `length` attributes) is read with a pixel size of NaN, and
 //! [`read_height_map`] then requires the pixel size argument. HDF5 files state no height unit
 //! either: their heights are metres unless a height unit is given
 //! ([`TopographyFormat::states_height_unit`]).
-//! | Digital Surf MountainsMap `.mnt` | [`mnt`] | OLE2 (`D0 CF 11 E0`) with a `ScopedContents` stream | `count·step + origin` of the z axis | x and y axis steps | mask value ≠ 9 |
-//! | Bruker/Veeco Vision64 `.opdx` | [`opdx`] | `VCA DATA\x01\x00\x00\x55` | float32 · `DataScale` (a 1-D profile is refused) | `Dimension2Extent`/(columns − 1), `Dimension1Extent`/(rows − 1) | NaN |
 //!
 //! **Invalid points** are stored as NaN in [`HeightMap::heights`] and counted in
 //! [`HeightMap::invalid_points`]; [`HeightMap::check_usable`] refuses a map with invalid
@@ -59,8 +67,9 @@
 //!
 //! **Channels**: [`read`] takes an optional channel name. An exact (case-insensitive) match wins,
 //! else the first channel whose name contains the request; without one, the only channel of a
-//! one-channel file whatever its name, else the first channel whose values are heights (a length
-//! unit, or a name with "height", "topograph" or "z-axis"). When no channel matches, the error
+//! one-channel file whatever its name, else the first height-like name ("height", "topograph",
+//! "z-axis", "zsensor") in a length unit, else the first channel in a length unit not named as
+//! another signal (deflection, amplitude, phase, error, …). When no channel matches, the error
 //! lists them all. The chosen channel's unit must still be a length.
 
 pub mod al3d;
