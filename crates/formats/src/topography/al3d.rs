@@ -248,7 +248,7 @@ mod tests {
 
     #[test]
     fn real_file_matches_surface_topography() {
-        let path = Path::new("/tmp/stex/al3d-1.al3d");
+        let path = &crate::topography::test_support::sample("al3d-1.al3d");
         let Ok(bytes) = std::fs::read(path) else {
             return;
         };

@@ -224,7 +224,7 @@ mod tests {
 
     #[test]
     fn real_file_matches_surface_topography() {
-        let path = Path::new("/tmp/stex/bcrf-1.bcrf");
+        let path = &crate::topography::test_support::sample("bcrf-1.bcrf");
         let Ok(bytes) = std::fs::read(path) else {
             return;
         };

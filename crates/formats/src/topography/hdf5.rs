@@ -273,7 +273,7 @@ mod tests {
 
     #[test]
     fn real_file_lists_its_datasets_and_states_no_pixel_size() {
-        let path = Path::new("/tmp/stex/multiple_data_sets.h5");
+        let path = &crate::topography::test_support::sample("multiple_data_sets.h5");
         let Ok(data) = std::fs::read(path) else {
             return;
         };
@@ -300,7 +300,7 @@ mod tests {
     #[test]
     fn read_height_map_asks_for_the_pixel_size_and_takes_a_height_unit() {
         use crate::topography::{detect, read_height_map, ReadOptions};
-        let path = Path::new("/tmp/stex/multiple_data_sets.h5");
+        let path = &crate::topography::test_support::sample("multiple_data_sets.h5");
         let Ok(data) = std::fs::read(path) else {
             return;
         };

@@ -235,7 +235,7 @@ mod tests {
 
     #[test]
     fn real_file_matches_surface_topography() {
-        let path = Path::new("/tmp/stex/metropro-1.dat");
+        let path = &crate::topography::test_support::sample("metropro-1.dat");
         let Ok(data) = std::fs::read(path) else {
             return;
         };

@@ -625,7 +625,7 @@ mod tests {
     #[test]
     fn sample_files_match_surface_topography() {
         for (k, r) in REFERENCE.iter().enumerate() {
-            let p = PathBuf::from(format!("/tmp/stex/mnt-{}.mnt", k + 1));
+            let p = crate::topography::test_support::sample(&format!("mnt-{}.mnt", k + 1));
             if !p.exists() {
                 return;
             }
@@ -654,10 +654,16 @@ mod tests {
     fn damaged_sample_files_give_errors_not_panics() {
         let dir = tempfile::tempdir().unwrap();
         for k in 1..=2 {
-            let Ok(bytes) = std::fs::read(format!("/tmp/stex/mnt-{k}.mnt")) else {
+            let Ok(bytes) = std::fs::read(crate::topography::test_support::sample(&format!(
+                "mnt-{k}.mnt"
+            ))) else {
                 return;
             };
-            let whole = read(Path::new(&format!("/tmp/stex/mnt-{k}.mnt")), None).unwrap();
+            let whole = read(
+                &crate::topography::test_support::sample(&format!("mnt-{k}.mnt")),
+                None,
+            )
+            .unwrap();
             let p = dir.path().join("cut.mnt");
             for i in 1..=10 {
                 std::fs::write(&p, &bytes[..bytes.len() * i / 11]).unwrap();

@@ -601,7 +601,7 @@ mod tests {
 
     #[test]
     fn real_file_matches_surface_topography() {
-        let path = Path::new("/tmp/stex/nc-1.nc");
+        let path = &crate::topography::test_support::sample("nc-1.nc");
         let Ok(data) = std::fs::read(path) else {
             return;
         };

@@ -216,18 +216,18 @@ mod tests {
         // read by SurfaceTopography's open_topography (taken for a MATLAB file).
         let expected = [
             (
-                "/tmp/stex/nms-1.nms",
+                "nms-1.nms",
                 (2.689124584197998e-6, 6.007402420043945e-6),
                 (4.344659998268515e-6, 7.187076314682163e-7),
             ),
             (
-                "/tmp/stex/nms-2.nms",
+                "nms-2.nms",
                 (6.320938587188721e-6, 8.28036880493164e-6),
                 (7.278152776065301e-6, 4.17745056072178e-7),
             ),
         ];
         for (file, (min, max), (mean, rms)) in expected {
-            let path = Path::new(file);
+            let path = &crate::topography::test_support::sample(file);
             let Ok(bytes) = std::fs::read(path) else {
                 continue;
             };

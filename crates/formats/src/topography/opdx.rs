@@ -611,14 +611,16 @@ mod tests {
         }
     }
 
-    const SAMPLE: &str = "/tmp/stex/opdx-3.opdx";
+    fn sample() -> std::path::PathBuf {
+        crate::topography::test_support::sample("opdx-3.opdx")
+    }
 
     #[test]
     fn sample_profile_matches_surface_topography() {
-        let Ok(data) = std::fs::read(SAMPLE) else {
+        let Ok(data) = std::fs::read(sample()) else {
             return;
         };
-        let p = Path::new(SAMPLE);
+        let p = &sample();
         let err = super::super::read(p, None).unwrap_err().to_string();
         assert!(err.contains("one profile of 3001 points spaced"), "{err}");
         let items = parse(p, &data).unwrap();

@@ -92,3 +92,43 @@ pub(crate) fn truncations_and_corruptions(
         let _ = read(&d);
     }
 }
+
+/// A sample file of SurfaceTopography's reader tests: from the folder named by
+/// `CONTACTSCOPE_ST_EXAMPLES` when set, else from the committed `fixtures/surface-topography`
+/// (a `.gz` copy decompressed once into a folder of the temporary directory that later runs
+/// reuse). The path may not exist: callers skip.
+pub(crate) fn sample(name: &str) -> std::path::PathBuf {
+    use std::io::Read;
+    if let Ok(dir) = std::env::var("CONTACTSCOPE_ST_EXAMPLES") {
+        return Path::new(&dir).join(name);
+    }
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/surface-topography");
+    let plain = fixtures.join(name);
+    if plain.exists() {
+        return plain;
+    }
+    let out = std::env::temp_dir()
+        .join("contactscope-test-samples")
+        .join(name);
+    if out.exists() {
+        return out;
+    }
+    let Ok(file) = std::fs::File::open(fixtures.join(format!("{name}.gz"))) else {
+        return plain;
+    };
+    let mut bytes = Vec::new();
+    flate2::read::GzDecoder::new(file)
+        .read_to_end(&mut bytes)
+        .unwrap();
+    let dir = out.parent().unwrap();
+    std::fs::create_dir_all(dir).unwrap();
+    // Written under a unique name and renamed: tests running at once may ask for the same file.
+    let partial = dir.join(format!(
+        "{name}.{}.{:?}",
+        std::process::id(),
+        std::thread::current().id()
+    ));
+    std::fs::write(&partial, bytes).unwrap();
+    std::fs::rename(&partial, &out).unwrap();
+    out
+}

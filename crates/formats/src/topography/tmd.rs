@@ -122,7 +122,7 @@ mod tests {
 
     #[test]
     fn real_file_matches_surface_topography() {
-        let path = Path::new("/tmp/stex/tmd-1.tmd");
+        let path = &crate::topography::test_support::sample("tmd-1.tmd");
         let Ok(bytes) = std::fs::read(path) else {
             return;
         };
