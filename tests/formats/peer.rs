@@ -268,3 +268,57 @@ fn profiles_and_other_files_are_refused_in_one_line() {
         );
     }
 }
+
+/// `simulate` runs on the peer's maps with no option beyond the mechanics: the grid and pixel
+/// size it records are the file's, and its roughness is `topography`'s (both plane-detrended).
+#[test]
+fn simulate_reads_the_maps_with_their_own_calibration() {
+    use crate::common::run_ok;
+    let tmp = tempfile::tempdir().unwrap();
+    let fixtures = crate::common::root().join("fixtures/surface-topography");
+    for name in ["al3d-1.al3d", "stp-1.stp"] {
+        let path = materialise(&fixtures, name, tmp.path()).unwrap();
+        let out = tmp.path().join(format!("sim-{name}"));
+        let p = |p: &Path| p.to_str().unwrap().to_string();
+        let topo = run_ok(&["topography", &p(&path), "--json"]);
+        let t: serde_json::Value = serde_json::from_slice(&topo.stdout).unwrap();
+        // The map is what is tested: whether the contact stays off the map's border (exit 0)
+        // or not (exit 4, results written and marked) does not matter here.
+        let o = crate::common::run(&[
+            "simulate",
+            "-q",
+            "--topography",
+            &p(&path),
+            "--modulus",
+            "3GPa",
+            "--model",
+            "elastic",
+            "--radius",
+            "290um",
+            "--forces",
+            "0.001mN,0.002mN",
+            "--out",
+            &p(&out),
+        ]);
+        assert!(
+            matches!(o.status.code(), Some(0 | 4)),
+            "{name}: {}",
+            crate::common::stderr(&o)
+        );
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let m = &summary["topography"];
+        assert_eq!((&m["nx"], &m["ny"]), (&t["nx"], &t["ny"]), "{name}");
+        let dx_nm = t["pixel_size_um"]["x"].as_f64().unwrap() * 1e3;
+        assert!(
+            rel(m["pixel_size_x_nm"].as_f64().unwrap(), dx_nm) < 1e-12,
+            "{name}: {m}"
+        );
+        let h = t["detrended"]["h_rms_nm"].as_f64().unwrap();
+        assert!(
+            rel(m["h_rms_nm"].as_f64().unwrap(), h) < 1e-9,
+            "{name}: {m}"
+        );
+    }
+}

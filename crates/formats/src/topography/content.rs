@@ -101,7 +101,7 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
     if let Some(reason) = known_unread(&head) {
         return Err(unsupported(path, reason));
     }
-    if head.starts_with(b"II*\0") || head.starts_with(b"MM\0*") {
+    if crate::microscopy::detect(&head) == Some(crate::microscopy::MicroscopyFormat::Tiff) {
         return single(read_tiff(path, options.pixel_size_m, options.height_unit_m));
     }
     if head.starts_with(b"Gwyddion Simple Field") {
