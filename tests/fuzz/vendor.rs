@@ -63,6 +63,22 @@ const REAL: &[(&str, &str)] = &[
     ("real-afm", "top-1.top"),
 ];
 
+/// SurfaceTopography's reader test files committed as fixtures (`fixtures/surface-topography`;
+/// binary ones stored gzip-compressed), used as seeds whatever is beside the checkout.
+const PEER: &[&str] = &[
+    "al3d-1.al3d",
+    "tmd-1.tmd",
+    "stp-1.stp",
+    "metropro-1.dat",
+    "nms-1.nms",
+    "di-2.di",
+    "nc-1.nc",
+    "opdx-3.opdx",
+    "matrix-4.txt.gz",
+    "gwyddion-export-german.txt",
+    "xyz-2.txt",
+];
+
 fn shared_data() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data")
 }
@@ -70,6 +86,22 @@ fn shared_data() -> PathBuf {
 /// The vendor seeds, in `dir`: the CZI series always, the real samples when present.
 pub fn build(dir: &Path) {
     czi_series(dir);
+    let peer = dir.join("peer");
+    fs::create_dir_all(&peer).unwrap();
+    let fixtures = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/surface-topography");
+    for name in PEER {
+        let plain = fixtures.join(name);
+        let bytes = if plain.is_file() {
+            fs::read(&plain).unwrap()
+        } else {
+            let mut out = Vec::new();
+            let zipped = fs::File::open(fixtures.join(format!("{name}.gz"))).unwrap();
+            std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(zipped), &mut out)
+                .unwrap();
+            out
+        };
+        fs::write(peer.join(name), bytes).unwrap();
+    }
     let real = dir.join("real");
     fs::create_dir_all(&real).unwrap();
     let mut missing = 0;
@@ -151,7 +183,26 @@ pub const TEMPLATES: &[Template] = &[
     topo!("real-park-tiff", "real/example_ps.tiff"),
     topo!("real-di", "real/di-3.di"),
     topo!("real-top", "real/top-1.top"),
+    topo!("peer-al3d", "peer/al3d-1.al3d"),
+    topo!("peer-tmd", "peer/tmd-1.tmd"),
+    topo!("peer-stp", "peer/stp-1.stp"),
+    topo!("peer-metropro", "peer/metropro-1.dat"),
+    topo!("peer-nms", "peer/nms-1.nms"),
+    topo!("peer-di", "peer/di-2.di"),
+    topo!("peer-nc", "peer/nc-1.nc"),
+    topo!("peer-opdx", "peer/opdx-3.opdx"),
+    topo!("peer-gz", "peer/matrix-4.txt.gz"),
+    topo!("peer-gwyddion-text", "peer/gwyddion-export-german.txt"),
+    topo!("peer-xyz", "peer/xyz-2.txt"),
 ];
+
+#[test]
+fn every_peer_template_names_a_listed_fixture() {
+    for t in TEMPLATES.iter().filter(|t| t.name.starts_with("peer-")) {
+        let file = t.copies[0].trim_start_matches("peer/");
+        assert!(PEER.contains(&file), "{}", t.name);
+    }
+}
 
 #[test]
 fn every_real_template_names_a_listed_sample() {

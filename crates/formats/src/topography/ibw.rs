@@ -107,12 +107,13 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
         .map(|k| {
             let name = labels
                 .get((k + 1) * 32..(k + 2) * 32)
+                // A C string: up to its first NUL; a label with control characters (a
+                // damaged header) is no name.
                 .map(|b| {
-                    String::from_utf8_lossy(b)
-                        .trim_end_matches('\0')
-                        .to_string()
+                    let end = b.iter().position(|&c| c == 0).unwrap_or(b.len());
+                    String::from_utf8_lossy(&b[..end]).to_string()
                 })
-                .filter(|s| !s.is_empty())
+                .filter(|s| !s.is_empty() && !s.chars().any(char::is_control))
                 .unwrap_or_else(|| format!("layer {k}"));
             let height = height_like(&name) || (layers == 1 && length.is_some());
             ChannelEntry { name, height }
