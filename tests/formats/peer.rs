@@ -322,3 +322,19 @@ fn simulate_reads_the_maps_with_their_own_calibration() {
         );
     }
 }
+
+/// `info` on a height map says which command reads it and lists its channels.
+#[test]
+fn info_on_a_height_map_names_its_channels_and_the_command() {
+    let tmp = tempfile::tempdir().unwrap();
+    let fixtures = crate::common::root().join("fixtures/surface-topography");
+    let path = materialise(&fixtures, "di-2.di", tmp.path()).unwrap();
+    let o = crate::common::run(&["info", path.to_str().unwrap()]);
+    let err = crate::common::stderr(&o);
+    assert!(
+        !o.status.success()
+            && err.contains("'Height', 'Height (Retrace)', 'Deflection'")
+            && err.contains("contactscope topography"),
+        "{err}"
+    );
+}

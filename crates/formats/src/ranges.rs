@@ -85,9 +85,14 @@ impl Quantity {
         } else {
             "is outside the plausible range"
         };
+        // A finite value whose conversion overflows is written in SI units (never "inf").
+        let shown = if (value * to_unit).is_finite() || !value.is_finite() {
+            format!("{} {unit}", short(value * to_unit))
+        } else {
+            format!("{} (SI)", short(value))
+        };
         format!(
-            "{name} {} {unit} {what} {} … {} {unit} (a typo or a wrong unit?)",
-            short(value * to_unit),
+            "{name} {shown} {what} {} … {} {unit} (a typo or a wrong unit?)",
             short(lo * to_unit),
             short(hi * to_unit)
         )
@@ -174,6 +179,9 @@ mod tests {
         assert_eq!(short(-3.7), "-3.7");
         assert_eq!(short(1.23456789e-5), "1.234568e-5");
         assert_eq!(short(2.5e-3), "0.0025");
+        // A size whose conversion to nm overflows is given in SI units, never as "inf".
+        let m = Quantity::PixelSize.refusal(3.3e307);
+        assert!(m.contains("3.3e307 (SI)") && !m.contains("inf"), "{m}");
     }
 
     #[test]

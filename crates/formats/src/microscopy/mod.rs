@@ -338,14 +338,24 @@ impl MicroscopyFile {
         let head = source.read_up_to(0, 64)?;
         let format = detect(&head).ok_or_else(|| match crate::topography::detect(&head) {
             // A height map given where a micrograph is expected: say which command reads it.
-            Some(map) => unsupported(
-                path,
-                format!(
-                    "a {} height map, not a CZI, ND2, LIF or TIFF micrograph: read it with \
-                     `contactscope topography` (or `simulate --topography`)",
-                    map.name()
-                ),
-            ),
+            Some(map) => {
+                // Its channels, when the map reads, so that `--channel` can be chosen from here.
+                let channels = crate::topography::read(path, None)
+                    .map(|m| {
+                        let names: Vec<String> =
+                            m.channels.iter().map(|c| format!("'{c}'")).collect();
+                        format!(" with channels {}", names.join(", "))
+                    })
+                    .unwrap_or_default();
+                unsupported(
+                    path,
+                    format!(
+                        "a {} height map{channels}, not a CZI, ND2, LIF or TIFF micrograph: read \
+                         it with `contactscope topography` (or `simulate --topography`)",
+                        map.name()
+                    ),
+                )
+            }
             None => unsupported(
                 path,
                 "not a CZI, ND2, LIF or TIFF file (unknown magic bytes at the start)",

@@ -190,22 +190,6 @@ mod tests {
         );
     }
 
-    /// Our statistics of a real file: (valid points, min, max, mean, rms about the mean).
-    fn stats(m: &HeightMap) -> (usize, f64, f64, f64, f64) {
-        let v: Vec<f64> = m
-            .heights
-            .iter()
-            .copied()
-            .filter(|h| h.is_finite())
-            .collect();
-        let n = v.len() as f64;
-        let min = v.iter().copied().fold(f64::INFINITY, f64::min);
-        let max = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let mean = v.iter().sum::<f64>() / n;
-        let rms = (v.iter().map(|h| (h - mean).powi(2)).sum::<f64>() / n).sqrt();
-        (v.len(), min, max, mean, rms)
-    }
-
     #[test]
     fn real_files_match_the_header() {
         let close = |a: f64, b: f64, tol: f64| assert!((a - b).abs() <= tol, "{a} vs {b}");
@@ -237,37 +221,11 @@ mod tests {
             assert_eq!((m.nx(), m.ny()), (512, 512));
             close(m.dx_m, 312.4999911618964e-9, 1e-9 * 312.5e-9);
             close(m.dy_m, 312.4999911618964e-9, 1e-9 * 312.5e-9);
-            let (n, lo, hi, mu, sigma) = stats(&m);
-            assert_eq!(n, 262144);
-            close(lo, min, 1e-12 * min);
-            close(hi, max, 1e-12 * max);
-            close(sigma, rms, 1e-9 * rms);
-            close(mu, mean, 1e-9 * rms);
-            for k in 0..10 {
-                let cut = bytes.len() * k / 10;
-                let err = read(path, &bytes[..cut], None).unwrap_err().to_string();
-                assert!(err.contains(".nms"), "{cut}: {err}");
-            }
-            if file.ends_with("nms-1.nms") {
-                corrupt(
-                    path,
-                    &bytes,
-                    &[
-                        0, 4, 8, 12, 16, 24, 1352, 1353, 1368, 1371, 1372, 1376, 1383, 1416,
-                    ],
-                );
-            }
-        }
-    }
-
-    /// Flip single bytes of the first 4 KiB (every 41st, and `fields`): Ok or Err, no panic.
-    fn corrupt(path: &Path, bytes: &[u8], fields: &[usize]) {
-        let mut b = bytes.to_vec();
-        let picks = (0..4096).step_by(41).chain(fields.iter().copied());
-        for i in picks.filter(|&i| i < bytes.len()) {
-            b[i] ^= 0xff;
-            let _ = read(path, &b, None);
-            b[i] ^= 0xff;
+            assert_eq!(m.valid_points(), 262144);
+            crate::topography::test_support::assert_stats(&m.heights, [min, max, mean, rms]);
+            crate::topography::test_support::truncations_and_corruptions(path, &bytes, |d| {
+                read(path, d, None).map(|_| ())
+            });
         }
     }
 }
