@@ -460,10 +460,12 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
                     height_unit: Optional[float] = None, detrend: str = "plane", *,
                     channel: Optional[str] = None,
                     fill_invalid: Optional[str] = None) -> Results:
-    """A height map from any format contactscope reads (npy, TIFF, GSF, text, WSxM, Nanoscope,
-    Igor ibw, Nanosurf nid, PicoView mi, Park TIFF, Gwyddion, X3P, SDF, Wyko opd, Sensofar plu,
-    Digital Surf sur, FRT … by extension or content), read as the command line's ``topography``
-    reads it (the same checks and messages).
+    """A height map from any format contactscope reads (npy, TIFF, GSF, text matrices with or
+    without a Gwyddion or h=/w= header, x y z grids, gzip text, WSxM, Nanoscope, Igor ibw,
+    Nanosurf nid, PicoView mi, Park TIFF, Gwyddion, X3P, SDF, Wyko opd, Sensofar plu, Digital
+    Surf sur and mnt, FRT, Alicona al3d, TrueMap tmd, NanoFocus nms, Image Metrology bcr/bcrf,
+    Zygo MetroPro dat, NetCDF, HDF5 … recognised by content; ``docs/formats.md``), read as the
+    command line's ``topography`` reads it (the same checks and messages).
 
     ``pixel_size`` (m, or (x, y)) overrides the file's; ``height_unit``: metres per stored unit
     for files without one. ``channel`` names the channel of a multi-channel file (default: its
@@ -473,7 +475,8 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
     Returns ``heights`` (rows = y, m; filled as asked, then detrended by ``detrend``: "none",
     "mean" or "plane", the command line's default), ``pixel_size_m`` ((x, y), m), ``notes`` and
     ``summary``: the command line's ``topography --json`` in SI units, describing the file as
-    stored (``file``, ``format``, ``channel``, ``nx``, ``ny``, ``pixel_size_m`` {``x``, ``y``},
+    stored (``file``, ``format``, ``channel``, ``channels`` (every channel of the file), ``nx``,
+    ``ny``, ``pixel_size_m`` {``x``, ``y``},
     ``valid_points``, ``height_min_m``, ``height_max_m``, ``height_mean_m``,
     ``h_rms_as_stored_m``, ``h_prime_rms_as_stored``, ``h_double_prime_rms_as_stored_per_m``)
     and after detrending (``detrended``: ``detrend``,

@@ -9,8 +9,9 @@ series). One image layer per series and channel, with the T, Z and extra axes (e
 file's pixel size (1 where the file does not state it) and the file's name and series name.
 
 Height maps: AFM and profilometer files (Igor ibw, Nanosurf nid, PicoView mi, Gwyddion gwy,
-X3P, SDF, Wyko opd, Sensofar plu, Digital Surf sur, FRT, GSF, WSxM top, Nanoscope di/spm/001,
-Park TIFF) through :func:`contactscope.read_topography`, as the command line's ``topography``
+X3P, SDF, Wyko opd, Sensofar plu, Digital Surf sur and mnt, FRT, GSF, WSxM top/stp, Nanoscope
+di/spm/001, Alicona al3d, TrueMap tmd, NanoFocus nms, Image Metrology bcr/bcrf, Vision64 opdx,
+NetCDF nc, HDF5 h5, Park TIFF) through :func:`contactscope.read_topography`, as the command line's ``topography``
 reads them (plane-levelled, its default): one image layer of heights in µm, scale in µm.
 
 A file contactscope cannot read gives napari's ordinary "no reader" path (``get_*_reader``
@@ -37,7 +38,8 @@ PathOrPaths = Union[str, Sequence[str]]
 MICROGRAPH_EXTENSIONS = (".tif", ".tiff", ".czi", ".nd2", ".lif")
 TIFF_EXTENSIONS = (".tif", ".tiff")
 TOPOGRAPHY_EXTENSIONS = (".ibw", ".nid", ".mi", ".gwy", ".x3p", ".sdf", ".opd", ".plu", ".sur",
-                         ".frt", ".gsf", ".top", ".di", ".spm", ".001")
+                         ".frt", ".gsf", ".top", ".stp", ".di", ".spm", ".001", ".al3d", ".tmd",
+                         ".nms", ".bcr", ".bcrf", ".mnt", ".opdx", ".nc", ".h5")
 
 
 CHANNEL_COLOURS = ("green", "magenta", "cyan", "yellow", "red", "blue", "gray")
