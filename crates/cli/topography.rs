@@ -35,6 +35,8 @@ pub fn run(args: Args) -> Result<()> {
     source.channel = args.channel.clone();
     let detrend = source.detrend.name();
     let outcome = job::run(&TopographyRequest { source })?;
+    // A pixel size that replaced the file's own, points filled: on stderr, as every command's.
+    super::common::print_warnings(&outcome.notes);
     if args.json {
         println!("{}", serde_json::to_string_pretty(&outcome.summary)?);
         return Ok(());

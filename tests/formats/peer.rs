@@ -338,3 +338,28 @@ fn info_on_a_height_map_names_its_channels_and_the_command() {
         "{err}"
     );
 }
+
+/// A pixel size given beside one the file states replaces it, and `topography` and `simulate` say
+/// so, naming both.
+#[test]
+fn a_pixel_size_given_beside_the_files_own_is_named() {
+    let fixtures = crate::common::root().join("fixtures/surface-topography");
+    let path = fixtures.join("matrix-6.txt");
+    let o = crate::common::run_ok(&[
+        "topography",
+        path.to_str().unwrap(),
+        "--pixel-size",
+        "2um",
+        "--json",
+    ]);
+    let err = crate::common::stderr(&o);
+    assert!(
+        err.contains("--pixel-size 2.00000 µm × 2.00000 µm replaces the pixel size the file states, 2.50000 µm × 3.33333 µm"),
+        "{err}"
+    );
+    let t: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(t["pixel_size_um"]["x"], 2.0);
+    // Without the flag, nothing is said.
+    let o = crate::common::run_ok(&["topography", path.to_str().unwrap(), "--json"]);
+    assert!(crate::common::stderr(&o).is_empty());
+}

@@ -216,10 +216,11 @@ impl TopographySource {
         Ok(self.read_with_notes()?.0)
     }
 
-    /// [`Self::read`], with notes for the user (how many invalid points were filled).
+    /// [`Self::read`], with notes for the user (a pixel size that replaced the file's own, how
+    /// many invalid points were filled).
     pub fn read_with_notes(&self) -> Result<(Topography, Vec<String>)> {
         let mut map = self.read_raw()?;
-        let mut notes = Vec::new();
+        let mut notes: Vec<String> = replaced_pixel_size_note(&map).into_iter().collect();
         match self.fill_invalid {
             Some(_) => notes.extend(self.fill(&mut map)),
             None if map.invalid_points > 0 && map.valid_points() > 0 => {
@@ -286,6 +287,20 @@ fn check_pixel_size((x, y): (f64, f64)) -> Result<()> {
     Quantity::PixelSize.check(x, Param::PixelSize)?;
     Quantity::PixelSize.check(y, Param::PixelSize)?;
     Ok(())
+}
+
+/// The note that the pixel size given replaced the one the file states (both named).
+pub fn replaced_pixel_size_note(map: &HeightMap) -> Option<String> {
+    use contactscope_formats::units::format_length;
+    let (x, y) = map.replaced_pixel_size_m?;
+    Some(format!(
+        "{} {} × {} replaces the pixel size the file states, {} × {}",
+        Param::PixelSize,
+        format_length(map.dx_m),
+        format_length(map.dy_m),
+        format_length(x),
+        format_length(y)
+    ))
 }
 
 /// The map as a [`Topography`] for a contact calculation, or an error naming the file (invalid

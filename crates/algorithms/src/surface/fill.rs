@@ -115,6 +115,7 @@ mod tests {
             dx_m: 1e-6,
             dy_m: 1e-6,
             invalid_points,
+            replaced_pixel_size_m: None,
         }
     }
 

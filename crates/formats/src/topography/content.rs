@@ -65,9 +65,8 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
                 ),
             ));
         }
-        if let Some((dx, dy)) = options.pixel_size_m {
-            map.dx_m = dx;
-            map.dy_m = dy;
+        if let Some(pixel) = options.pixel_size_m {
+            map.replace_pixel_size(pixel);
         } else if map.dx_m.is_nan() || map.dy_m.is_nan() {
             // NaN: the file states no pixel size.
             return Err(bad(

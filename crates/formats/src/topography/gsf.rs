@@ -77,7 +77,14 @@ pub fn read_gsf(
         .chunks_exact(4)
         .map(|c| z(f64::from(f32::from_le_bytes(c.try_into().unwrap()))))
         .collect();
-    topography(path, TopographyFormat::Gsf, (ny, nx), heights, pixel)
+    let mut map = topography(path, TopographyFormat::Gsf, (ny, nx), heights, pixel)?;
+    // The file's own size, when it states one, is recorded as replaced.
+    if let (Some(_), Ok(stated)) = (pixel_size_m, file_pixel_size(path, &get, nx, ny)) {
+        map.dx_m = stated.0;
+        map.dy_m = stated.1;
+        map.replace_pixel_size(pixel);
+    }
+    Ok(map)
 }
 
 fn file_pixel_size<'a>(

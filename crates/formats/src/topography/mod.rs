@@ -243,13 +243,19 @@ pub fn read_tiff(
     };
     let convert = to_metres(scale);
     let heights: Vec<f64> = values.iter().map(|&v| convert(f64::from(v))).collect();
-    topography(
+    let mut map = topography(
         path,
         TopographyFormat::Tiff,
         (plane.height, plane.width),
         heights,
         (dx, dy),
-    )
+    )?;
+    if let (Some(_), Some(stated)) = (pixel_size_m, info.pixel_size) {
+        map.dx_m = stated.x_m;
+        map.dy_m = stated.y_m;
+        map.replace_pixel_size((dx, dy));
+    }
+    Ok(map)
 }
 
 pub(crate) use crate::binary::bad;
@@ -403,6 +409,7 @@ pub(crate) fn topography(
         dx_m: pixel_size_m.0,
         dy_m: pixel_size_m.1,
         invalid_points: 0,
+        replaced_pixel_size_m: None,
     })
 }
 

@@ -139,6 +139,22 @@ pub struct HeightMap {
     pub dy_m: f64,
     /// Number of NaN heights.
     pub invalid_points: usize,
+    /// The pixel size (x, y) the file states, m, when a pixel size given as an argument replaced
+    /// it (`dx_m`, `dy_m` are then the argument's); `None` otherwise.
+    pub replaced_pixel_size_m: Option<(f64, f64)>,
+}
+
+impl HeightMap {
+    /// Use `pixel_size_m` instead of the file's own, recording the file's when it states one
+    /// that differs.
+    pub(crate) fn replace_pixel_size(&mut self, (dx, dy): (f64, f64)) {
+        let stated = (self.dx_m, self.dy_m);
+        if stated.0.is_finite() && stated.1.is_finite() && stated != (dx, dy) {
+            self.replaced_pixel_size_m = Some(stated);
+        }
+        self.dx_m = dx;
+        self.dy_m = dy;
+    }
 }
 
 impl HeightMap {
@@ -443,6 +459,7 @@ pub(crate) fn height_map(
         dx_m,
         dy_m,
         invalid_points,
+        replaced_pixel_size_m: None,
     })
 }
 

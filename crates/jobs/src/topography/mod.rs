@@ -249,7 +249,10 @@ pub fn run(request: &TopographyRequest) -> Result<TopographyOutcome> {
     let mut map = source.read_raw()?;
     let stored = TopographySummary::of(&path.display().to_string(), &map);
     stored.check_finite(path)?;
-    let notes: Vec<String> = source.fill(&mut map).into_iter().collect();
+    let notes: Vec<String> = crate::heights::replaced_pixel_size_note(&map)
+        .into_iter()
+        .chain(source.fill(&mut map))
+        .collect();
     let detrend = source.detrend;
     match usable(path, map) {
         Ok(mut topography) => {

@@ -187,15 +187,18 @@ pub(crate) fn read_str(
             .map(|r| [convert(r[0]), convert(r[1]), convert(r[2])])
             .collect();
         let (heights, shape, spacing) = columns::xyz_grid(path, &points)?;
-        let pixel = options.pixel_size_m.unwrap_or(spacing);
-        return height_map(
+        let mut map = height_map(
             path,
             TopographyFormat::Xyz,
             (&channels, index),
             shape,
             heights,
-            pixel,
-        );
+            spacing,
+        )?;
+        if let Some(pixel) = options.pixel_size_m {
+            map.replace_pixel_size(pixel);
+        }
+        return Ok(map);
     }
     if columns <= 2 || rows.len() == 1 {
         return Err(line_scan(path, rows.len().max(columns), None));
@@ -209,11 +212,14 @@ pub(crate) fn read_str(
             ));
         }
     }
-    let pixel = match (options.pixel_size_m, stated.size_m, stated.pixel_m) {
-        (Some(p), _, _) => p,
-        (None, Some((w, h)), _) => (w / nx as f64, h / ny as f64),
-        (None, None, Some(p)) => (p, p),
-        (None, None, None) => {
+    let stated_pixel = match (stated.size_m, stated.pixel_m) {
+        (Some((w, h)), _) => Some((w / nx as f64, h / ny as f64)),
+        (None, Some(p)) => Some((p, p)),
+        (None, None) => None,
+    };
+    let pixel = match (stated_pixel, options.pixel_size_m) {
+        (Some(p), _) | (None, Some(p)) => p,
+        (None, None) => {
             return Err(bad(
                 path,
                 format!(
@@ -224,7 +230,11 @@ pub(crate) fn read_str(
         }
     };
     let heights = rows.into_iter().flatten().map(&convert).collect();
-    height_map(path, format, (&channels, index), (ny, nx), heights, pixel)
+    let mut map = height_map(path, format, (&channels, index), (ny, nx), heights, pixel)?;
+    if let Some(given) = options.pixel_size_m {
+        map.replace_pixel_size(given);
+    }
+    Ok(map)
 }
 
 #[cfg(test)]
