@@ -1,7 +1,8 @@
 //! Which reader a height-map file goes to, decided from its content: magic bytes and headers
 //! first ([`super::detect_file`], NumPy, TIFF, Gwyddion Simple Field, gzip), then text; the
 //! extension only names what the file was expected to be in an error. A file in a format
-//! contactscope knows but does not read (Nanonis, JPK, Keyence, old Gwyddion, images, …) is refused
+//! contactscope knows but does not read (Nanonis, JPK, Keyence, old Gwyddion, Nanoscope force
+//! curves, images, …) is refused
 //! saying what it is.
 
 use std::io::Read;
@@ -25,7 +26,9 @@ fn known_unread(head: &[u8]) -> Option<&'static str> {
         head.windows(needle.len())
             .any(|w| w.eq_ignore_ascii_case(needle))
     };
-    Some(if starts(b"GWYO") {
+    Some(if starts(b"\\*Force file list") {
+        "a Nanoscope force-curve file, not a height map"
+    } else if starts(b"GWYO") {
         "an old-format Gwyddion file (GWYO, before Gwyddion 2): open it in Gwyddion and save it \
          again (.gwy) to read it"
     } else if starts(b":NANONIS_VERSION:") {
@@ -206,6 +209,7 @@ mod tests {
     fn known_formats_that_are_not_read_say_what_they_are() {
         for (head, needle) in [
             (&b"GWYOxxxx"[..], "old-format Gwyddion"),
+            (b"\\*Force file list\r\n", "force-curve"),
             (b":NANONIS_VERSION:\n2", "Nanonis"),
             (b"VK4_\0\0\0\0", "Keyence"),
             (b"\x89PNG\r\n\x1a\n", "picture"),
