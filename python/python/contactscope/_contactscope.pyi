@@ -364,6 +364,7 @@ class TopographySummary(TypedDict, total=False):
     file: str
     format: str
     channel: str
+    channels: List[str]
     nx: int
     ny: int
     pixel_size_m: TopographyPixelSize
