@@ -83,7 +83,18 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
         }
         return Ok(map);
     }
-    let head = FileSource::open(path)?.read_up_to(0, HEAD_BYTES)?;
+    let mut source = FileSource::open(path)?;
+    if source.len > MAX_FILE_BYTES {
+        return Err(unsupported(
+            path,
+            format!(
+                "file of {} bytes is larger than the {} GiB limit",
+                source.len,
+                MAX_FILE_BYTES >> 30
+            ),
+        ));
+    }
+    let head = source.read_up_to(0, HEAD_BYTES)?;
     let single = |map: Result<HeightMap>| -> Result<HeightMap> {
         let map = map?;
         match &options.channel {

@@ -80,7 +80,7 @@ fn numbers(line: &str) -> Option<Vec<f64>> {
     tokens.iter().map(|t| t.parse::<f64>().ok()).collect()
 }
 
-/// The parsed file: header, numbers row by row, and the line number of each row.
+/// The parsed file: what its header states, its numbers row by row, and the row length.
 struct Parsed {
     stated: Stated,
     rows: Vec<Vec<f64>>,
