@@ -64,11 +64,11 @@ pub enum TopographyFormat {
     Mnt,
     /// Bruker/Veeco Vision64 OPDx.
     Opdx,
-    /// NumPy `.npy` array (by extension).
+    /// NumPy `.npy` array.
     Npy,
-    /// float32/float64 TIFF (by extension).
+    /// float32/float64 TIFF.
     Tiff,
-    /// Gwyddion Simple Field `.gsf` (by extension).
+    /// Gwyddion Simple Field `.gsf`.
     Gsf,
     /// Text matrix, with or without a header (also gzip-compressed).
     Text,
@@ -155,9 +155,7 @@ impl HeightMap {
         self.dx_m = dx;
         self.dy_m = dy;
     }
-}
 
-impl HeightMap {
     /// Columns.
     pub fn nx(&self) -> usize {
         self.heights.ncols()
