@@ -7,8 +7,8 @@
 //! `tests/data/surface_topography_reference.py` with SurfaceTopography 1.27.1 (every channel of
 //! every file). Files: the subset committed in `fixtures/surface-topography` (binary ones stored
 //! gzip-compressed, decompressed here to their own name; `fixtures/README.md`), and the whole
-//! folder when `CONTACTSCOPE_ST_EXAMPLES` names a checkout of it (run by hand: the folder is
-//! 40 MB).
+//! folder when `CONTACTSCOPE_ST_EXAMPLES` names a checkout of it (run by hand: the 67 files of
+//! the snapshot used take 51 MB).
 //!
 //! Where we read a file differently on purpose, the row is listed in [`DIFFERENT`] with the
 //! reason and what the file itself states; channel names we give where SurfaceTopography says
