@@ -12,7 +12,7 @@ use super::{
     bad, detect_file, read, read_gsf, read_npy, read_tiff, text, HeightMap, ReadOptions,
     TopographyFormat, MAX_FILE_BYTES,
 };
-use crate::binary::{unsupported, FileSource};
+use crate::binary::unsupported;
 use crate::error::Result;
 
 /// Bytes looked at to recognise a file.
@@ -83,18 +83,7 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
         }
         return Ok(map);
     }
-    let mut source = FileSource::open(path)?;
-    if source.len > MAX_FILE_BYTES {
-        return Err(unsupported(
-            path,
-            format!(
-                "file of {} bytes is larger than the {} GiB limit",
-                source.len,
-                MAX_FILE_BYTES >> 30
-            ),
-        ));
-    }
-    let head = source.read_up_to(0, HEAD_BYTES)?;
+    let head = super::vendor::open_limited(path)?.read_up_to(0, HEAD_BYTES)?;
     let single = |map: Result<HeightMap>| -> Result<HeightMap> {
         let map = map?;
         match &options.channel {

@@ -289,9 +289,9 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
     }
 }
 
-/// The whole file, refused above [`MAX_FILE_BYTES`].
-fn read_whole(path: &Path) -> Result<Vec<u8>> {
-    let mut source = FileSource::open(path)?;
+/// The file opened for reading, refused above [`MAX_FILE_BYTES`].
+pub(crate) fn open_limited(path: &Path) -> Result<FileSource> {
+    let source = FileSource::open(path)?;
     if source.len > MAX_FILE_BYTES {
         return Err(unsupported(
             path,
@@ -302,6 +302,12 @@ fn read_whole(path: &Path) -> Result<Vec<u8>> {
             ),
         ));
     }
+    Ok(source)
+}
+
+/// The whole file, refused above [`MAX_FILE_BYTES`].
+fn read_whole(path: &Path) -> Result<Vec<u8>> {
+    let mut source = open_limited(path)?;
     source.read_at(0, source.len as usize, "the file")
 }
 
