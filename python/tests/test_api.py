@@ -547,6 +547,10 @@ def test_read_topography_gsf_carries_its_pixel_size(cli, tmp_path):
     assert t.pixel_size_m == pytest.approx((50e-9, 50e-9), rel=1e-9)
     np.testing.assert_allclose(t.heights, cs.surface(64, 64, 50e-9, rms_height=20e-9, seed=9),
                                rtol=1e-6, atol=1e-15)
+    # A pixel size beside the file's own replaces it, with the command line's warning.
+    with pytest.warns(cs.ContactscopeWarning, match="replaces the pixel size the file states"):
+        t = cs.read_topography(gsf, pixel_size=60e-9, detrend="none")
+    assert t.pixel_size_m == pytest.approx((60e-9, 60e-9), rel=1e-12)
     # The content decides, not the extension: one row of numbers is a profile.
     with pytest.raises(cs.InputError, match="line scan"):
         (tmp_path / "s.xyz").write_text("1 2 3")

@@ -485,6 +485,9 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
     """
     result = Results(_cs.read_topography(os.fspath(path), pixel_size, height_unit, detrend,
                                          channel, fill_invalid))
+    # The command line's warnings (a pixel size that replaced the file's, points filled).
+    for text in result.get("notes") or ():
+        _warnings.warn(text, ContactscopeWarning, stacklevel=2)
     d = result["summary"]["detrended"]
     result["pixel_size_m"] = (d["pixel_size_x_m"], d["pixel_size_y_m"])
     return result

@@ -21,11 +21,6 @@ const HEAD_BYTES: usize = 4096;
 /// Formats recognised by their first bytes that no reader here reads, with what to say.
 fn known_unread(head: &[u8]) -> Option<&'static str> {
     let starts = |m: &[u8]| head.starts_with(m);
-    let tiff = starts(b"II*\0") || starts(b"MM\0*");
-    let contains = |needle: &[u8]| {
-        head.windows(needle.len())
-            .any(|w| w.eq_ignore_ascii_case(needle))
-    };
     Some(if starts(b"\\*Force file list") {
         "a Nanoscope force-curve file, not a height map"
     } else if starts(b"GWYO") {
@@ -36,9 +31,6 @@ fn known_unread(head: &[u8]) -> Option<&'static str> {
     } else if starts(b"VK4_") || starts(b"VK3_") {
         "a Keyence VK3/VK4 file: not read by contactscope (no sample file to test a reader on); \
          export the map as .gsf or a text matrix"
-    } else if tiff && contains(b"jpk") {
-        "a JPK Instruments TIFF: not read by contactscope (no sample file to test a reader on); \
-         export the map as .gsf"
     } else if starts(b"MATLAB 5.0 MAT-file") {
         "a MATLAB .mat file: not read by contactscope; save the array with numpy.save (.npy)"
     } else if starts(b"OLYMPUSRAWFORMAT") {
@@ -104,7 +96,17 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
         return Err(unsupported(path, reason));
     }
     if crate::microscopy::detect(&head) == Some(crate::microscopy::MicroscopyFormat::Tiff) {
-        return single(read_tiff(path, options.pixel_size_m, options.height_unit_m));
+        // A float TIFF reads whatever wrote it; a JPK Instruments TIFF (integer channels with
+        // JPK's own scaling tags) that does not is named as such.
+        let jpk = head.windows(3).any(|w| w.eq_ignore_ascii_case(b"jpk"));
+        return match read_tiff(path, options.pixel_size_m, options.height_unit_m) {
+            Err(_) if jpk => Err(unsupported(
+                path,
+                "a JPK Instruments TIFF: not read by contactscope (no sample file to test a \
+                 reader on); export the map as .gsf",
+            )),
+            read => single(read),
+        };
     }
     if head.starts_with(b"Gwyddion Simple Field") {
         return single(read_gsf(path, options.pixel_size_m, options.height_unit_m));
@@ -220,6 +222,15 @@ mod tests {
                 .to_string();
             assert!(err.contains(needle) && err.contains("a.dat"), "{err}");
         }
+        // A TIFF that does not read as heights and says JPK is named as JPK's.
+        let (_j, path) = write("m.jpk", b"II*\0\x08\0\0\0JPKInstruments");
+        let err = read_height_map(&path, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("JPK Instruments TIFF") && err.contains("m.jpk"),
+            "{err}"
+        );
         let (_d, path) = write("a.npy", b"\x01\x02\x03\x00\x05binary");
         let err = read_height_map(&path, &ReadOptions::default())
             .unwrap_err()
