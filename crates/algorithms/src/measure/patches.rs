@@ -89,8 +89,15 @@ fn row_runs(row: &[u8], forest: &mut Forest, runs: &mut Vec<Run>) {
 /// Number of 8-connected regions of non-zero bytes in a row-major `width`-wide mask, and the
 /// pixel count of the largest.
 pub fn count_patches(mask: &[u8], width: usize) -> (u64, u64) {
+    let sizes = patch_sizes(mask, width);
+    (sizes.len() as u64, sizes.iter().copied().max().unwrap_or(0))
+}
+
+/// The pixel count of every 8-connected region of non-zero bytes in a row-major `width`-wide
+/// mask, in the order the regions' first runs were met (row by row).
+pub fn patch_sizes(mask: &[u8], width: usize) -> Vec<u64> {
     if width == 0 {
-        return (0, 0);
+        return Vec::new();
     }
     let mut forest = Forest::default();
     let (mut previous, mut current): (Vec<Run>, Vec<Run>) = (Vec::new(), Vec::new());
@@ -111,15 +118,10 @@ pub fn count_patches(mask: &[u8], width: usize) -> (u64, u64) {
         }
         std::mem::swap(&mut previous, &mut current);
     }
-    let mut patches = 0;
-    let mut largest = 0;
-    for n in 0..forest.parent.len() {
-        if forest.parent[n] == n as u32 {
-            patches += 1;
-            largest = largest.max(forest.pixels[n]);
-        }
-    }
-    (patches, largest)
+    (0..forest.parent.len())
+        .filter(|&n| forest.parent[n] == n as u32)
+        .map(|n| forest.pixels[n])
+        .collect()
 }
 
 #[cfg(test)]
@@ -172,6 +174,8 @@ mod tests {
             })
         ) {
             prop_assert_eq!(count_patches(&mask, width), reference(&mask, width, height));
+            let contact = mask.iter().filter(|m| **m != 0).count() as u64;
+            prop_assert_eq!(patch_sizes(&mask, width).iter().sum::<u64>(), contact);
         }
     }
 }
