@@ -10,6 +10,7 @@
 //! | 4 + 4 + 4 | width, height, loads |
 //! | 8 + 8 | simulation pixel (m), rms height of the roughness (m) |
 //! | 1 | patch scale (0 none, 1 sub-PSF, 2 PSF-sized, 3 coarse) |
+//! | 1 | preset (0 none, 1 paper, 2 small, 3 cloud) |
 //! | 6 × 8 | H, h′_rms, λ_r (m), λ_s (m), R (m), E* (Pa) |
 //! | 1 + 8 + 8 | model: 0 elastic, 1 hardness (p_Y), 2 volume-conserving hardness (p_Y, α), 3 hardening (k, p_Y0) |
 //! | 8 | seed |
@@ -22,7 +23,7 @@
 //! is an error, never a panic.
 
 use super::{
-    BitMask, ContactRamp, PatchScale, PatchStats, RampSpec, SolvedLoad, MAX_LOADS, MAX_SIZE,
+    BitMask, ContactRamp, PatchScale, PatchStats, Preset, RampSpec, SolvedLoad, MAX_LOADS, MAX_SIZE,
 };
 use crate::error::{Error, Result};
 use crate::solver::simulate::Model;
@@ -30,9 +31,9 @@ use crate::solver::simulate::Model;
 /// The first eight bytes.
 pub const MAGIC: [u8; 8] = *b"CSRAMP\0\x1a";
 /// The format version this code writes and reads.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 /// Bytes before the first load.
-const HEADER: usize = 8 + 4 + 12 + 16 + 1 + 48 + 17 + 8;
+const HEADER: usize = 8 + 4 + 12 + 16 + 2 + 48 + 17 + 8;
 /// Bytes of a load's numbers, before its mask.
 const LOAD_FIXED: usize = 9 * 8;
 
@@ -58,6 +59,7 @@ pub fn encode(ramp: &ContactRamp) -> Vec<u8> {
     f(&mut out, ramp.sim_pixel_m);
     f(&mut out, ramp.rms_height_m);
     out.push(spec.scale.map_or(0, PatchScale::code));
+    out.push(spec.preset.map_or(0, Preset::code));
     for v in [
         spec.hurst,
         spec.rms_slope,
@@ -175,7 +177,7 @@ pub fn decode(bytes: &[u8]) -> Result<ContactRamp> {
     let version = r.u32()?;
     if version != VERSION {
         return Err(corrupt(format!(
-            "format version {version}, this build reads {VERSION}"
+            "format version {version}, this build reads {VERSION} (a cache written by another version: solve the ramp again)"
         )));
     }
     if fnv1a(body) != stored {
@@ -197,6 +199,7 @@ pub fn decode(bytes: &[u8]) -> Result<ContactRamp> {
     }
     let (sim_pixel_m, rms_height_m) = (r.f64()?, r.f64()?);
     let scale = PatchScale::from_code(r.u8()?).ok_or_else(|| corrupt("unknown patch scale"))?;
+    let preset = Preset::from_code(r.u8()?).ok_or_else(|| corrupt("unknown preset"))?;
     let mut numbers = [0.0; 6];
     for v in &mut numbers {
         *v = r.f64()?;
@@ -252,6 +255,7 @@ pub fn decode(bytes: &[u8]) -> Result<ContactRamp> {
     }
     let spec = RampSpec {
         scale,
+        preset,
         size: width,
         sim_pixel_m,
         hurst,

@@ -27,7 +27,7 @@
 //! ```
 //! use contactscope::synth::solved::{image_ramp, solve_ramp, Camera, ContactRamp, PatchScale, RampSpec};
 //!
-//! let ramp = solve_ramp(&RampSpec::small(PatchScale::PsfSized, 1))?; // hardness, ½ s
+//! let ramp = solve_ramp(&RampSpec::small(PatchScale::PsfSized, 1))?; // hardness, under a second
 //! let cached = ramp.encode();
 //! assert_eq!(ContactRamp::decode(&cached)?, ramp);
 //! // 200 nm pixels, 500 nm FWHM, 40 photons in a fully covered contact pixel at the first load.
@@ -41,93 +41,134 @@
 //!
 //! ## Presets
 //!
-//! [`RampSpec::paper`]: 1024² pixels of 50 nm (a 51.2 µm field), R = 290 µm, E* = 3.7 GPa
-//! (polystyrene on glass), 8 loads log-spaced over two decades (the paper's 4–400 mN is two
-//! decades), 0.24–24 mN: the largest is the Hertz load (N = 4E*a³/(3R)) whose contact radius is
-//! 22 % of the field ([`HERTZ_RADIUS_SHARE`]), so that the rough contact, which spreads beyond
-//! Hertz's, stays inside the map (measured below). [`RampSpec::small`]: the same physics on 256² pixels of 50 nm
-//! (12.8 µm), R = 50 µm, 0.012–1.2 mN (Hertz radius 18 % of the field), about half a second per
-//! ramp, for tests.
-//!
-//! The model rotates with the seed: `seed % 3` = 0 elastic, 1 penetration hardness (Eq. 4, p_Y
-//! drawn in [`HARDNESS_RANGE_PA`], so that the mean pressures come out at 135–205 MPa),
+//! Every preset: pixels of 50 nm, E* = 3.7 GPa (polystyrene on glass), 8 loads log-spaced over
+//! two decades (the paper's 4–400 mN is two decades). The model rotates with the seed:
+//! `seed % 3` = 0 elastic, 1 penetration hardness (Eq. 4, p_Y drawn in [`HARDNESS_RANGE_PA`]),
 //! 2 linear hardening (k = 4 MPa/nm, p_Y0 = 0, the paper's fit). Per seed the Hurst exponent is
 //! drawn in 0.7–0.9 and the rms slope within ±30 % of the scale's value.
+//!
+//! **The paper's pressures.** The paper's sphere (R = 290 µm) at 400 mN has a Hertz contact
+//! radius of 29 µm, wider than a 51 µm field, and a Hertz centre pressure p₀ of 232 MPa; the mean
+//! real pressure N/A rises from ≈ 100 MPa at 4 mN to 250 MPa at 400 mN (Fig. 2), and the contact
+//! "evolves from a discrete collection of asperities in contact at 4 mN to an almost Hertzian
+//! contact circle at 400 mN". The presets keep the pressures and shrink the sphere: the largest
+//! load's Hertz contact has the paper's p₀ = 230 MPa ([`TOP_HERTZ_PRESSURE_PA`]) and a radius of
+//! 21 % of the field ([`HERTZ_RADIUS_SHARE`]), so R = 2E*a/(πp₀) and N = 4E*a³/(3R) (Johnson
+//! 1985). As p₀ ∝ N^⅓ at a given R, every load of the ramp has the nominal
+//! pressures of its counterpart in the paper's 4–400 mN (p₀ = 50 MPa at the smallest).
+//!
+//! * [`RampSpec::paper`]: 1024² (a 51.2 µm field), R = 110 µm, 0.56–55.7 mN.
+//! * [`RampSpec::small`]: 256² (12.8 µm), R = 27.5 µm, 0.035–3.5 mN, 0.4–1 s a ramp, for tests.
+//!   The whole contact is a few micrometres wide, so the coarse scale gives one patch.
+//! * [`RampSpec::cloud`]: the **stress case outside the paper's regime**, the sub-PSF preset of
+//!   before: 1024², R = 290 µm, 0.24–24.3 mN (the largest load's Hertz radius 22 % of the field,
+//!   p₀ = 90 MPa), h′_rms = 0.20 ± 30 % ([`CLOUD_RMS_SLOPE`]), λ_s = 0.2 µm, λ_r = 0.8 µm. The
+//!   real pressure (200–390 MPa elastic, measured) stays far above the nominal one, so the
+//!   contact is a cloud of sub-PSF patches at every load (contact fraction 0.2–0.45 even at the
+//!   centre of the largest load, hardening aside): a 300–750 nm PSF images every load of such a
+//!   series as a grey disc without the contact's signal, and its area cannot be measured by
+//!   fluorescence. It is labelled [`Preset::Cloud`] (scale [`PatchScale::SubPsf`]).
 //!
 //! The roughness is set by its **rms slope** (central differences,
 //! [`crate::surface::generate::RmsTarget::Slope`]), not its rms height: the slope fixes the
 //! elastic mean pressure over the real contact (Persson: p̄ ≈ h′_rms E*/κ, κ ≈ 2) and with it
 //! the contact fraction p_nominal/p̄, which together with the short-wavelength cutoff λ_s decides
-//! how the contact is cut into patches. A narrow band (λ_r = 4 λ_s) keeps the patches from
-//! clustering on longer wavelengths.
+//! how the contact is cut into patches. A narrow band (λ_r = 2 λ_s) keeps the patches from
+//! clustering on longer wavelengths. The slopes give the paper's ≈ 100 MPa at the smallest load
+//! (measured p̄ ≈ 1600–1900 MPa × h′_rms there for the sub-PSF and PSF-sized scales; the coarse
+//! scale's few asperities carry it at less, so it has a steeper slope), and the ±30 % draws stay
+//! within ≈ 60–150 MPa; a steeper slope would keep the smallest load's patches apart but leaves
+//! the paper's pressures (the cloud).
 //!
-//! | scale | λ_s | λ_r | h′_rms | patches meant (area-weighted, middle loads) |
+//! | scale | λ_s | λ_r | h′_rms | patches meant (area-weighted, smallest load) |
 //! |---|---|---|---|---|
-//! | [`PatchScale::SubPsf`] | 0.2 µm | 0.8 µm | 0.20 | ≈ 0.1–0.3 µm, below a 300–750 nm PSF |
-//! | [`PatchScale::PsfSized`] | 0.6 µm | 2.4 µm | 0.12 | ≈ 0.4–1.5 µm, the paper's "0.3–1.5 µm" |
-//! | [`PatchScale::Coarse`] | 3.2 µm | 12.8 µm | 0.08 | ≳ 2–5 µm, many PSF widths |
+//! | [`PatchScale::SubPsf`] | 0.15 µm | 0.3 µm | 0.07 | ≈ 0.2–0.6 µm, most of the area in patches below a 300–750 nm PSF |
+//! | [`PatchScale::PsfSized`] | 0.5 µm | 1.0 µm | 0.06 | ≈ 0.7–2 µm, the paper's "0.3–1.5 µm" |
+//! | [`PatchScale::Coarse`] | 3.2 µm | 6.4 µm | 0.075 (small: 0.0525) | two or three asperities of ≈ 2–3 µm, many PSF widths |
 //!
 //! ## Measured
 //!
-//! Per scale and model: the area-weighted mean equivalent diameter d_A = Σ aᵢ·2√(aᵢ/π) / Σ aᵢ
-//! of the 8-connected patches ([`PatchStats`]), the patches and the true area at the smallest,
-//! the middle (4th of 8) and the largest load, the mean pressure at the middle load, the
-//! farthest contact pixel from the centre (2 r_max / field side) and the seconds per ramp on
-//! the 2-core development machine (shared with another job while measured; `solve_ramp` only;
-//! on the machine alone a paper ramp took 9–14 s and a small one 0.4–0.7 s). Imaging a paper
-//! ramp ([`camera::image_ramp`], 8 loads) takes 0.3–0.6 s; its encoded form is 1.05 MB and
-//! encodes and decodes in 4 ms.
+//! Per scale and model, at the smallest, the middle (4th of 8) and the largest load: the
+//! area-weighted mean equivalent diameter d_A = Σ aᵢ·2√(aᵢ/π) / Σ aᵢ of the 8-connected
+//! patches ([`PatchStats`]), the patches, the share of the true area in patches of equivalent
+//! diameter below 0.45 µm ([`ContactRamp::area_share_below`]); the contact fraction within half
+//! the contact radius of the centre at the largest load ([`ContactRamp::central_fill`]); the mean
+//! real pressure p̄ = N/A_true at the smallest and the largest load; the farthest contact pixel
+//! from the centre at the largest load (2 r_max / field side); the seconds per ramp
+//! (`solve_ramp` only) on the 2-core development machine, shared with another job while measured.
+//! Imaging a paper ramp ([`camera::image_ramp`], 8 loads) takes 0.3–0.6 s; its encoded form is
+//! 1.05 MB and encodes and decodes in 4 ms.
 //!
-//! [`RampSpec::paper`] (seeds 0–8 for the sub-PSF and PSF-sized scales, 0–14 for coarse):
+//! [`RampSpec::paper`], seeds 0–8 (three per model):
 //!
-//! | scale | model | seeds | d_A (µm) | patches | area (µm²) | p̄ (MPa) | 2r/L | s |
-//! |---|---|---|---|---|---|---|---|---|
-//! | sub-PSF | elastic | 3 | 0.17–0.18 / **0.20–0.25** / 0.34–0.53 | 53–83 / 269–294 / 1368–1555 | 0.7–1.2 / 5.0–7.4 / 62–91 | 237–353 | 0.55 | 17 |
-//! | sub-PSF | hardness | 3 | 0.20–0.24 / **0.31–0.32** / 1.1–3.2 | 72–92 / 282–301 / 958–1110 | 1.5–1.6 / 10–11 / 130–141 | 159–172 | 0.55 | 13 |
-//! | sub-PSF | hardening | 3 | 0.40 / **1.45–2.56** / 18–20 | 129–140 / 239–272 / 307–412 | 6.7–7.9 / 35–41 / 320–353 | 42–50 | 0.58 | 12 |
-//! | PSF-sized | elastic | 3 | 0.51–0.60 / **0.59–0.93** / 1.8–4.9 | 7–19 / 45–60 / 134–175 | 1.0–2.3 / 7.9–12.5 / 100–139 | 140–222 | 0.57 | 15 |
-//! | PSF-sized | hardness | 3 | 0.54–0.91 / **0.80–1.00** / 5.4–9.9 | 7–17 / 42–46 / 88–120 | 1.4–1.8 / 11–13 / 146–165 | 136–159 | 0.55 | 12 |
-//! | PSF-sized | hardening | 3 | 0.92–1.43 / **1.71–3.02** / 16–19 | 11–24 / 41–51 / 57–77 | 4.1–6.6 / 28–40 / 286–333 | 44–63 | 0.59 | 10 |
-//! | coarse | elastic | 5 | 1.12–1.56 / **2.24–3.00** / 8.4–14 | 1–4 / 3–7 / 4–6 | 1.9–4.4 / 11–20 / 142–209 | 86–162 | 0.69 | 20 |
-//! | coarse | hardness | 5 | 1.36–2.14 / **2.18–3.27** / 7.4–15 | 1–3 / 4–6 / 4–12 | 2.1–4.0 / 12–21 / 148–218 | 82–144 | 0.67 | 20 |
-//! | coarse | hardening | 5 | 1.58–2.54 / **3.05–5.85** / 11–19 | 1–3 / 2–6 / 4–10 | 2.8–8.4 / 15–35 / 203–295 | 50–119 | 0.80 | 10 |
+//! | scale | model | h′_rms drawn | d_A (µm) | patches | area share < 0.45 µm | central fill | p̄ (MPa) | 2r/L | s |
+//! |---|---|---|---|---|---|---|---|---|---|
+//! | sub-PSF | elastic | 0.053–0.082 | **0.20–0.47** / 2.0–5.3 / 16–19 | 177–235 / 190–386 / 257–455 | 0.67–1.00 / 0.10–0.38 / 0.01–0.04 | 0.81–0.94 | 102–143 / 190–231 | 0.44 | 17 |
+//! | sub-PSF | hardness | 0.050–0.067 | **0.32–0.63** / 4.5–5.6 / 19–20 | 130–190 / 193–239 / 203–295 | 0.44–0.79 / 0.11–0.14 / 0.01–0.02 | 0.99–1.00 | 93–111 / 174–181 | 0.44 | 14–18 |
+//! | sub-PSF | hardening | 0.063–0.080 | **5.0–5.1** / 9.7–9.8 / 23 | 43–48 / 38–79 / 41–70 | 0.02–0.04 / 0.00–0.01 / 0.00 | 1.00 | 25–26 / 137 | 0.46 | 9–10 |
+//! | PSF-sized | elastic | 0.046–0.071 | **0.66–1.5** / 4.4–6.6 / 18–20 | 20–26 / 19–43 / 20–33 | 0.10–0.30 / 0.02–0.06 / 0.00 | 0.91–0.99 | 77–128 / 170–199 | 0.45 | 12–13 |
+//! | PSF-sized | hardness | 0.043–0.058 | **0.81–2.0** / 5.6–6.7 / 20–21 | 17–23 / 20–23 / 15–27 | 0.08–0.18 / 0.02–0.03 / 0.00 | 1.00 | 79–105 / 164–171 | 0.45 | 11–14 |
+//! | PSF-sized | hardening | 0.054–0.068 | **4.1–4.8** / 9.2–9.7 / 23 | 9–13 / 8–11 / 5–11 | 0.02–0.03 / 0.00–0.01 / 0.00 | 1.00 | 28–32 / 137–138 | 0.47 | 7–8 |
+//! | coarse | elastic | 0.057–0.088 | **2.0–2.2** / 5.5–6.2 / 18–20 | 3 / 2–4 / 1–2 | 0.00–0.01 / 0.00 / 0.00 | 0.87–0.97 | 70–94 / 169–217 | 0.51 | 12–13 |
+//! | coarse | hardness | 0.053–0.072 | **1.9–2.6** / 3.6–6.0 / 20–21 | 2–3 / 3–5 / 1–3 | 0.00–0.02 / 0.00 / 0.00 | 0.96–1.00 | 87–140 / 163–175 | 0.54 | 12–15 |
+//! | coarse | hardening | 0.067–0.085 | **2.4–3.0** / 4.9–7.8 / 21–22 | 1–2 / 2–4 / 1–2 | 0.00 / 0.00 / 0.00 | 0.93–1.00 | 46–124 / 147–160 | 0.53 | 7–11 |
 //!
-//! [`RampSpec::small`] (seeds 0–29, ten per model):
+//! [`RampSpec::small`], seeds 0–29 (ten per model):
 //!
-//! | scale | model | d_A (µm) | patches | area (µm²) | p̄ (MPa) | 2r/L | s |
-//! |---|---|---|---|---|---|---|---|
-//! | sub-PSF | elastic | 0.11–0.18 / **0.16–0.26** / 0.33–0.80 | 2–9 / 12–20 / 69–95 | 0.02–0.1 / 0.2–0.4 / 3–5 | 216–414 | 0.53 | 0.6 |
-//! | sub-PSF | hardness | 0.12–0.23 / **0.19–0.31** / 0.47–1.7 | 3–9 / 15–25 / 49–82 | 0.1 / 0.4–0.5 / 5–7 | 161–203 | 0.53 | 0.6 |
-//! | sub-PSF | hardening | 0.23–0.36 / **0.39–1.04** / 3.6–4.8 | 8–23 / 22–38 / 25–49 | 0.3–0.6 / 1.9–2.8 / 16–20 | 32–46 | 0.62 | 0.6 |
-//! | PSF-sized | elastic | 0.22–0.36 / **0.38–0.69** / 0.93–1.9 | 1–3 / 2–7 / 7–16 | 0.1 / 0.4–0.6 / 4–7 | 140–232 | 0.66 | 0.7 |
-//! | PSF-sized | hardness | 0.26–0.37 / **0.38–0.78** / 1.4–3.1 | 1–2 / 2–7 / 3–16 | 0.1 / 0.5–0.6 / 6–9 | 135–179 | 0.61 | 0.7 |
-//! | PSF-sized | hardening | 0.41–0.81 / **0.70–1.59** / 2.7–4.8 | 1–7 / 2–9 / 3–13 | 0.3–0.6 / 1.3–3.1 / 14–20 | 28–67 | 0.64 | 0.6 |
-//! | coarse | elastic | 0.44–0.64 / **0.86–1.36** / 2.1–3.9 | 1 / 1–3 / 1–3 | 0.2–0.3 / 0.6–2.0 / 4–13 | 43–148 | 0.77 | 0.6 |
-//! | coarse | hardness | 0.47–0.65 / **0.92–1.21** / 2.1–3.8 | 1 / 1–2 / 1–3 | 0.2–0.3 / 0.7–1.4 / 6–12 | 61–129 | 0.62 | 0.6 |
-//! | coarse | hardening | 0.80–1.07 / **1.39–2.04** / 3.1–5.7 | 1 / 1–3 / 1–3 | 0.5–0.9 / 1.5–3.8 / 9–26 | 23–57 | 0.91 | 0.5 |
+//! | scale | model | h′_rms drawn | d_A (µm) | patches | area share < 0.45 µm | central fill | p̄ (MPa) | 2r/L | s |
+//! |---|---|---|---|---|---|---|---|---|---|
+//! | sub-PSF | elastic | 0.053–0.090 | **0.16–0.42** / 0.44–1.4 / 3.9–4.7 | 14–25 / 20–49 / 23–60 | 0.33–1.00 / 0.12–0.66 / 0.01–0.07 | 0.77–0.94 | 89–144 / 188–240 | 0.47 | 0.6–1.0 |
+//! | sub-PSF | hardness | 0.050–0.086 | **0.16–0.32** / 0.67–1.4 / 4.4–5.0 | 13–24 / 17–40 / 18–45 | 0.56–1.00 / 0.11–0.29 / 0.01–0.04 | 0.89–1.00 | 80–139 / 170–207 | 0.47 | 0.7–1.0 |
+//! | sub-PSF | hardening | 0.053–0.087 | **1.2–1.6** / 2.8–2.9 / 6.2–6.3 | 3–16 / 4–11 / 2–17 | 0.00–0.13 / 0.00–0.01 / 0.00 | 1.00 | 17–19 / 112–113 | 0.52 | 0.5–0.9 |
+//! | PSF-sized | elastic | 0.046–0.077 | **0.30–0.64** / 0.84–1.7 / 4.7–5.1 | 2–7 / 2–9 / 1–8 | 0.02–1.00 / 0.02–0.24 / 0.00–0.02 | 0.88–1.00 | 81–110 / 170–195 | 0.51 | 0.6–0.8 |
+//! | PSF-sized | hardness | 0.043–0.074 | **0.34–0.65** / 1.2–1.9 / 4.8–5.3 | 1–6 / 1–5 / 1–7 | 0.00–1.00 / 0.00–0.12 / 0.00–0.01 | 0.95–1.00 | 66–120 / 159–190 | 0.50 | 0.6–0.9 |
+//! | PSF-sized | hardening | 0.045–0.075 | **0.91–1.6** / 2.5–2.9 / 6.2–6.3 | 1–5 / 1–4 / 1–4 | 0.00–0.12 / 0.00–0.04 / 0.00–0.01 | 1.00 | 17–32 / 112–116 | 0.56 | 0.4–0.6 |
+//! | coarse | elastic | 0.040–0.068 | **0.70–1.2** / 1.4–2.2 / 4.7–5.6 | 1–2 / 1–2 / 1 | 0.00–0.12 / 0.00 / 0.00 | 0.84–1.00 | 29–90 / 142–197 | 0.62 | 0.6–0.8 |
+//! | coarse | hardness | 0.037–0.065 | **0.75–1.2** / 1.5–2.2 / 4.9–5.6 | 1 / 1 / 1 | 0.00 / 0.00 / 0.00 | 0.75–1.00 | 32–79 / 143–185 | 0.56 | 0.7–0.8 |
+//! | coarse | hardening | 0.040–0.066 | **1.2–1.6** / 2.2–3.2 / 5.5–6.4 | 1 / 1 / 1 | 0.00 / 0.00 / 0.00 | 0.96–1.00 | 18–30 / 109–144 | 0.69 | 0.4–0.6 |
+//!
+//! [`RampSpec::cloud`], seeds 0–8 (three per model):
+//!
+//! | scale | model | h′_rms drawn | d_A (µm) | patches | area share < 0.45 µm | central fill | p̄ (MPa) | 2r/L | s |
+//! |---|---|---|---|---|---|---|---|---|---|
+//! | cloud | elastic | 0.153–0.235 | **0.17–0.18** / 0.20–0.25 / 0.34–0.53 | 53–83 / 269–294 / 1368–1555 | 1.00 / 0.96–1.00 / 0.47–0.79 | 0.19–0.29 | 198–368 / 267–391 | 0.55 | 15–20 |
+//! | cloud | hardness | 0.142–0.192 | **0.20–0.24** / 0.31–0.32 / 1.1–3.1 | 72–92 / 282–301 / 958–1110 | 1.00 / 0.82–0.86 / 0.20–0.22 | 0.42–0.45 | 155–162 / 172–187 | 0.55 | 13–15 |
+//! | cloud | hardening | 0.179–0.228 | **0.40** / 1.4–2.6 / 18–20 | 129–140 / 239–272 / 307–412 | 0.56–0.64 / 0.16–0.22 / 0.02–0.04 | 0.83–0.91 | 31–36 / 69–76 | 0.58 | 7–16 |
 //!
 //! What the numbers say:
 //!
-//! * The elastic and hardness seeds give the scale they are named for at the middle loads
-//!   ([`PatchScale::of_diameter`] of the 4th load equals the label; the ignored test
-//!   `paper_presets_give_their_patch_scales` checks seeds 0 and 1). The contact grows from a
-//!   scatter of asperity patches at the smallest load to a much larger, more connected contact
-//!   (d_A grows 2–50 fold from the smallest to the largest load); elastic sub-PSF contacts
-//!   stay a dense cloud of sub-PSF patches even at the largest load (the real pressure,
-//!   h′_rms E*/2 ≈ 240–350 MPa, stays well above the nominal one), which a 300–750 nm PSF
-//!   images as a grey disc.
-//! * **Linear hardening** (k = 4 MPa/nm, p_Y0 = 0) carries the load at 40–120 MPa: it flattens
-//!   the fine roughness, so its patches are one scale coarser than the label at the middle
-//!   load (sub-PSF → PSF-sized, PSF-sized → coarse). No roughness within the stated ranges
-//!   avoids this (an rms slope of 0.43 at the sub-PSF scale still gave 0.6–0.9 µm). Group by
-//!   the measured scale ([`SolvedLoad::measured_scale`]) or leave out `seed % 3 == 2` where a
-//!   pure scale is wanted.
-//! * On the small map the contact is at most a few micrometres wide: the coarse scale gives one
-//!   or two patches of ≈ 1 µm at the middle load there.
-//! * Every paper ramp of the seeds above stays inside its map (no contact on the border); the
-//!   farthest contact pixel lies at most 0.35 field sides from the centre for the elastic and
-//!   hardness seeds (the widest contact ≤ 70 % of the field) and 0.40 for hardening, whose
-//!   plastic flattening spreads the contact furthest.
+//! * **Pressures.** The elastic seeds carry the smallest load at 70–143 MPa and the largest at
+//!   169–231 MPa (the paper: ≈ 100 and 250 MPa); the hardness seeds at 79–140 and 163–181 MPa
+//!   (capped by p_Y = 200–280 MPa only on the highest asperities).
+//! * **Almost Hertzian at the largest load.** Within half the contact radius of the centre the
+//!   contact covers 0.81–0.99 of the map for the elastic seeds (the steepest draws, h′_rms ≈ 0.08,
+//!   leave ≈ 20 % open: at p₀ = 230 MPa that is what the paper's pressures give) and 0.93–1.00
+//!   for the plastic ones. The widest contact spans at most 54 % of the field (no contact on the
+//!   border: [`solve_ramp`] refuses one).
+//! * **The scale holds at the smallest loads only.** At p₀ = 50 MPa against p̄ ≈ 100 MPa the
+//!   centre of the smallest load is already 25–50 % in contact (within half its contact radius,
+//!   elastic and hardness), near where 8-connected patches join: from the second or third load
+//!   the patches merge into a network of micrometre clusters for every scale (d_A 2–7 µm at the
+//!   middle load, 9–10 µm for hardening) and into one disc at the largest (d_A 16–23 µm). At the smallest load the sub-PSF seeds keep 0.44–1.00 of their area in
+//!   patches below 0.45 µm (1.00 for the steeper draws; the shallowest, ×0.7–0.8, merge at the
+//!   centre already), the PSF-sized ones have d_A 0.7–2 µm, the coarse ones two or three
+//!   asperities of 2–3 µm.
+//! * **Linear hardening** (k = 4 MPa/nm, p_Y0 = 0) flattens the fine roughness: the rms height of
+//!   the sub-PSF and PSF-sized bands is only 3–11 nm, so k·h_rms ≈ 10–45 MPa, and those seeds
+//!   carry the smallest load at 17–32 MPa in micrometre patches (d_A 4–5 µm on the paper map):
+//!   below the paper's pressures and one or two scales coarser than the label. Only the coarse
+//!   band (h_rms 50–85 nm) gives hardening the paper's pressures. A wider band would give the
+//!   height but clusters the other models' patches (λ_r = 4.8 µm instead of 0.3 µm on the
+//!   sub-PSF scale raised hardening's smallest-load pressure only from 26 to 49 MPa, and the
+//!   elastic seed's d_A there from 0.20 to 0.78 µm).
+//!   Group by the measured scale ([`SolvedLoad::measured_scale`]) or leave out `seed % 3 == 2`
+//!   where a pure scale is wanted.
+//! * **The small map** keeps the pressures and the compact largest load (central fill ≥ 0.75),
+//!   but its contact is only a few micrometres wide: the coarse scale is one or two patches at
+//!   every load and carries the smallest load on one asperity, at 29–90 MPa (elastic). Its slope
+//!   is lower than the paper map's ([`PatchScale::small_rms_slope`]): at 0.075 a roughness valley
+//!   at the centre left the largest load open in a sixth of the seeds (central fill down to
+//!   0.52).
 
 pub mod camera;
 pub mod codec;
@@ -140,6 +181,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::error::{Error, Result};
+use crate::measure::patches::patch_sizes;
 use crate::solver::cg::SolverOptions;
 use crate::solver::halfspace::Boundary;
 use crate::solver::simulate::{sweep_each, LoadStep, Model, Setup};
@@ -149,15 +191,33 @@ use crate::surface::Topography;
 /// The ChaCha8 stream the presets draw H, h′_rms and p_Y from (the surface's noise uses
 /// stream 0 of the same seed).
 const PRESET_STREAM: u64 = 0x0050_17ed;
-/// Where the penetration hardness of the hardness seeds is drawn, Pa.
+/// Where the penetration hardness of the hardness seeds is drawn, Pa: above the paper presets'
+/// mean pressures, so that it caps only the highest asperities there (it carries the cloud's
+/// contacts at 155–190 MPa).
 pub const HARDNESS_RANGE_PA: (f64, f64) = (200e6, 280e6);
 /// Hardening modulus of the hardening seeds: 4 MPa/nm (the paper's k), Pa/m.
 pub const HARDENING_PA_PER_M: f64 = 4e15;
 /// Largest Hertz contact radius of a [`RampSpec::paper`] ramp, as a share of the field side.
-pub const HERTZ_RADIUS_SHARE: f64 = 0.22;
-/// Largest Hertz contact radius of a [`RampSpec::small`] ramp, as a share of the field side:
-/// smaller, because the roughness is the paper's and the sphere's sag over the field is not.
-pub const HERTZ_RADIUS_SHARE_SMALL: f64 = 0.18;
+pub const HERTZ_RADIUS_SHARE: f64 = 0.21;
+/// Largest Hertz contact radius of a [`RampSpec::small`] ramp, as a share of the field side.
+pub const HERTZ_RADIUS_SHARE_SMALL: f64 = 0.21;
+/// Hertz centre pressure p₀ at the largest load of [`RampSpec::paper`] and [`RampSpec::small`],
+/// Pa: the paper's 400 mN on R = 290 µm.
+pub const TOP_HERTZ_PRESSURE_PA: f64 = 230e6;
+/// Contact modulus of the presets, Pa (polystyrene on glass).
+pub const E_STAR_PA: f64 = 3.7e9;
+/// Simulation pixel of the presets, m.
+pub const SIM_PIXEL_M: f64 = 50e-9;
+/// Sphere radius of [`RampSpec::cloud`], m (the paper's).
+pub const CLOUD_RADIUS_M: f64 = 290e-6;
+/// Largest Hertz contact radius of [`RampSpec::cloud`], as a share of the field side.
+pub const CLOUD_HERTZ_RADIUS_SHARE: f64 = 0.22;
+/// Short-wavelength cutoff λ_s of [`RampSpec::cloud`], m.
+pub const CLOUD_CUTOFF_M: f64 = 0.2e-6;
+/// Roll-off wavelength λ_r of [`RampSpec::cloud`], m.
+pub const CLOUD_ROLLOFF_M: f64 = 0.8e-6;
+/// Central rms slope of [`RampSpec::cloud`] (each seed draws within ±30 % of it).
+pub const CLOUD_RMS_SLOPE: f64 = 0.20;
 /// Loads per preset ramp.
 pub const PRESET_LOADS: usize = 8;
 /// Area-weighted patch diameters below this are sub-PSF ([`PatchScale::of_diameter`]), m.
@@ -169,14 +229,18 @@ pub const MAX_SIZE: usize = 4096;
 /// The most loads a ramp may have.
 pub const MAX_LOADS: usize = 1024;
 
-/// Which patch size a preset is made for, relative to a confocal PSF of 300–750 nm FWHM.
+/// Which patch size a preset is made for, relative to a confocal PSF of 300–750 nm FWHM, at the
+/// smallest loads of a ramp (at the paper's pressures the patches merge as the load grows: module
+/// docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PatchScale {
-    /// Patches mostly below the PSF (≈ 0.1–0.3 µm at the middle loads).
+    /// Patches below the PSF at the smallest loads (area-weighted ≈ 0.2–0.6 µm, most of the area
+    /// in patches under 0.45 µm).
     SubPsf,
-    /// Patches of the PSF's size (≈ 0.4–1.5 µm), as the paper's "patches 0.3–1.5 µm".
+    /// Patches of the PSF's size at the smallest loads (area-weighted ≈ 0.7–2 µm), as the
+    /// paper's "patches 0.3–1.5 µm".
     PsfSized,
-    /// Patches many times the PSF (≳ 2–5 µm).
+    /// Two or three asperity contacts of ≈ 2–3 µm at the smallest load, many PSF widths.
     Coarse,
 }
 
@@ -196,35 +260,44 @@ impl PatchScale {
     /// Short-wavelength cutoff λ_s, m: sets the smallest patches.
     pub fn cutoff_m(self) -> f64 {
         match self {
-            PatchScale::SubPsf => 0.2e-6,
-            PatchScale::PsfSized => 0.6e-6,
+            PatchScale::SubPsf => 0.15e-6,
+            PatchScale::PsfSized => 0.5e-6,
             PatchScale::Coarse => 3.2e-6,
         }
     }
 
-    /// Roll-off wavelength λ_r, m (clamped to half the field on smaller maps).
+    /// Roll-off wavelength λ_r = 2 λ_s, m (clamped to half the field on smaller maps).
     pub fn rolloff_m(self) -> f64 {
+        2.0 * self.cutoff_m()
+    }
+
+    /// Central rms slope h′_rms of [`RampSpec::paper`] (each seed draws within ±30 % of it): the
+    /// elastic mean pressure at the smallest load comes out at the paper's ≈ 100 MPa (module
+    /// docs).
+    pub fn rms_slope(self) -> f64 {
         match self {
-            PatchScale::SubPsf => 0.8e-6,
-            PatchScale::PsfSized => 2.4e-6,
-            PatchScale::Coarse => 12.8e-6,
+            PatchScale::SubPsf => 0.07,
+            PatchScale::PsfSized => 0.06,
+            PatchScale::Coarse => 0.075,
         }
     }
 
-    /// Central rms slope h′_rms (each seed draws within ±30 % of it).
-    pub fn rms_slope(self) -> f64 {
+    /// Central rms slope h′_rms of [`RampSpec::small`]: [`PatchScale::rms_slope`], but 0.0525
+    /// for the coarse scale, whose 3.2–6.4 µm wavelengths are as wide as the small map's whole
+    /// contact: at 0.075 a valley at the centre left the largest load open in a sixth of the
+    /// seeds (central fill down to 0.52; module docs).
+    pub fn small_rms_slope(self) -> f64 {
         match self {
-            PatchScale::SubPsf => 0.20,
-            PatchScale::PsfSized => 0.12,
-            PatchScale::Coarse => 0.08,
+            PatchScale::Coarse => 0.0525,
+            other => other.rms_slope(),
         }
     }
 
     /// The scale a measured area-weighted patch diameter (m) falls in: below 0.35 µm sub-PSF,
-    /// from 0.35 µm to 1.75 µm PSF-sized, above coarse (the bounds halve the gaps between the
-    /// ranges the presets are made for). The presets' labels describe the surface; the measured
-    /// patches also depend on the model and the load (module docs), so a benchmark that groups
-    /// by patch size should group by this.
+    /// from 0.35 µm to 1.75 µm PSF-sized, above coarse. The presets' labels describe the
+    /// surface and hold at the smallest loads; the measured patches also depend on the model and
+    /// the load (they merge as the load grows: module docs), so a benchmark that groups by patch
+    /// size should group by this.
     pub fn of_diameter(mean_diameter_m: f64) -> PatchScale {
         if mean_diameter_m < SUB_PSF_BELOW_M {
             PatchScale::SubPsf
@@ -254,11 +327,54 @@ impl PatchScale {
     }
 }
 
+/// Which constructor a [`RampSpec`] came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Preset {
+    /// [`RampSpec::paper`]: 1024², the paper's pressures.
+    Paper,
+    /// [`RampSpec::small`]: 256², the paper's pressures, for tests.
+    Small,
+    /// [`RampSpec::cloud`]: the stress case outside the paper's regime.
+    Cloud,
+}
+
+impl Preset {
+    /// Name used in outputs (`paper`, `small`, `cloud`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Paper => "paper",
+            Preset::Small => "small",
+            Preset::Cloud => "cloud",
+        }
+    }
+
+    fn code(self) -> u8 {
+        match self {
+            Preset::Paper => 1,
+            Preset::Small => 2,
+            Preset::Cloud => 3,
+        }
+    }
+
+    fn from_code(code: u8) -> Option<Option<Preset>> {
+        match code {
+            0 => Some(None),
+            1 => Some(Some(Preset::Paper)),
+            2 => Some(Some(Preset::Small)),
+            3 => Some(Some(Preset::Cloud)),
+            _ => None,
+        }
+    }
+}
+
 /// Everything a contact ramp is solved from. SI units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RampSpec {
-    /// The preset this spec came from (`None`: made by hand); recorded, not used by the solver.
+    /// The patch scale of the preset this spec came from (`None`: made by hand); recorded, not
+    /// used by the solver.
     pub scale: Option<PatchScale>,
+    /// The preset this spec came from (`None`: made by hand); recorded, not used by the solver.
+    pub preset: Option<Preset>,
     /// Grid side, pixels (square map, free boundary).
     pub size: usize,
     /// Simulation pixel, m.
@@ -291,30 +407,83 @@ fn log_spaced(first: f64, last: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The sphere radius, m, and the preset forces, N, of a `size`² map of [`SIM_PIXEL_M`] pixels:
+/// the largest force's Hertz contact radius is `share` of the field and its Hertz centre
+/// pressure [`TOP_HERTZ_PRESSURE_PA`] (p₀ = 2E*a/(πR), so R = 2E*a/(πp₀)); the forces span two
+/// decades.
+fn paper_sphere(size: usize, share: f64) -> (f64, Vec<f64>) {
+    let a_m = share * size as f64 * SIM_PIXEL_M;
+    let radius_m = 2.0 * E_STAR_PA * a_m / (std::f64::consts::PI * TOP_HERTZ_PRESSURE_PA);
+    let largest = hertz_load(a_m, radius_m, E_STAR_PA);
+    (radius_m, log_spaced(largest / 100.0, largest, PRESET_LOADS))
+}
+
 /// Hertz load whose contact radius is `a`, N = 4E*a³/(3R) (Johnson 1985, Eq. 4.22).
 fn hertz_load(a_m: f64, radius_m: f64, e_star_pa: f64) -> f64 {
     4.0 * e_star_pa * a_m.powi(3) / (3.0 * radius_m)
 }
 
 impl RampSpec {
-    /// A paper-sized ramp (module docs): 1024² × 50 nm, R = 290 µm, E* = 3.7 GPa, 8 loads over
-    /// two decades up to 24.3 mN, the model by `seed % 3`, H and h′_rms drawn from the seed.
+    /// A paper-sized ramp at the paper's pressures (module docs): 1024² × 50 nm, R = 110 µm,
+    /// E* = 3.7 GPa, 8 loads over two decades up to 55.7 mN (Hertz p₀ = 230 MPa), the model by
+    /// `seed % 3`, H and h′_rms drawn from the seed.
     pub fn paper(scale: PatchScale, seed: u64) -> Self {
-        Self::preset(scale, seed, 1024, 290e-6, HERTZ_RADIUS_SHARE)
+        let (radius_m, forces_n) = paper_sphere(1024, HERTZ_RADIUS_SHARE);
+        let surface = (scale.cutoff_m(), scale.rolloff_m(), scale.rms_slope());
+        Self::preset(
+            Preset::Paper,
+            scale,
+            surface,
+            seed,
+            1024,
+            radius_m,
+            forces_n,
+        )
     }
 
-    /// The same physics on a map small enough for a test: 256² × 50 nm (12.8 µm), R = 50 µm,
-    /// 8 loads over two decades up to 1.2 mN. The contact is at most a few micrometres wide, so
-    /// [`PatchScale::Coarse`] gives one or two patches of ≈ 1 µm at the middle loads (module
-    /// docs).
+    /// The same pressures on a map small enough for a test (module docs): 256² × 50 nm,
+    /// R = 27.5 µm, 8 loads over two decades up to 3.5 mN. The contact is a few micrometres wide,
+    /// so [`PatchScale::Coarse`] gives one or two patches at every load.
     pub fn small(scale: PatchScale, seed: u64) -> Self {
-        Self::preset(scale, seed, 256, 50e-6, HERTZ_RADIUS_SHARE_SMALL)
+        let (radius_m, forces_n) = paper_sphere(256, HERTZ_RADIUS_SHARE_SMALL);
+        let surface = (scale.cutoff_m(), scale.rolloff_m(), scale.small_rms_slope());
+        Self::preset(Preset::Small, scale, surface, seed, 256, radius_m, forces_n)
     }
 
-    fn preset(scale: PatchScale, seed: u64, size: usize, radius_m: f64, share: f64) -> Self {
-        let sim_pixel_m = 50e-9;
-        let e_star_pa = 3.7e9;
-        let field = size as f64 * sim_pixel_m;
+    /// The stress case **outside the paper's regime** (module docs): the sub-PSF preset of
+    /// before, 1024² × 50 nm, R = 290 µm, 8 loads over two decades up to 24.3 mN, h′_rms =
+    /// 0.20 ± 30 %, λ_s = 0.2 µm, λ_r = 0.8 µm. Its contacts are a cloud of sub-PSF patches at
+    /// every load, which no image of the series resolves: their area cannot be measured by
+    /// fluorescence. The model and the draws as [`RampSpec::paper`] of the same seed.
+    pub fn cloud(seed: u64) -> Self {
+        let size = 1024;
+        let radius_m = CLOUD_RADIUS_M;
+        let field = size as f64 * SIM_PIXEL_M;
+        let largest = hertz_load(CLOUD_HERTZ_RADIUS_SHARE * field, radius_m, E_STAR_PA);
+        let forces_n = log_spaced(largest / 100.0, largest, PRESET_LOADS);
+        let surface = (CLOUD_CUTOFF_M, CLOUD_ROLLOFF_M, CLOUD_RMS_SLOPE);
+        Self::preset(
+            Preset::Cloud,
+            PatchScale::SubPsf,
+            surface,
+            seed,
+            size,
+            radius_m,
+            forces_n,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn preset(
+        preset: Preset,
+        scale: PatchScale,
+        (cutoff_m, rolloff_m, rms_slope): (f64, f64, f64),
+        seed: u64,
+        size: usize,
+        radius_m: f64,
+        forces_n: Vec<f64>,
+    ) -> Self {
+        let field = size as f64 * SIM_PIXEL_M;
         // Drawn from a stream of their own, always the same three draws in the same order.
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(PRESET_STREAM);
@@ -332,19 +501,19 @@ impl RampSpec {
                 initial_pa: 0.0,
             },
         };
-        let largest = hertz_load(share * field, radius_m, e_star_pa);
         RampSpec {
             scale: Some(scale),
+            preset: Some(preset),
             size,
-            sim_pixel_m,
+            sim_pixel_m: SIM_PIXEL_M,
             hurst: 0.7 + 0.2 * u_hurst,
-            rms_slope: scale.rms_slope() * (0.7 + 0.6 * u_slope),
-            rolloff_m: scale.rolloff_m().min(field / 2.0),
-            cutoff_m: scale.cutoff_m(),
+            rms_slope: rms_slope * (0.7 + 0.6 * u_slope),
+            rolloff_m: rolloff_m.min(field / 2.0),
+            cutoff_m,
             radius_m,
-            e_star_pa,
+            e_star_pa: E_STAR_PA,
             model,
-            forces_n: log_spaced(largest / 100.0, largest, PRESET_LOADS),
+            forces_n,
             seed,
         }
     }
@@ -460,6 +629,61 @@ impl ContactRamp {
     /// The contact model's name (`elastic`, `hardness`, `hardening`).
     pub fn model_name(&self) -> &'static str {
         self.spec.model.name()
+    }
+
+    /// The share of load `i`'s true area in patches (8-connected) whose equivalent diameter
+    /// 2√(a/π) is below `diameter_m`; 0 without contact. Panics if `i` is not a load.
+    pub fn area_share_below(&self, i: usize, diameter_m: f64) -> f64 {
+        let sizes = patch_sizes(&self.loads[i].mask.to_bytes(), self.width);
+        let pixel_area = self.sim_pixel_m * self.sim_pixel_m;
+        let total: u64 = sizes.iter().sum();
+        let below: u64 = sizes
+            .iter()
+            .filter(|&&px| {
+                2.0 * (px as f64 * pixel_area / std::f64::consts::PI).sqrt() < diameter_m
+            })
+            .sum();
+        if total == 0 {
+            0.0
+        } else {
+            below as f64 / total as f64
+        }
+    }
+
+    /// The contact fraction of load `i` within `radius_m` of the map centre (the sphere's apex):
+    /// contact pixels over the pixels whose centres lie within it; NaN if none do. Panics if `i`
+    /// is not a load.
+    pub fn fill_within(&self, i: usize, radius_m: f64) -> f64 {
+        let mask = &self.loads[i].mask;
+        let r = radius_m / self.sim_pixel_m;
+        let (cx, cy) = (
+            (self.width as f64 - 1.0) / 2.0,
+            (self.height as f64 - 1.0) / 2.0,
+        );
+        let span = |c: f64, n: usize| {
+            let lo = (c - r).ceil().max(0.0) as usize;
+            let hi = ((c + r).floor().min(n as f64 - 1.0)).max(-1.0);
+            (lo, hi as isize)
+        };
+        let ((x0, x1), (y0, y1)) = (span(cx, self.width), span(cy, self.height));
+        let (mut inside, mut contact) = (0u64, 0u64);
+        for y in y0..(y1 + 1).max(0) as usize {
+            for x in x0..(x1 + 1).max(0) as usize {
+                if (x as f64 - cx).hypot(y as f64 - cy) <= r {
+                    inside += 1;
+                    contact += u64::from(mask.get(x, y));
+                }
+            }
+        }
+        contact as f64 / inside as f64
+    }
+
+    /// How compact load `i` is at its centre: [`ContactRamp::fill_within`] half its contact
+    /// radius ([`SolvedLoad::contact_radius_m`], the farthest contact pixel). Near 1 for an
+    /// almost Hertzian disc, the contact fraction of the cloud for scattered patches. Panics if
+    /// `i` is not a load.
+    pub fn central_fill(&self, i: usize) -> f64 {
+        self.fill_within(i, self.loads[i].contact_radius_m / 2.0)
     }
 
     /// The ramp in its binary form (module [`codec`]).
