@@ -51,6 +51,12 @@ pub struct SynthParams {
     pub sphere_radius_m: f64,
     /// RMS roughness height, m.
     pub roughness_rms_m: f64,
+    /// Scale of the roughness' two correlation lengths (1.5 µm and 0.4 µm at 1): below 1 the
+    /// contact patches are smaller, above 1 coarser (the coverage benchmark's patch scales).
+    pub patch_scale: f64,
+    /// Gaussian read noise of the detector, grey levels (standard deviation), added to the
+    /// shot noise; 0 for none.
+    pub read_noise_counts: f64,
 }
 
 impl Default for SynthParams {
@@ -74,6 +80,8 @@ impl Default for SynthParams {
             area_exponent: 0.85,
             sphere_radius_m: 290e-6,
             roughness_rms_m: 0.12e-6,
+            patch_scale: 1.0,
+            read_noise_counts: 0.0,
         }
     }
 }
@@ -130,12 +138,17 @@ impl SynthParams {
                 .checked_mul(self.height)
                 .is_some_and(|n| n <= 1 << 26)
             && self.pixel_size_m > 0.0
+            && self.patch_scale > 0.0
+            && self.patch_scale.is_finite()
+            && self.read_noise_counts >= 0.0
+            && self.read_noise_counts.is_finite()
             && !self.forces_n.is_empty()
             && self.forces_n.iter().all(|f| f.is_finite() && *f > 0.0);
         if ok {
             self.check_memory()?;
             // The widest blur: the coarse roughness (1.5 µm) or the PSF, in pixels.
-            let widest = (1.5e-6f64).max(self.psf_fwhm_m / 2.3548) / self.pixel_size_m;
+            let widest =
+                (1.5e-6 * self.patch_scale).max(self.psf_fwhm_m / 2.3548) / self.pixel_size_m;
             crate::limits::Limits::DEFAULT
                 .kernel_radius(widest)
                 .map(|_| ())
@@ -214,8 +227,8 @@ pub fn generate(p: &SynthParams) -> Result<Vec<SynthImage>> {
 
 /// Undeformed separation s = r²/2R − z in metres.
 fn separation_map(p: &SynthParams, rng: &mut ChaCha8Rng) -> Vec<f64> {
-    let coarse = normalised_noise(p, 1.5e-6, rng);
-    let fine = normalised_noise(p, 0.4e-6, rng);
+    let coarse = normalised_noise(p, 1.5e-6 * p.patch_scale, rng);
+    let fine = normalised_noise(p, 0.4e-6 * p.patch_scale, rng);
     let (cx, cy) = (
         p.width as f64 / 2.0 + rng.random_range(-2.0..2.0),
         p.height as f64 / 2.0 + rng.random_range(-2.0..2.0),
@@ -244,7 +257,8 @@ fn normalised_noise(p: &SynthParams, correlation_m: f64, rng: &mut ChaCha8Rng) -
     field
 }
 
-/// Background with a weak gradient, plus signal, with shot noise, clipped to 12 bits.
+/// Background with a weak gradient, plus signal, with shot noise (and read noise when asked
+/// for), clipped to 12 bits.
 fn render(p: &SynthParams, signal: &[f64], rng: &mut ChaCha8Rng) -> Result<Vec<u16>> {
     let expected: Vec<f64> = signal
         .iter()
@@ -254,7 +268,18 @@ fn render(p: &SynthParams, signal: &[f64], rng: &mut ChaCha8Rng) -> Result<Vec<u
             p.background * (0.95 + 0.1 * x) + s
         })
         .collect();
-    shot_noise_12bit(&expected, p.counts_per_photon, rng)
+    let mut codes = shot_noise_12bit(&expected, p.counts_per_photon, rng)?;
+    if p.read_noise_counts > 0.0 {
+        // Drawn after the shot noise, so that a series without read noise is the same as before
+        // the option existed.
+        for c in &mut codes {
+            let n: f64 = rng.sample(StandardNormal);
+            *c = (f64::from(*c) + p.read_noise_counts * n)
+                .round()
+                .clamp(0.0, 4095.0) as u16;
+        }
+    }
+    Ok(codes)
 }
 
 #[cfg(test)]
