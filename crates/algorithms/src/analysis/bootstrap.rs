@@ -62,8 +62,41 @@ pub fn fit_intervals(
     hi: &[f64],
     calibration: f64,
 ) -> Option<FitIntervals> {
+    if lo.len() != forces.len() || hi.len() != forces.len() {
+        return None;
+    }
+    resample(forces, calibration, |rng, _, i| {
+        let u: f64 = rng.random();
+        lo[i] + u * (hi[i] - lo[i])
+    })
+}
+
+/// The intervals from `forces` and joint draws of the images' true areas (`draws[r][i]`: draw
+/// r of image i, in the units of the fits, without the calibration; [`super::corrected`]):
+/// resample r takes draw r mod the draws given, so that an error the draws share between loads
+/// (the contact signal and its trend with load) moves the exponent as it moves the areas, and
+/// draws the images with replacement. `None` as [`fit_intervals`], or for rows of another length.
+pub fn joint_fit_intervals(
+    forces: &[f64],
+    draws: &[Vec<f64>],
+    calibration: f64,
+) -> Option<FitIntervals> {
+    if draws.is_empty() || draws.iter().any(|d| d.len() != forces.len()) {
+        return None;
+    }
+    resample(forces, calibration, |_, r, i| draws[r % draws.len()][i])
+}
+
+/// The bootstrap both intervals share: [`RESAMPLES`] resamples of the images with replacement,
+/// image i of resample r given the area `area(rng, r, i)` times the resample's calibration
+/// factor, each resample refitted.
+fn resample(
+    forces: &[f64],
+    calibration: f64,
+    mut area: impl FnMut(&mut ChaCha8Rng, usize, usize) -> f64,
+) -> Option<FitIntervals> {
     let n = forces.len();
-    if n < 3 || lo.len() != n || hi.len() != n {
+    if n < 3 {
         return None;
     }
     let mut distinct: Vec<f64> = forces.to_vec();
@@ -76,13 +109,12 @@ pub fn fit_intervals(
     let (mut exponents, mut prefactors, mut slopes) = (Vec::new(), Vec::new(), Vec::new());
     let mut laws = Vec::new();
     let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
-    for _ in 0..RESAMPLES {
+    for r in 0..RESAMPLES {
         let scale = calibration_factor(&mut rng, calibration);
         for k in 0..n {
             let i = rng.random_range(0..n);
-            let u: f64 = rng.random();
             x[k] = forces[i];
-            y[k] = scale * (lo[i] + u * (hi[i] - lo[i]));
+            y[k] = scale * area(&mut rng, r, i);
         }
         if let Some(f) = fit_power_law(&x, &y) {
             exponents.push(f.exponent);
@@ -199,5 +231,39 @@ mod tests {
             let f = calibration_factor(&mut rng, 0.01);
             assert!((0.99f64.powi(2)..=1.01f64.powi(2)).contains(&f));
         }
+    }
+
+    #[test]
+    fn joint_draws_trending_with_load_move_the_exponent() {
+        // Each draw tilts the law by t ∈ [−0.05, 0.05] (a signal that trends with load): the
+        // exponent's interval spans the tilts.
+        let forces = [4.0, 6.0, 10.0, 16.0, 25.0, 40.0, 63.0, 100.0];
+        let truth: Vec<f64> = forces.iter().map(|f: &f64| 10.0 * f.powf(0.8)).collect();
+        let tilted: Vec<Vec<f64>> = (0..=200)
+            .map(|k| {
+                let t = -0.05 + 0.1 * k as f64 / 200.0;
+                forces
+                    .iter()
+                    .zip(&truth)
+                    .map(|(f, a)| a * (f / 20.0).powf(t))
+                    .collect()
+            })
+            .collect();
+        let i = joint_fit_intervals(&forces, &tilted, 0.0).unwrap();
+        assert!(
+            i.exponent.0 < 0.76 && i.exponent.1 > 0.84,
+            "{:?}",
+            i.exponent
+        );
+        assert!(
+            i.exponent.0 > 0.74 && i.exponent.1 < 0.86,
+            "{:?}",
+            i.exponent
+        );
+        // One exact row: the bootstrap over the images alone gives the exponent itself.
+        let exact = joint_fit_intervals(&forces, std::slice::from_ref(&truth), 0.0).unwrap();
+        assert!((exact.exponent.0 - 0.8).abs() < 1e-12 && (exact.exponent.1 - 0.8).abs() < 1e-12);
+        assert_eq!(joint_fit_intervals(&forces, &[vec![1.0, 2.0]], 0.0), None);
+        assert_eq!(joint_fit_intervals(&forces, &[], 0.0), None);
     }
 }

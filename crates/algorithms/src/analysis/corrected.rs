@@ -1,0 +1,429 @@
+//! The contact area from the light it gives, with a 95 % interval that carries what imaging does
+//! to a contact (`docs/methods.md`, "Area intervals").
+//!
+//! Each image's light budget ([`super::light`]) holds M = s·A + noise: the true area A times the
+//! contact signal s, whatever the PSF did to the patches (shrunk, vanished, bridged: the light
+//! stays). A = M/s once s is known; this module finds what the series says about s at every
+//! load and propagates it, with the light's own noise, to each area and to the fits.
+//!
+//! **Readings of the signal.** Where a contact has a deep interior (contact farther than
+//! 3σ_PSF + 1 px from any edge), the blurred image is the signal itself, unless holes narrower
+//! than the PSF darken it (a hole below the PSF and a dimmer spot look the same). Two readings:
+//! the **top** (the 90th percentile of the PSF-smoothed interior less 1.2816 standard deviations
+//! of its smoothed white noise: what is not dark is contact) and the **mean**. The signal is
+//! taken to lie between the top and the top raised by [`Assumptions::porosity`] times their
+//! relative gap, uniformly: the more the interior's darkness varies, the less sure the top is.
+//!
+//! **From load to load.** The signal is one property of the coverslip and the detector; it rises
+//! modestly with load (Weber et al. 2018, Supplementary Fig. 1c). Between loads it is taken as
+//! s(N) = s(N_ref)·(N/N_ref)^γ, γ uniform in [[`Assumptions::gamma_min`],
+//! [`Assumptions::gamma_max`]] (one γ for the whole series). Each image uses the reading (its
+//! own, or another image's carried by γ) whose spread is smallest. Two bounds hold whatever the
+//! model: the signal is at least the image's brightest smoothed excess less five standard
+//! deviations of its noise (no pixel is brighter than full contact), and at most the detector's
+//! ceiling less the background (a lab sets the gain so that contact does not saturate, Methods).
+//! A series without any interior has no reading: its signal is only bounded, log-uniformly
+//! between the two, and the intervals say so by their width.
+//!
+//! **Propagation.** [`SeriesLight::draws`] draws everything at once, [`DRAWS`] times, seeded:
+//! one γ, each reading's place in its range and its statistical error, each image's light noise.
+//! An image's interval is the 2.5th and 97.5th percentiles of its drawn areas, its corrected
+//! area their median; the fits' bootstrap ([`super::bootstrap`]) refits the same joint draws, so
+//! that an error shared by the loads or trending with them (the signal's) moves the exponent as
+//! it does the areas.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
+
+use super::light::LightBudget;
+use super::Analysis;
+use crate::image::SampleType;
+
+/// The PSF's FWHM taken when it is not known: wider than a confocal microscope's at visible
+/// wavelengths (the paper's is 450 nm), so that the light's region and the plateau's depth are
+/// drawn generously, m.
+pub const UNKNOWN_PSF_FWHM_M: f64 = 1.0e-6;
+
+/// Joint draws of the propagation.
+pub const DRAWS: usize = 2000;
+
+/// Seed of the draws.
+const SEED: u64 = 41;
+
+/// Relative standard deviation of the signal over a contact against the signal where it was
+/// read: the illumination varies across the field (a few per cent from corner to corner, the
+/// contact sits in part of it).
+const ILLUMINATION_SD: f64 = 0.01;
+
+/// Standard deviations of smoothed noise the brightest smoothed pixel is lowered by before it
+/// bounds the signal (the largest of many correlated noise values).
+const PEAK_NOISE_SD: f64 = 5.0;
+
+/// What the series model takes for granted (module docs), each a number a user can change.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Assumptions {
+    /// Smallest exponent γ of s ∝ N^γ.
+    pub gamma_min: f64,
+    /// Largest exponent γ.
+    pub gamma_max: f64,
+    /// How far above the top reading the signal may lie, in units of the relative gap between
+    /// the top and the mean readings.
+    pub porosity: f64,
+}
+
+impl Default for Assumptions {
+    /// γ in [0, 0.10] (the signal does not fall with load, and rises by at most 26 % per decade);
+    /// porosity 2.5.
+    fn default() -> Self {
+        Assumptions {
+            gamma_min: 0.0,
+            gamma_max: 0.10,
+            porosity: 2.5,
+        }
+    }
+}
+
+/// One image as the series model sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageLight {
+    /// Normal force, N; `None` when unknown (the image can then only use its own reading).
+    pub force_n: Option<f64>,
+    /// Its light budget; `None` without contact.
+    pub budget: Option<LightBudget>,
+    /// The largest signal the detector can record over this image's background (the ceiling
+    /// of its codes less the background), grey levels; `None` for float data.
+    pub ceiling: Option<f64>,
+}
+
+/// Where an image's signal comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SignalSource {
+    /// Its own interior.
+    Own,
+    /// The interior of image `0` (index in the series), carried by γ.
+    Image(usize),
+    /// No image of the series has an interior: only the bounds.
+    Bounds,
+}
+
+/// One image's corrected area and interval, pixels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CorrectedArea {
+    /// The corrected area (the median of the drawn areas).
+    pub area_px: f64,
+    /// Lower end of the 95 % interval.
+    pub lo_px: f64,
+    /// Upper end.
+    pub hi_px: f64,
+    /// The signal of the median draw, grey levels.
+    pub signal: f64,
+    /// Where the signal comes from.
+    pub source: SignalSource,
+}
+
+/// A reading of the signal: ln of its range's lower end, the range's width in ln, and the
+/// standard error of ln.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Reading {
+    ln_low: f64,
+    ln_width: f64,
+    ln_se: f64,
+}
+
+/// The series' light and signal, ready to be drawn from.
+#[derive(Debug, Clone)]
+pub struct SeriesLight {
+    assumptions: Assumptions,
+    /// Per image: M and its standard deviation, the bounds on ln s, and the source.
+    images: Vec<Option<ImagePlan>>,
+    readings: Vec<Option<Reading>>,
+    /// The largest γ the readings allow (module docs).
+    gamma_up: f64,
+    /// The detector's gain estimated from the plateaus (variance per grey level of signal).
+    pub gain: f64,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct ImagePlan {
+    light: f64,
+    light_sd: f64,
+    /// ln of the lowest signal the image allows: its brightest tile less its noise, and its own
+    /// plateau's mean (no reading of another load can put the signal below what this image's
+    /// interior shows).
+    ln_floor: f64,
+    ln_ceiling: f64,
+    source: SignalSource,
+    /// ln(N_i/N_ref) for a reading carried from another image.
+    distance: f64,
+}
+
+/// The texture of an interior is correlated over about the PSF's area: 4πσ² pixels.
+fn correlated_pixels(sigma_px: f64) -> f64 {
+    4.0 * std::f64::consts::PI * sigma_px.max(0.5).powi(2)
+}
+
+/// The corrected areas of a series and the joint draws behind them (for the fits' bootstrap).
+#[derive(Debug, Clone)]
+pub struct SeriesCorrection {
+    /// Per image (input order); `None` without a light budget.
+    pub areas: Vec<Option<CorrectedArea>>,
+    /// [`DRAWS`] rows of one drawn area per image, pixels (NaN where `areas` is `None`).
+    pub draws: Vec<Vec<f64>>,
+    /// The model the draws came from.
+    pub model: SeriesLight,
+}
+
+/// The ceiling of integer data's codes: 255 for 8-bit data; for 16-bit data the smallest
+/// 2^b − 1 (b ≥ 8) at or above the brightest smoothed contact (a 12-bit camera's 4095 in a
+/// 16-bit file); `None` for signed or float data.
+fn code_ceiling(analysis: &Analysis) -> Option<f64> {
+    match analysis.sample_type {
+        SampleType::U8 => Some(255.0),
+        SampleType::U16 => {
+            let brightest = analysis
+                .images
+                .iter()
+                .filter_map(|r| r.light)
+                .map(|b| b.background_level + b.peak)
+                .fold(0.0f64, f64::max);
+            let bits = (brightest.max(1.0) + 1.0).log2().ceil().clamp(8.0, 16.0);
+            Some(2f64.powf(bits) - 1.0)
+        }
+        _ => None,
+    }
+}
+
+/// The corrected areas of `analysis` (module docs) with each image's force (`None`: unknown;
+/// the same length as the images), under `assumptions`. Deterministic.
+pub fn correct_series(
+    analysis: &Analysis,
+    forces_n: &[Option<f64>],
+    assumptions: Assumptions,
+) -> SeriesCorrection {
+    let ceiling = code_ceiling(analysis);
+    let lights: Vec<ImageLight> = analysis
+        .images
+        .iter()
+        .enumerate()
+        .map(|(i, r)| ImageLight {
+            force_n: forces_n.get(i).copied().flatten(),
+            budget: r.light,
+            ceiling: ceiling.zip(r.light).map(|(c, b)| c - b.background_level),
+        })
+        .collect();
+    let model = SeriesLight::new(&lights, analysis.light_sigma_px, assumptions);
+    let draws = model.draws();
+    SeriesCorrection {
+        areas: model.corrected(&draws),
+        draws,
+        model,
+    }
+}
+
+impl SeriesLight {
+    /// The largest exponent γ the series' readings allow (module docs), and the assumptions.
+    pub fn gamma_range(&self) -> (f64, f64) {
+        (
+            self.assumptions.gamma_min,
+            self.gamma_up.max(self.assumptions.gamma_min),
+        )
+    }
+
+    /// The assumptions the model was made with.
+    pub fn assumptions(&self) -> Assumptions {
+        self.assumptions
+    }
+
+    /// The model of a series (module docs); `sigma_px`: the PSF's standard deviation in pixels.
+    pub fn new(images: &[ImageLight], sigma_px: f64, assumptions: Assumptions) -> Self {
+        let gain = estimate_gain(images);
+        let readings: Vec<Option<Reading>> = images
+            .iter()
+            .map(|im| {
+                let p = im.budget?.plateau?;
+                let se = p.standard_error(correlated_pixels(sigma_px));
+                let top = p.top();
+                if !(top > 0.0 && p.level > 0.0) {
+                    return None;
+                }
+                let texture = p.texture_variance.sqrt() / p.level;
+                // From the mean (a signal that varies over the interior) to the top raised by
+                // the texture allowance (holes below the PSF).
+                Some(Reading {
+                    ln_low: p.level.ln(),
+                    ln_width: (top / p.level * (1.0 + assumptions.porosity * texture)).ln(),
+                    ln_se: se / p.level,
+                })
+            })
+            .collect();
+        let forces: Vec<f64> = images
+            .iter()
+            .map(|im| im.force_n.filter(|f| *f > 0.0).unwrap_or(f64::NAN))
+            .collect();
+        let reference = (0..images.len())
+            .filter(|&j| readings[j].is_some() && forces[j].is_finite())
+            .max_by(|&a, &b| forces[a].total_cmp(&forces[b]));
+        // A lighter load's interior holds at least its mean: the signal cannot rise faster from
+        // there to the reference than to the reference's highest reading.
+        let gamma_up = reference
+            .and_then(|r| {
+                let top = readings[r]?;
+                let highest = top.ln_low + top.ln_width + 2.0 * top.ln_se;
+                (0..images.len())
+                    .filter(|&j| j != r && forces[j] < forces[r])
+                    .filter_map(|j| {
+                        let lowest = readings[j].map(|q| q.ln_low - 2.0 * q.ln_se)?;
+                        let span = (forces[r] / forces[j]).ln();
+                        (span > 0.0).then(|| (highest - lowest) / span)
+                    })
+                    .min_by(f64::total_cmp)
+            })
+            .unwrap_or(assumptions.gamma_max)
+            .clamp(assumptions.gamma_min, assumptions.gamma_max);
+        let plans = images
+            .iter()
+            .enumerate()
+            .map(|(i, im)| {
+                let b = im.budget?;
+                if b.excess.is_nan() || b.excess <= 0.0 {
+                    return None;
+                }
+                let noise_var = b.region_pixels as f64 * b.background_variance
+                    + gain * b.excess
+                    + b.fit_variance;
+                let peak_sd = ((b.background_variance + gain * b.peak.max(0.0))
+                    / (super::light::TILE * super::light::TILE) as f64)
+                    .sqrt();
+                let own =
+                    readings[i].map_or(f64::MIN_POSITIVE, |r| (r.ln_low - 2.0 * r.ln_se).exp());
+                let floor = (b.peak - PEAK_NOISE_SD * peak_sd)
+                    .max(own)
+                    .max(f64::MIN_POSITIVE);
+                let ceiling = im.ceiling.filter(|c| *c > floor).unwrap_or(f64::INFINITY);
+                // The reading of the heaviest load that has one (the most compact contact:
+                // holes close with load), carried by γ; without forces, the image's own.
+                let (source, distance) = match (reference, im.force_n) {
+                    (Some(j), Some(f)) if j == i => (SignalSource::Own, 0.0 * f),
+                    (Some(j), Some(f)) => (SignalSource::Image(j), (f / forces[j]).ln()),
+                    _ if readings[i].is_some() => (SignalSource::Own, 0.0),
+                    _ => (SignalSource::Bounds, 0.0),
+                };
+                Some(ImagePlan {
+                    light: b.excess,
+                    light_sd: noise_var.max(0.0).sqrt(),
+                    ln_floor: floor.ln(),
+                    ln_ceiling: ceiling.ln(),
+                    source,
+                    distance,
+                })
+            })
+            .collect();
+        SeriesLight {
+            assumptions,
+            images: plans,
+            readings,
+            gamma_up,
+            gain,
+        }
+    }
+
+    /// The joint draws (module docs): `DRAWS` rows of one area per image (pixels; NaN for an
+    /// image without a budget). Deterministic.
+    pub fn draws(&self) -> Vec<Vec<f64>> {
+        let mut rng = ChaCha8Rng::seed_from_u64(SEED);
+        let a = self.assumptions;
+        (0..DRAWS)
+            .map(|_| {
+                let gamma = rng.random_range(a.gamma_min..=self.gamma_up.max(a.gamma_min));
+                let illumination: f64 = rng.sample(StandardNormal);
+                let ln_s: Vec<Option<f64>> = self
+                    .readings
+                    .iter()
+                    .map(|r| {
+                        let u: f64 = rng.random();
+                        let z: f64 = rng.sample(StandardNormal);
+                        r.map(|r| r.ln_low + u * r.ln_width + z * r.ln_se)
+                    })
+                    .collect();
+                self.images
+                    .iter()
+                    .enumerate()
+                    .map(|(i, plan)| {
+                        let u: f64 = rng.random();
+                        let z: f64 = rng.sample(StandardNormal);
+                        let Some(p) = plan else {
+                            return f64::NAN;
+                        };
+                        let ln_signal = match p.source {
+                            SignalSource::Own => ln_s[i].unwrap_or(p.ln_floor),
+                            SignalSource::Image(j) => {
+                                ln_s[j].unwrap_or(p.ln_floor) + gamma * p.distance
+                            }
+                            SignalSource::Bounds => {
+                                let top = if p.ln_ceiling.is_finite() {
+                                    p.ln_ceiling
+                                } else {
+                                    // Float data without a ceiling: up to ten times the floor.
+                                    p.ln_floor + 10f64.ln()
+                                };
+                                p.ln_floor + u * (top - p.ln_floor)
+                            }
+                        };
+                        let ln_signal = (ln_signal + ILLUMINATION_SD * illumination)
+                            .clamp(p.ln_floor, p.ln_ceiling.max(p.ln_floor));
+                        (p.light + z * p.light_sd) / ln_signal.exp()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Every image's corrected area and 95 % interval from the draws; `None` without a budget.
+    pub fn corrected(&self, draws: &[Vec<f64>]) -> Vec<Option<CorrectedArea>> {
+        self.images
+            .iter()
+            .enumerate()
+            .map(|(i, plan)| {
+                let p = plan.as_ref()?;
+                let mut v: Vec<f64> = draws.iter().map(|d| d[i]).collect();
+                v.sort_by(f64::total_cmp);
+                let at = |q: f64| v[((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1)];
+                let median = at(0.5);
+                Some(CorrectedArea {
+                    area_px: median.max(0.0),
+                    lo_px: at(0.025).max(0.0),
+                    hi_px: at(0.975).max(0.0),
+                    signal: if median > 0.0 {
+                        p.light / median
+                    } else {
+                        f64::NAN
+                    },
+                    source: p.source,
+                })
+            })
+            .collect()
+    }
+}
+
+/// The detector's gain: the white noise of the plateaus above the background's, per grey level
+/// of signal; without plateaus, the background's variance per grey level of background (a
+/// detector without offset).
+fn estimate_gain(images: &[ImageLight]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for b in images.iter().filter_map(|im| im.budget) {
+        if let Some(p) = b.plateau {
+            num += p.pixels as f64 * (p.white_variance - b.background_variance);
+            den += p.pixels as f64 * p.level;
+        }
+    }
+    if den > 0.0 {
+        return (num / den).max(0.0);
+    }
+    images
+        .iter()
+        .filter_map(|im| im.budget)
+        .map(|b| b.background_variance / b.background_level.max(1.0))
+        .next()
+        .unwrap_or(0.0)
+}
