@@ -285,6 +285,7 @@ pub fn run_open(
     let options = AnalysisOptions {
         method: request.method,
         pixel_size,
+        ..AnalysisOptions::default()
     };
     let mut analysis = analysis::analyze(
         &open.planes(request.memory_budget),
