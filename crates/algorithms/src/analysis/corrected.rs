@@ -1,5 +1,5 @@
 //! The contact area from the light it gives, with a 95 % interval that carries what imaging does
-//! to a contact (`docs/methods.md`, "Area intervals").
+//! to a contact (`docs/methods.md`, "Corrected areas from the light budget").
 //!
 //! Each image's light budget ([`super::light`]) holds M = s·A + noise: the true area A times the
 //! contact signal s, whatever the PSF did to the patches (shrunk, vanished, bridged: the light

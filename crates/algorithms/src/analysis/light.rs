@@ -1,5 +1,5 @@
 //! The light budget of one image: how much contact light it holds, whatever the PSF made of the
-//! contact's shape (`docs/methods.md`, "Area intervals").
+//! contact's shape (`docs/methods.md`, "Corrected areas from the light budget").
 //!
 //! A Gaussian PSF and the detector's pixels move light but conserve it (B24): an image of a
 //! contact χ with a uniform signal s over a background b holds Σ (v − b) = s·A pixels' worth
