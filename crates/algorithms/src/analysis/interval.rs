@@ -229,7 +229,7 @@ fn normal_tail(x: f64) -> f64 {
 }
 
 /// The median of `v` (the upper one of an even count); `None` when empty.
-fn median(mut v: Vec<f64>) -> Option<f64> {
+pub(super) fn median(mut v: Vec<f64>) -> Option<f64> {
     if v.is_empty() {
         return None;
     }

@@ -120,7 +120,7 @@ pub struct LightBudget {
 fn noise_variance(plane: &Plane, tw: usize, tiles: &[usize]) -> Option<f64> {
     let step = tiles.len().div_ceil(NOISE_TILES).max(1);
     let w = plane.width;
-    let mut variances: Vec<f64> = tiles
+    let variances: Vec<f64> = tiles
         .iter()
         .step_by(step)
         .filter_map(|&k| {
@@ -141,7 +141,7 @@ fn noise_variance(plane: &Plane, tw: usize, tiles: &[usize]) -> Option<f64> {
             var.is_finite().then_some(var.max(0.0))
         })
         .collect();
-    median(&mut variances).map(|m| m / CHI2_15_MEDIAN)
+    super::interval::median(variances).map(|m| m / CHI2_15_MEDIAN)
 }
 
 /// A smooth background b(x, y) = Σ θ_j·φ_j(x, y), the basis in coordinates scaled to [−1, 1].
@@ -571,16 +571,6 @@ fn plateau(plane: &Plane, t: &Window, excess: &[f64], reach: usize) -> Option<Pl
         texture_variance: texture,
         tile_q90: *q90,
     })
-}
-
-/// The median of `v` (the upper one of an even count); `None` when empty.
-fn median(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    let k = v.len() / 2;
-    let (_, m, _) = v.select_nth_unstable_by(k, f64::total_cmp);
-    Some(*m)
 }
 
 #[cfg(test)]

@@ -241,7 +241,19 @@ pub(crate) fn classify_codes(
         mask.fill(0);
         s_all = codes.iter().map(|&c| u64::from(c)).sum();
     }
-    let n_background = codes.len() as u64 - n_contact;
+    class_sums(codes.len() as u64, n_contact, s_contact, s_all, offset)
+}
+
+/// The (contact, background) sums of `total` codes, `n_contact` of them in contact summing to
+/// `s_contact` of `s_all`, each code `offset` below its value.
+pub(crate) fn class_sums(
+    total: u64,
+    n_contact: u64,
+    s_contact: u64,
+    s_all: u64,
+    offset: i32,
+) -> (ClassSums, ClassSums) {
+    let n_background = total - n_contact;
     let with_offset = |sum: u64, n: u64| sum as f64 + f64::from(offset) * n as f64;
     (
         ClassSums {

@@ -200,19 +200,9 @@ pub(super) fn classify_codes_tiled(
         tiles.add_tile_row(ty, y1 - y0, &col_sum, &col_contact, f64::from(offset));
         tiles.add_to_blocks(ty);
     }
-    let n_background = codes.len() as u64 - n_contact;
-    let with_offset = |sum: u64, n: u64| sum as f64 + f64::from(offset) * n as f64;
-    (
-        ClassSums {
-            count: n_contact,
-            sum: with_offset(s_contact, n_contact),
-        },
-        ClassSums {
-            count: n_background,
-            sum: with_offset(s_all - s_contact, n_background),
-        },
-        tiles,
-    )
+    let (contact, background) =
+        super::class_sums(codes.len() as u64, n_contact, s_contact, s_all, offset);
+    (contact, background, tiles)
 }
 
 #[cfg(test)]
