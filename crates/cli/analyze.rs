@@ -48,6 +48,13 @@ pub struct Args {
     /// widens the area and fit intervals (also written --pixel-size 200nm±1%).
     #[arg(long)]
     pixel_size_uncertainty: Option<String>,
+    /// psf.json written by `contactscope psf` (uses fwhm_nm_mean): the PSF the area intervals
+    /// take (without it or --psf-fwhm, a 1 µm FWHM, wider than a confocal microscope's).
+    #[arg(long, conflicts_with = "psf_fwhm")]
+    psf: Option<PathBuf>,
+    /// PSF full width at half maximum for the area intervals (e.g. 450nm), instead of --psf.
+    #[arg(long)]
+    psf_fwhm: Option<String>,
     /// Sphere radius for Hertz columns, e.g. 290um (needs --modulus).
     #[arg(long, requires = "modulus")]
     radius: Option<String>,
@@ -94,8 +101,16 @@ pub fn run(args: Args) -> Result<Finished> {
     let (pixel_size_m, pixel_size_uncertainty) = args
         .pixel_size
         .metres_and_uncertainty(&args.pixel_size_uncertainty)?;
+    let psf_fwhm_m = match (&args.psf, &args.psf_fwhm) {
+        (Some(json), _) => Some(contactscope_jobs::results::fwhm_from_psf_json(json)?),
+        (None, Some(text)) => {
+            Some(units::parse_positive(text, Dimension::Length).context("--psf-fwhm")?)
+        }
+        (None, None) => None,
+    };
     let request = AnalyzeRequest {
         method: Method::parse(&args.threshold)?,
+        psf_fwhm_m,
         pixel_size_m,
         pixel_size_uncertainty,
         hertz,
@@ -160,9 +175,10 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
         AreaUnit::Pixel => "px",
     };
     println!(
-        "{:>10} {:>12} {:>19} {:>8} {:>10}  image",
+        "{:>10} {:>12} {:>12} {:>19} {:>8} {:>10}  image",
         "force_mN",
         format!("area_{unit}"),
+        "corrected",
         "95 % interval",
         "patches",
         "p_MPa"
@@ -176,8 +192,14 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
             .file_name()
             .map_or(row.image.clone(), |n| n.to_string_lossy().into_owned());
         let interval = format!("{:.2}…{:.2}", row.area_lo, row.area_hi);
+        // No corrected area where the interval is the edge band's.
+        let corrected = if row.area_corrected.is_finite() {
+            format!("{:.2}", row.area_corrected)
+        } else {
+            "-".into()
+        };
         println!(
-            "{f:>10} {:>12.2} {interval:>19} {:>8} {p:>10}  {name} p{}",
+            "{f:>10} {:>12.2} {corrected:>12} {interval:>19} {:>8} {p:>10}  {name} p{}",
             row.area, row.patches, row.page
         );
     }
@@ -188,10 +210,17 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
             .map_or("— (fewer than 3 distinct forces)".into(), |r| {
                 format!("{r:.4}")
             });
+        let of = match outcome.fits.power_law_corrected {
+            Some(_) => "true β",
+            None => "β (edge band)",
+        };
         let ci = outcome.fits.intervals.as_ref().map_or(String::new(), |i| {
-            format!(" (95 % interval {:.3}…{:.3})", i.exponent.0, i.exponent.1)
+            format!("; {of} in {:.3}…{:.3} (95 %)", i.exponent.0, i.exponent.1)
         });
-        println!("power law: A ∝ N^β, β = {beta}{ci}, R² = {r2}");
+        let corrected = outcome.fits.power_law_corrected.map_or(String::new(), |c| {
+            format!("; corrected β = {:.3}", c.exponent)
+        });
+        println!("power law: A ∝ N^β, β = {beta} (contact pixels), R² = {r2}{corrected}{ci}");
     }
     if let Some((p, _)) = outcome.fits.proportional_mpa {
         let ci = outcome

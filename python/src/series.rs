@@ -264,7 +264,7 @@ impl<'a, 'py> FromPyObject<'a, 'py> for MethodArg {
 /// `--overlays` and `--save-masks`), and `written`: the files' paths. `progress(pass, done,
 /// total)` is called as the images are read ("histogram") and measured ("measure").
 #[pyfunction]
-#[pyo3(signature = (images, forces=None, pixel_size=None, method=None, radius=None, modulus=None, masks=false, out=None, command_line=None, overlays=false, save_masks=false, progress=None, pixel_size_uncertainty=0.0))]
+#[pyo3(signature = (images, forces=None, pixel_size=None, method=None, radius=None, modulus=None, masks=false, out=None, command_line=None, overlays=false, save_masks=false, progress=None, pixel_size_uncertainty=0.0, psf_fwhm=None))]
 #[allow(clippy::too_many_arguments)]
 fn analyze<'py>(
     py: Python<'py>,
@@ -281,9 +281,11 @@ fn analyze<'py>(
     save_masks: bool,
     progress: Option<Py<PyAny>>,
     pixel_size_uncertainty: f64,
+    psf_fwhm: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut request = AnalyzeRequest::new(micrographs(images, forces)?);
     request.pixel_size_uncertainty = pixel_size_uncertainty;
+    request.psf_fwhm_m = psf_fwhm;
     request.method = match method {
         None => Method::GlobalOtsu,
         Some(MethodArg::Manual(t)) => Method::Manual(t),

@@ -19,18 +19,24 @@ def test_python_rows_carry_the_intervals_of_areas_csv(tmp_path, cli):
     r = cs.analyze(cs.read_series(tmp_path / "s"))
     assert len(r.rows) == len(rows)
     for mine, theirs in zip(r.rows, rows):
-        assert mine["area_m2_lo"] <= mine["area_m2"] <= mine["area_m2_hi"]
+        assert mine["area_m2_lo"] <= mine["area_corrected_m2"] <= mine["area_m2_hi"]
         for key in ("area_um2_lo", "area_um2_hi"):
             si = key.replace("um2", "m2")
             assert mine[si] * 1e12 == pytest.approx(float(theirs[key]), rel=1e-12), key
     law = r["fits"]["power_law"]
     lo, hi = law["exponent_ci95"]
-    assert lo < law["exponent"] < hi
+    assert lo < law["exponent_corrected"] < hi
     # The prefactor's interval, in the prefactor's own units, holds the prefactor.
     name = next(k for k in law if k.startswith("prefactor") and not k.endswith("_ci95"))
     c_lo, c_hi = law[name + "_ci95"]
     assert 0 < c_lo < law[name] < c_hi
-    assert np.isfinite(r["area_interval"]["band_half_width"])
+    assert r["area_interval"]["psf_source"].startswith("not given")
+    # A PSF given moves the intervals, not the contact pixels.
+    given = cs.analyze(cs.read_series(tmp_path / "s"), psf_fwhm=450e-9)
+    assert given["area_interval"]["psf_source"] == "given"
+    assert [g["area_m2"] for g in given.rows] == [m["area_m2"] for m in r.rows]
+    assert np.all([g["area_m2_lo"] <= g["area_corrected_m2"] <= g["area_m2_hi"]
+                   for g in given.rows])
 
 
 def test_a_pixel_size_uncertainty_widens_the_areas_and_the_prefactor_not_beta(tmp_path, cli):

@@ -269,11 +269,14 @@ def test_series_widget_exports_the_cli_folder(viewer, series_tif, tmp_path, cli)
     assert w.table.rowCount() == 3
     assert float(w.table.item(2, 2).text()) == pytest.approx(result.rows[2]["area_m2"] * 1e12,
                                                               abs=0.005)
-    # Each area's 95 % interval beside it, as the analysis gave it.
-    lo, hi = (float(v) for v in w.table.item(2, 3).text().split("…"))
+    # The corrected area and its 95 % interval on the true area beside it, as the analysis
+    # gave them.
+    corrected = float(w.table.item(2, 3).text())
+    assert corrected == pytest.approx(result.rows[2]["area_corrected_m2"] * 1e12, abs=0.005)
+    lo, hi = (float(v) for v in w.table.item(2, 4).text().split("…"))
     assert lo == pytest.approx(result.rows[2]["area_m2_lo"] * 1e12, abs=0.005)
     assert hi == pytest.approx(result.rows[2]["area_m2_hi"] * 1e12, abs=0.005)
-    assert lo <= float(w.table.item(2, 2).text()) <= hi
+    assert lo <= corrected <= hi
     mine, theirs = tmp_path / "widget", tmp_path / "cli"
     written = w.export_now(str(mine))["written"]
     assert {pathlib.Path(p).name for p in written} >= {"areas.csv", "summary.json",

@@ -106,6 +106,7 @@ fn analyze_a_directory_with_forces() {
             "threshold",
             "contact_pixels",
             "area_um2",
+            "area_corrected_um2",
             "area_um2_lo",
             "area_um2_hi",
             "mean_intensity",

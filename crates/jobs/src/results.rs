@@ -31,7 +31,10 @@ pub fn read_areas_csv(path: &Path) -> Result<Vec<(f64, f64)>> {
 /// (`area_um2_lo`, `area_um2_hi`) where the table has them, and the pixel size's uncertainty
 /// (`pixel_size_uncertainty_pct`, the same on every row; 0 without the column), which the
 /// intervals carry and which is taken out of them here so that the fit's bootstrap can share
-/// it among the loads ([`contactscope::model_fit::interval`]).
+/// it among the loads ([`contactscope::model_fit::interval`]). The interval is on the true
+/// area and holds `area_corrected_um2`; the contact-pixel area `area_um2` (what a model counted
+/// as imaged is compared with) may lie outside it where the PSF biases the count, and the
+/// interval taken is widened to hold it ([`interval_holding`]).
 pub fn read_measured(path: &Path) -> Result<Measured> {
     let table = Table::read(path)?;
     let rows = read_area_rows(&table, path)?;
@@ -62,21 +65,29 @@ pub fn read_measured(path: &Path) -> Result<Measured> {
     let mut points = Vec::with_capacity(rows.len());
     for (k, force, area) in rows {
         let (l, h) = (lo[k] / shrink, hi[k] / grow);
-        // The interval must hold the area (up to the rounding of the written digits).
-        if !(l >= 0.0 && l <= area * (1.0 + 1e-9) && h >= area * (1.0 - 1e-9)) {
+        // An interval is ordered and not negative (NaN: none, an image without contact light).
+        if l < 0.0 || l > h * (1.0 + 1e-9) || (l.is_nan() != h.is_nan()) {
             return Err(Error::bad_input(
                 Location::file(format!("{}:{}", path.display(), table.line(k))),
                 format!(
-                    "area_um2_lo..area_um2_hi = {:e}..{:e} µm² does not hold area_um2 = {:e} µm²",
+                    "area_um2_lo..area_um2_hi = {:e}..{:e} µm² is not an interval",
                     lo[k] * 1e12,
                     hi[k] * 1e12,
-                    area * 1e12
                 ),
             ));
         }
-        points.push((force, area, l.min(area), h.max(area)));
+        let (l, h) = interval_holding(area, l, h);
+        points.push((force, area, l, h));
     }
     Measured::with_intervals(points, u).map_err(bad)
+}
+
+/// The interval [`lo`, `hi`] widened to hold `area` (the point itself where there is none).
+pub fn interval_holding(area: f64, lo: f64, hi: f64) -> (f64, f64) {
+    if lo.is_nan() || hi.is_nan() {
+        return (area, area);
+    }
+    (lo.min(area), hi.max(area))
 }
 
 /// (data row, force N, area m²) of the rows with a positive force ([`read_areas_csv`]).

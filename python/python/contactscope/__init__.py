@@ -259,7 +259,8 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
             out: Optional[PathLike] = None, overlays: bool = False, save_masks: bool = False,
             command_line: Optional[Sequence[str]] = None,
             progress: Optional[Any] = None,
-            pixel_size_uncertainty: float = 0.0) -> Results:
+            pixel_size_uncertainty: float = 0.0,
+            psf_fwhm: Optional[float] = None) -> Results:
     """The paper's series analysis, the command line's ``analyze``: one global Otsu threshold
     over all images, then each image measured. ``series``: a :class:`Series` (its files are read
     as the command line reads them, with its forces and pixel size unless given here) or
@@ -269,6 +270,9 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
     contact masks (images, rows, columns) as ``masks``. ``pixel_size_uncertainty``: the pixel
     size's relative uncertainty as bounds (0.01 for ±1 %, the command line's
     ``--pixel-size-uncertainty``); it widens ``area_m2_lo``/``_hi`` and the fit intervals.
+    ``psf_fwhm``: the PSF's FWHM in m (``--psf-fwhm``), for the corrected areas
+    (``area_corrected_m2``) and their 95 % intervals on the true area (``area_m2_lo``/``_hi``);
+    without it a 1 µm FWHM is taken (``area_interval["psf_source"]`` says so).
 
     Returns the outcome the command line writes as ``summary.json`` and ``areas.csv``, in SI
     units: ``rows`` (per image: ``image``, ``page``, ``force_n``, ``threshold``,
@@ -294,7 +298,10 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
                                  _command_line(command_line, "analyze", out), bool(overlays),
                                  bool(save_masks), progress,
                                  _number(pixel_size_uncertainty, "pixel_size_uncertainty",
-                                         "fraction (0.01 for ±1 %)")), table="rows")
+                                         "fraction (0.01 for ±1 %)"),
+                                 None if psf_fwhm is None
+                                 else _number(psf_fwhm, "psf_fwhm", "m (4.5e-7 for 450 nm)")),
+                      table="rows")
     _warn(result)
     return result
 

@@ -198,7 +198,7 @@ pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
         .collect();
     if !bars.is_empty() {
         curves.push(Curve {
-            label: "95 % interval of the true area (edge band)".into(),
+            label: "95 % interval of the true area (light budget)".into(),
             xy: bars,
         });
     }

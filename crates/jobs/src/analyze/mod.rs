@@ -11,6 +11,7 @@ pub mod report;
 use serde::Serialize;
 
 use contactscope::analysis::{self, Analysis, AnalysisOptions, ImageSink, Progress};
+use contactscope::optics::blur::FWHM_PER_SIGMA;
 use contactscope::threshold::Method;
 use contactscope_formats::param::Param;
 use contactscope_formats::ranges::{short, Quantity};
@@ -21,6 +22,7 @@ use crate::error::Result;
 use crate::fits::{self, Source};
 use crate::lab;
 use crate::series::{self, Micrographs, OpenSeries, Series, DEFAULT_MEMORY_BUDGET};
+use report::IntervalModel;
 
 /// Everything `analyze` needs. SI units.
 #[derive(Debug, Clone)]
@@ -36,6 +38,9 @@ pub struct AnalyzeRequest {
     /// Relative uncertainty of the pixel size (given or from the files), as bounds: 0.01 for
     /// ±1 %. 0 takes it as exact. Widens the area intervals and the fit intervals.
     pub pixel_size_uncertainty: f64,
+    /// The PSF's full width at half maximum, m, for the area intervals (`None`: not known, and
+    /// [`contactscope::analysis::corrected::UNKNOWN_PSF_FWHM_M`] is taken).
+    pub psf_fwhm_m: Option<f64>,
     /// Hertz reference columns.
     pub hertz: Option<HertzParams>,
     /// Bytes of decoded planes of compressed files kept between the two passes.
@@ -50,6 +55,7 @@ impl AnalyzeRequest {
             method: Method::GlobalOtsu,
             pixel_size_m: None,
             pixel_size_uncertainty: 0.0,
+            psf_fwhm_m: None,
             hertz: None,
             memory_budget: DEFAULT_MEMORY_BUDGET,
         }
@@ -63,6 +69,9 @@ impl AnalyzeRequest {
             Quantity::PixelSize.check(y, Param::PixelSize)?;
         }
         check_pixel_size_uncertainty(self.pixel_size_uncertainty)?;
+        if let Some(f) = self.psf_fwhm_m {
+            Quantity::Fwhm.check(f, Param::PsfFwhm)?;
+        }
         if let Some(h) = self.hertz {
             Quantity::Radius.check(h.radius_m, Param::Radius)?;
             Quantity::Modulus.check(h.modulus_pa, Param::Modulus)?;
@@ -117,14 +126,33 @@ pub struct AnalyzeOutcome {
 /// The definition of the per-image area intervals (`docs/methods.md`, "Area intervals").
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AreaIntervalFacts {
+    /// `light_budget` or `edge_band` (the fallback where an image the fits use has no light
+    /// budget).
+    pub model: &'static str,
     /// The method, in words.
     pub method: &'static str,
+    /// Why the edge band was used; `None` for the light budget.
+    pub why_edge_band: Option<String>,
     /// The nominal coverage, percent.
     pub level_pct: f64,
-    /// Half-width w of the band of levels, as a fraction of the contact signal.
-    pub band_half_width: f64,
-    /// Standard deviations of the noise term.
-    pub noise_sd_multiple: f64,
+    /// The PSF FWHM the light budgets took, µm.
+    #[serde(serialize_with = "lab::m_as_um", rename = "psf_fwhm_um")]
+    pub psf_fwhm_m: f64,
+    /// Where it came from.
+    pub psf_source: &'static str,
+    /// The range of γ in s ∝ N^γ (the contact signal's trend with load) the draws took: the
+    /// assumption's, capped by what the series' interiors allow; `None` for the edge band.
+    pub signal_trend_exponent: Option<(f64, f64)>,
+    /// How far above the top reading of an interior the signal may lie, in units of the gap
+    /// between its top and mean readings; `None` for the edge band.
+    pub porosity: Option<f64>,
+    /// Joint draws behind each interval; `None` for the edge band.
+    pub draws: Option<usize>,
+    /// Half-width w of the edge band's levels, as a fraction of the contact signal; `None` for
+    /// the light budget.
+    pub band_half_width: Option<f64>,
+    /// Standard deviations of the edge band's noise term; `None` for the light budget.
+    pub noise_sd_multiple: Option<f64>,
     /// The pixel size's relative uncertainty (bounds) the interval carries, 0 when the pixel
     /// size is taken as exact (or areas are in pixels).
     #[serde(
@@ -139,9 +167,42 @@ pub struct AreaIntervalFacts {
 }
 
 impl AreaIntervalFacts {
-    /// The facts of intervals carrying the pixel size's relative uncertainty `u` (0: none).
-    pub fn with_calibration(u: f64) -> Self {
+    /// The facts of intervals from `model`, with the PSF FWHM taken (m) and where it came
+    /// from, carrying the pixel size's relative uncertainty `u` (0: none).
+    pub fn new(model: &IntervalModel, psf: (f64, &'static str), u: f64) -> Self {
+        use contactscope::analysis::interval::{EDGE_BAND_HALF_WIDTH, NOISE_WIDENING};
+        let light = match model {
+            IntervalModel::Light(l) => Some(l),
+            IntervalModel::Band { .. } => None,
+        };
         AreaIntervalFacts {
+            model: if light.is_some() {
+                "light_budget"
+            } else {
+                "edge_band"
+            },
+            method: if light.is_some() {
+                "the light budget: each image's excess light over its fitted background, \
+                 summed where the contact's light reaches, divided by the contact signal; \
+                 the signal read in the contact interiors and carried to the other loads by \
+                 s ∝ N^γ; signal, γ and the light's noise drawn jointly"
+            } else {
+                "edge band: pixels above b + (1/2 + w)·s (lo) and pixels above b + (1/2 − w)·s \
+                 connected to the contact (hi), b and s the image's background and contact \
+                 signal, widened by the pixel noise's spread; blind to the PSF"
+            },
+            why_edge_band: match model {
+                IntervalModel::Band { why } => Some(why.clone()),
+                IntervalModel::Light(_) => None,
+            },
+            level_pct: 95.0,
+            psf_fwhm_m: psf.0,
+            psf_source: psf.1,
+            signal_trend_exponent: light.map(|l| l.gamma_range()),
+            porosity: light.map(|l| l.assumptions().porosity),
+            draws: light.map(|_| contactscope::analysis::corrected::DRAWS),
+            band_half_width: light.is_none().then_some(EDGE_BAND_HALF_WIDTH),
+            noise_sd_multiple: light.is_none().then_some(NOISE_WIDENING),
             pixel_size_uncertainty: u,
             calibration: if u > 0.0 {
                 "the pixel size within ±u of its value: lo × (1 − u)², hi × (1 + u)²; in the fit \
@@ -150,37 +211,34 @@ impl AreaIntervalFacts {
                 "none: the pixel size is taken as exact (give its uncertainty as \
                  --pixel-size 200nm±1% or --pixel-size-uncertainty 1%)"
             },
-            not_included: if u > 0.0 {
-                "the forces' calibration"
-            } else {
-                "the pixel size's calibration; the forces' calibration"
+            not_included: match (light.is_some(), u > 0.0) {
+                (true, true) => {
+                    "the forces' calibration; a contact signal that varies over a contact by \
+                     more than the illumination's 1 %"
+                }
+                (true, false) => {
+                    "the pixel size's calibration; the forces' calibration; a contact signal \
+                     that varies over a contact by more than the illumination's 1 %"
+                }
+                (false, true) => {
+                    "the forces' calibration; what the PSF does to patches near its size \
+                     (shrunk, vanished or bridged)"
+                }
+                (false, false) => {
+                    "the pixel size's calibration; the forces' calibration; what the PSF does \
+                     to patches near its size (shrunk, vanished or bridged)"
+                }
             },
-            ..AreaIntervalFacts::default()
-        }
-    }
-}
-
-impl Default for AreaIntervalFacts {
-    fn default() -> Self {
-        use contactscope::analysis::interval::{EDGE_BAND_HALF_WIDTH, NOISE_WIDENING};
-        AreaIntervalFacts {
-            method: "edge band: pixels above b + (1/2 + w)·s (lo) and pixels above \
-                     b + (1/2 − w)·s connected to the contact (hi), b and s the image's background \
-                     and contact signal, widened by the pixel noise's spread",
-            level_pct: 95.0,
-            band_half_width: EDGE_BAND_HALF_WIDTH,
-            noise_sd_multiple: NOISE_WIDENING,
-            pixel_size_uncertainty: 0.0,
-            calibration: "none: the pixel size is taken as exact",
-            not_included: "the pixel size's calibration; the forces' calibration",
         }
     }
 }
 
 impl AnalyzeOutcome {
     /// The measured curve as `fit-hardening` reads it from this analysis's `areas.csv`: the
-    /// images the fits use (a positive force, contact, none at the border), each area with its
-    /// interval less the pixel size's calibration, and that calibration; `None` for areas in
+    /// images the fits use (a positive force, contact, none at the border), each contact-pixel
+    /// area with its interval less the pixel size's calibration, widened to hold the pixel count
+    /// (the interval is on the true area, and a model counted as imaged is compared with the
+    /// count: [`crate::results::read_measured`]), and that calibration; `None` for areas in
     /// pixels or with fewer than two such images.
     pub fn measured_curve(&self) -> Option<contactscope::model_fit::Measured> {
         if self.area_unit != AreaUnit::SquareMicrometre {
@@ -194,11 +252,13 @@ impl AnalyzeOutcome {
             .iter()
             .filter(|r| r.load_point().in_fit() && r.force_mn.is_some_and(|f| f > 0.0))
             .map(|r| {
+                let (lo, hi) =
+                    crate::results::interval_holding(r.area, r.area_lo / shrink, r.area_hi / grow);
                 (
                     r.force_mn.unwrap_or(f64::NAN) * 1e-3,
                     r.area * 1e-12,
-                    r.area_lo / shrink * 1e-12,
-                    r.area_hi / grow * 1e-12,
+                    lo * 1e-12,
+                    hi * 1e-12,
                 )
             })
             .collect();
@@ -282,10 +342,29 @@ pub fn run_open(
     series::refuse_maps(series)?;
     let mut warnings = Vec::new();
     let pixel_size = series::pixel_size(series, request.pixel_size_m, &mut warnings)?;
+    let psf = match (request.psf_fwhm_m, pixel_size) {
+        (Some(f), Some(_)) => (f, "given"),
+        (Some(f), None) => {
+            warnings.push(format!(
+                "{} is not used without a pixel size: the area intervals take a PSF of {} pixels",
+                Param::PsfFwhm,
+                short(analysis::UNKNOWN_PSF_SIGMA_PX * FWHM_PER_SIGMA)
+            ));
+            (f, "given, not used: no pixel size")
+        }
+        (None, _) => (
+            analysis::corrected::UNKNOWN_PSF_FWHM_M,
+            "not given: a width above a confocal microscope's taken",
+        ),
+    };
     let options = AnalysisOptions {
         method: request.method,
         pixel_size,
-        ..AnalysisOptions::default()
+        psf_sigma_px: request
+            .psf_fwhm_m
+            .zip(pixel_size)
+            .map(|(f, p)| f / FWHM_PER_SIGMA / p.x_m.min(p.y_m)),
+        light_budgets: true,
     };
     let mut analysis = analysis::analyze(
         &open.planes(request.memory_budget),
@@ -294,7 +373,7 @@ pub fn run_open(
         sink,
     )?;
     warnings.append(&mut analysis.warnings);
-    let (rows, fits) = report::table_and_fits(
+    let (rows, fits, model) = report::table_and_fits(
         series,
         &analysis,
         request.hertz,
@@ -334,6 +413,28 @@ pub fn run_open(
     let points: Vec<_> = rows.rows.iter().map(Row::load_point).collect();
     warnings.extend(fits::exclusion_warnings(&points, Source::Micrographs));
     warnings.extend(fits::power_law_warnings(fits.power_law.as_ref(), &points));
+    if let IntervalModel::Band { why } = &model {
+        warnings.push(format!(
+            "the area intervals are the edge band's, which does not model the PSF (patches near \
+             its size may lie outside them): {why}"
+        ));
+    }
+    if let (Some(p), Some(i), IntervalModel::Light(_)) =
+        (fits.power_law, fits.intervals.as_ref(), &model)
+    {
+        let (lo, hi) = i.exponent;
+        if p.exponent < lo || p.exponent > hi {
+            warnings.push(format!(
+                "the contact pixels' exponent β = {:.3} lies outside the 95 % interval on the \
+                 true exponent, {lo:.3}…{hi:.3}: the PSF biases the pixel count (patches near \
+                 its size shrink at light loads and merge at heavy ones); the corrected areas \
+                 give β = {}",
+                p.exponent,
+                fits.power_law_corrected
+                    .map_or("—".to_string(), |c| format!("{:.3}", c.exponent))
+            ));
+        }
+    }
     warnings.extend(duplicate_warnings(series, &rows.rows));
     if rows.rows.iter().all(|r| r.contact_pixels == 0) {
         warnings.push(format!(
@@ -347,7 +448,7 @@ pub fn run_open(
         threshold: ThresholdFacts::of(&analysis, open.sample_type().is_integer()),
         area_unit: rows.unit,
         fits,
-        area_interval: AreaIntervalFacts::with_calibration(rows.pixel_size_uncertainty),
+        area_interval: AreaIntervalFacts::new(&model, psf, rows.pixel_size_uncertainty),
         hertz: request.hertz,
         warnings,
         rows,

@@ -8,7 +8,10 @@
 use serde::ser::{SerializeMap, SerializeSeq};
 use serde::{Serialize, Serializer};
 
-use contactscope::analysis::bootstrap::{calibration_bounds, fit_intervals, FitIntervals};
+use contactscope::analysis::bootstrap::{
+    calibration_bounds, fit_intervals, joint_fit_intervals, FitIntervals,
+};
+use contactscope::analysis::corrected::{correct_series, Assumptions, SeriesLight};
 use contactscope::analysis::fit::{fit_power_law, fit_proportional, PowerLawFit};
 use contactscope::analysis::Analysis;
 use contactscope::mechanics::hertz;
@@ -44,8 +47,13 @@ pub struct Row {
     pub threshold: f64,
     /// Contact pixels.
     pub contact_pixels: u64,
-    /// Contact area in µm² (or pixels without a pixel size).
+    /// Contact area in µm² (or pixels without a pixel size): the contact pixels (the paper's
+    /// measure, biased where patches are near the PSF's size).
     pub area: f64,
+    /// The true contact area estimated from the image's light (`docs/methods.md`, "Area
+    /// intervals"), µm² (or pixels); NaN without contact light or in an older batch record.
+    #[serde(default = "not_recorded", deserialize_with = "nan_if_null")]
+    pub area_corrected: f64,
     /// Lower end of the 95 % interval on the true contact area (`docs/methods.md`, "Area
     /// intervals"), µm² (or pixels); NaN in a batch record written before intervals existed.
     #[serde(default = "not_recorded", deserialize_with = "nan_if_null")]
@@ -207,6 +215,10 @@ impl Serialize for RowOf<'_> {
         m.serialize_entry("threshold", &r.threshold)?;
         m.serialize_entry("contact_pixels", &r.contact_pixels)?;
         m.serialize_entry(&format!("area_{a}"), &Q(r.area, t.unit.area()))?;
+        m.serialize_entry(
+            &format!("area_corrected_{a}"),
+            &Q(r.area_corrected, t.unit.area()),
+        )?;
         m.serialize_entry(&format!("area_{a}_lo"), &Q(r.area_lo, t.unit.area()))?;
         m.serialize_entry(&format!("area_{a}_hi"), &Q(r.area_hi, t.unit.area()))?;
         if t.pixel_size_uncertainty > 0.0 {
@@ -271,9 +283,11 @@ pub struct Fits {
     pub proportional_mpa: Option<(f64, usize)>,
     /// Smallest and largest mean pressure, MPa.
     pub pressure_range_mpa: Option<(f64, f64)>,
-    /// 95 % intervals on the fits' parameters by a bootstrap over the images and their area
-    /// intervals ([`contactscope::analysis::bootstrap`]).
+    /// 95 % intervals on the true law's parameters by a bootstrap over the images and the joint
+    /// draws of their true areas ([`contactscope::analysis::bootstrap`]).
     pub intervals: Option<FitIntervals>,
+    /// The power law fitted to the corrected areas (the estimate the intervals are about).
+    pub power_law_corrected: Option<PowerLawFit>,
 }
 
 impl Serialize for Fits {
@@ -282,9 +296,15 @@ impl Serialize for Fits {
         let mut m = s.serialize_map(Some(3))?;
         m.serialize_entry(
             "power_law",
-            &self
-                .power_law
-                .map(|f| PowerLawOf(self.unit, f, si, self.intervals.as_ref())),
+            &self.power_law.map(|f| {
+                PowerLawOf(
+                    self.unit,
+                    f,
+                    si,
+                    self.intervals.as_ref(),
+                    self.power_law_corrected,
+                )
+            }),
         )?;
         let pressure_ci = self
             .intervals
@@ -306,13 +326,19 @@ impl Serialize for Fits {
     }
 }
 
-struct PowerLawOf<'a>(AreaUnit, PowerLawFit, bool, Option<&'a FitIntervals>);
+struct PowerLawOf<'a>(
+    AreaUnit,
+    PowerLawFit,
+    bool,
+    Option<&'a FitIntervals>,
+    Option<PowerLawFit>,
+);
 
 impl Serialize for PowerLawOf<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let (unit, f, si) = (self.0, &self.1, self.2);
         let a = unit.area_suffix();
-        let mut m = s.serialize_map(Some(6))?;
+        let mut m = s.serialize_map(None)?;
         // In SI units (Python): A in m² (or pixels) and N in newtons.
         let (model, prefactor) = match (si, unit) {
             (false, _) => (
@@ -339,6 +365,11 @@ impl Serialize for PowerLawOf<'_> {
             (true, AreaUnit::Pixel) => c * 1e3f64.powf(b),
         };
         let intervals = self.3;
+        m.serialize_entry("exponent_corrected", &self.4.map(|c| c.exponent))?;
+        m.serialize_entry(
+            &format!("prefactor_corrected_{a}_per_mN_pow_exponent"),
+            &self.4.map(|c| to_output(c.prefactor, c.exponent)),
+        )?;
         m.serialize_entry(
             "exponent_ci95",
             &intervals.map(|i| Interval(i.exponent.0, i.exponent.1, Unit::None)),
@@ -392,7 +423,7 @@ pub fn table_and_fits(
     analysis: &Analysis,
     hertz: Option<HertzParams>,
     pixel_size_uncertainty: f64,
-) -> (AreaTable, Fits) {
+) -> (AreaTable, Fits, IntervalModel) {
     let unit = match analysis.pixel_size {
         Some(_) => AreaUnit::SquareMicrometre,
         None => AreaUnit::Pixel,
@@ -403,17 +434,32 @@ pub fn table_and_fits(
     };
     let (shrink, grow) = calibration_bounds(u);
     let pixel_area = analysis.pixel_size.map_or(1.0, |p| p.area_um2());
+    let forces_n: Vec<Option<f64>> = series.images.iter().map(|i| i.force_n).collect();
+    let correction = correct_series(analysis, &forces_n, Assumptions::default());
+    let model = interval_model(series, analysis, &correction);
+    let light = matches!(model, IntervalModel::Light(_));
     let rows: Vec<Row> = series
         .images
         .iter()
         .zip(&analysis.images)
-        .map(|(image, r)| {
+        .zip(&correction.areas)
+        .map(|((image, r), corrected)| {
             let m = &r.measurement;
             let area = m.contact_pixels as f64 * pixel_area;
-            let (area_lo, area_hi) = (
-                r.band.lo_pixels as f64 * pixel_area * shrink,
-                r.band.hi_pixels as f64 * pixel_area * grow,
-            );
+            // The edge band where the light budget cannot be used (no contact light, or a
+            // series whose fits would need an image without one).
+            let (area_corrected, area_lo, area_hi) = match corrected.filter(|_| light) {
+                Some(c) => (
+                    c.area_px * pixel_area,
+                    c.lo_px * pixel_area * shrink,
+                    c.hi_px * pixel_area * grow,
+                ),
+                None => (
+                    f64::NAN,
+                    r.band.lo_pixels as f64 * pixel_area * shrink,
+                    r.band.hi_pixels as f64 * pixel_area * grow,
+                ),
+            };
             let force_mn = image.force_n.map(|f| f * 1e3);
             let pressure = |a: f64| match (unit, force_mn) {
                 (AreaUnit::SquareMicrometre, Some(f)) if a > 0.0 => Some(f / a * 1e3),
@@ -430,6 +476,7 @@ pub fn table_and_fits(
                 threshold: r.threshold.value,
                 contact_pixels: m.contact_pixels,
                 area,
+                area_corrected,
                 area_lo,
                 area_hi,
                 mean_intensity: m.mean_intensity,
@@ -450,18 +497,43 @@ pub fn table_and_fits(
         .collect();
     let points: Vec<LoadPoint> = rows.iter().map(Row::load_point).collect();
     let (forces, areas) = fit_points(&points);
-    // The same images as the fits, each with its area interval.
-    let in_fit: Vec<&Row> = rows.iter().filter(|r| r.load_point().in_fit()).collect();
-    // The bands alone: the calibration enters the bootstrap as one factor for all images.
-    let intervals = fit_intervals(
-        &in_fit.iter().filter_map(|r| r.force_mn).collect::<Vec<_>>(),
-        &in_fit
+    // The same images as the fits, each with its joint draws (the calibration enters the
+    // bootstrap as one factor for all images).
+    let in_fit: Vec<usize> = rows
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.load_point().in_fit())
+        .map(|(i, _)| i)
+        .collect();
+    let fit_forces: Vec<f64> = in_fit.iter().filter_map(|&i| rows[i].force_mn).collect();
+    let (intervals, power_law_corrected) = if fit_forces.len() != in_fit.len() {
+        (None, None)
+    } else if light {
+        let draws: Vec<Vec<f64>> = correction
+            .draws
             .iter()
-            .map(|r| r.area_lo / shrink)
-            .collect::<Vec<_>>(),
-        &in_fit.iter().map(|r| r.area_hi / grow).collect::<Vec<_>>(),
-        u,
-    );
+            .map(|d| in_fit.iter().map(|&i| d[i] * pixel_area).collect())
+            .collect();
+        let corrected: Vec<f64> = in_fit.iter().map(|&i| rows[i].area_corrected).collect();
+        (
+            joint_fit_intervals(&fit_forces, &draws, u),
+            fit_power_law(&fit_forces, &corrected),
+        )
+    } else {
+        // The bands alone: the calibration enters the bootstrap as one factor for all images.
+        let band = |f: fn(&Row) -> f64, by: f64| -> Vec<f64> {
+            in_fit.iter().map(|&i| f(&rows[i]) / by).collect()
+        };
+        (
+            fit_intervals(
+                &fit_forces,
+                &band(|r| r.area_lo, shrink),
+                &band(|r| r.area_hi, grow),
+                u,
+            ),
+            None,
+        )
+    };
     let proportional_mpa = match unit {
         AreaUnit::SquareMicrometre => fit_proportional(&forces, &areas)
             .filter(|(s, _)| *s > 0.0)
@@ -478,6 +550,7 @@ pub fn table_and_fits(
         power_law: fit_power_law(&forces, &areas),
         proportional_mpa,
         intervals,
+        power_law_corrected,
         pressure_range_mpa: (!pressures.is_empty()).then(|| {
             (
                 pressures.iter().copied().fold(f64::INFINITY, f64::min),
@@ -492,7 +565,48 @@ pub fn table_and_fits(
         pixel_size_uncertainty: u,
         rows,
     };
-    (table, fits)
+    (table, fits, model)
+}
+
+/// How a series' area intervals are made (`docs/methods.md`, "Area intervals").
+#[derive(Debug, Clone)]
+pub enum IntervalModel {
+    /// From the light budgets: every image the fits use has one.
+    Light(SeriesLight),
+    /// The edge band around the threshold, for a series where an image the fits use has no
+    /// light budget; `why` says which and why.
+    Band {
+        /// The image and the reason, in words.
+        why: String,
+    },
+}
+
+/// The light model where every image the fits use (contact, none at the border) has a light
+/// budget, else the edge band with the first image that has none.
+fn interval_model(
+    series: &Series,
+    analysis: &Analysis,
+    correction: &contactscope::analysis::corrected::SeriesCorrection,
+) -> IntervalModel {
+    let missing = analysis.images.iter().enumerate().find(|(i, r)| {
+        let m = &r.measurement;
+        m.contact_pixels > 0 && !m.edge_contact && correction.areas[*i].is_none()
+    });
+    match missing {
+        None => IntervalModel::Light(correction.model.clone()),
+        Some((i, r)) => IntervalModel::Band {
+            why: format!(
+                "{} has no light budget: {}",
+                crate::series::image_location(&series.images[i]),
+                if r.light.is_none() {
+                    "no 16 × 16-pixel block of background lies beyond the contact's light \
+                     (a field too small around the contact)"
+                } else {
+                    "its contact light does not stand out from the noise"
+                }
+            ),
+        },
+    }
 }
 
 /// One file of the series as `summary.json` records it.

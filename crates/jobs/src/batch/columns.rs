@@ -79,8 +79,19 @@ pub fn images_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
     if any_px {
         t.float("area_px", in_unit(false, |i| i.area));
     }
-    // The area interval (empty for a series analysed before intervals existed).
+    // The corrected area and the interval on the true area (empty for a series analysed
+    // before they existed, or an image without contact light).
     let finite = |v: Vec<Option<f64>>| v.into_iter().map(|x| x.filter(|x| x.is_finite()));
+    t.float(
+        "area_corrected_um2",
+        finite(in_unit(true, |i| i.area_corrected)),
+    );
+    if any_px {
+        t.float(
+            "area_corrected_px",
+            finite(in_unit(false, |i| i.area_corrected)),
+        );
+    }
     t.float("area_um2_lo", finite(in_unit(true, |i| i.area_lo)));
     t.float("area_um2_hi", finite(in_unit(true, |i| i.area_hi)));
     if any_px {

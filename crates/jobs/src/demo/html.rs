@@ -23,7 +23,7 @@ pub(super) struct Facts<'a> {
     pub comparisons: &'a [(String, Comparison)],
     pub measured: &'a [(f64, f64)],
     /// Each measured area's 95 % interval (lo, hi), m².
-    pub measured_intervals: &'a [(f64, f64)],
+    pub measured_intervals: &'a [(f64, f64, f64)],
     pub truth_areas_m2: &'a [f64],
     pub fits: &'a [ModelFit],
 }
@@ -171,9 +171,10 @@ fn demo_json(facts: &Facts) -> serde_json::Value {
         "recovered": facts.recovered,
         "true_shift_x_px": MICROGRAPH_OFFSET_PX.0,
         "true_shift_y_px": MICROGRAPH_OFFSET_PX.1,
-        "areas": facts.measured.iter().zip(facts.measured_intervals).zip(facts.truth_areas_m2).map(|((&(f, a), &(lo, hi)), t)| json!({
+        "areas": facts.measured.iter().zip(facts.measured_intervals).zip(facts.truth_areas_m2).map(|((&(f, a), &(c, lo, hi)), t)| json!({
             "force_mN": f * 1e3,
             "measured_area_um2": a * 1e12,
+            "measured_area_corrected_um2": c * 1e12,
             "measured_area_um2_lo": lo * 1e12,
             "measured_area_um2_hi": hi * 1e12,
             "true_area_um2": t * 1e12,
@@ -477,8 +478,8 @@ fn fits_table(s: &mut String, fits: &[ModelFit]) {
 }
 
 fn areas_table(s: &mut String, facts: &Facts) {
-    s.push_str("<table>\n<tr><th>force (mN)</th><th>measured area (µm²)</th><th>its 95 % interval (µm²)</th><th>true area, g = 0 (µm²)</th></tr>\n");
-    for ((&(f, a), &(lo, hi)), t) in facts
+    s.push_str("<table>\n<tr><th>force (mN)</th><th>contact pixels' area (µm²)</th><th>corrected area (µm²)</th><th>95 % interval on the true area (µm²)</th><th>true area, g = 0 (µm²)</th></tr>\n");
+    for ((&(f, a), &(c, lo, hi)), t) in facts
         .measured
         .iter()
         .zip(facts.measured_intervals)
@@ -489,9 +490,15 @@ fn areas_table(s: &mut String, facts: &Facts) {
         } else {
             " (misses the truth)"
         };
+        // No corrected area where the intervals are the edge band's (a field too small).
+        let corrected = if c.is_finite() {
+            format!("{:.2}", c * 1e12)
+        } else {
+            "—".to_string()
+        };
         let _ = writeln!(
             s,
-            "<tr><td>{:.4}</td><td>{:.2}</td><td>{:.2}…{:.2}{holds}</td><td>{:.2}</td></tr>",
+            "<tr><td>{:.4}</td><td>{:.2}</td><td>{corrected}</td><td>{:.2}…{:.2}{holds}</td><td>{:.2}</td></tr>",
             f * 1e3,
             a * 1e12,
             lo * 1e12,

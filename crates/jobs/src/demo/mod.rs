@@ -253,11 +253,13 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
     let experiment = synthetic_experiment(p, &data, progress)?;
     let mut recovered = Vec::new();
 
-    progress("analyze: global Otsu threshold, contact areas");
-    let (measured, measured_intervals) = analyze(work, &experiment.manifest)?;
-
+    // The PSF first: the area intervals take the width the beads give.
     progress("psf: beads");
     recovered.push(psf(work, &data, p)?);
+    let fwhm_m = recovered[0].recovered * 1e-9;
+
+    progress("analyze: global Otsu threshold, contact areas");
+    let (measured, measured_intervals) = analyze(work, &experiment.manifest, fwhm_m)?;
     progress("newton: detection gap");
     recovered.extend(newton(work, &data, p)?);
     progress("hertz: squeeze test");
@@ -296,12 +298,14 @@ fn build(work: &Path, p: &DemoParams, progress: DemoProgress) -> Result<DemoOutc
     })
 }
 
-/// Measured (force N, area m²) from `analyze`, and each area's 95 % interval (lo, hi), m².
-type MeasuredCurve = (Vec<(f64, f64)>, Vec<(f64, f64)>);
+/// Measured (force N, contact pixels' area m²) from `analyze`, and each image's corrected area
+/// and 95 % interval on the true area (corrected, lo, hi), m².
+type MeasuredCurve = (Vec<(f64, f64)>, Vec<(f64, f64, f64)>);
 
-fn analyze(work: &Path, manifest: &Path) -> Result<MeasuredCurve> {
+fn analyze(work: &Path, manifest: &Path, psf_fwhm_m: f64) -> Result<MeasuredCurve> {
     let request = AnalyzeRequest {
         memory_budget: 64 << 20,
+        psf_fwhm_m: Some(psf_fwhm_m),
         ..AnalyzeRequest::new(Micrographs::Files(SeriesSpec {
             manifest: Some(manifest.to_path_buf()),
             ..SeriesSpec::default()
@@ -323,7 +327,13 @@ fn analyze(work: &Path, manifest: &Path) -> Result<MeasuredCurve> {
             .map(|r| (r.force_mn.unwrap_or(f64::NAN) * 1e-3, r.area * 1e-12))
             .collect(),
         rows.iter()
-            .map(|r| (r.area_lo * 1e-12, r.area_hi * 1e-12))
+            .map(|r| {
+                (
+                    r.area_corrected * 1e-12,
+                    r.area_lo * 1e-12,
+                    r.area_hi * 1e-12,
+                )
+            })
             .collect(),
     ))
 }

@@ -143,7 +143,21 @@ impl MeasuredInput {
             MeasuredInput::Intervals(points) => {
                 let forces: Vec<f64> = points.iter().map(|p| p.0).collect();
                 check_loads(&forces, Param::Forces)?;
-                Ok(Measured::with_intervals(points.clone(), 0.0)?)
+                // `analyze`'s intervals are on the true area and need not hold the contact-pixel
+                // area: widened to hold it, as from areas.csv (`results::read_measured`); an
+                // interval out of order is refused.
+                let mut widened = Vec::with_capacity(points.len());
+                for &(f, a, lo, hi) in points {
+                    if lo > hi {
+                        return Err(crate::error::Error::InvalidArgument(format!(
+                            "area_intervals: the interval {lo:e}..{hi:e} m² at {f} N is out of \
+                             order"
+                        )));
+                    }
+                    let (lo, hi) = crate::results::interval_holding(a, lo, hi);
+                    widened.push((f, a, lo, hi));
+                }
+                Ok(Measured::with_intervals(widened, 0.0)?)
             }
         }
     }

@@ -150,9 +150,19 @@ class _Progress(QObject):
     changed = Signal(str, int, int)
 
 
+def _um2(value: Optional[float]) -> str:
+    """An area in m² shown in µm² ("-" where there is none: no contact light)."""
+    return "-" if value is None or not np.isfinite(value) else f"{value * 1e12:.2f}"
+
+
+def _px(value: Optional[float]) -> str:
+    """An area in pixels ("-" where there is none)."""
+    return "-" if value is None or not np.isfinite(value) else f"{value:.1f}"
+
+
 def table_rows(result: Dict[str, Any]) -> List[List[str]]:
-    """The area-vs-load table as shown: image, force (mN), area (µm² or px), its 95 % interval,
-    patches, p (MPa)."""
+    """The area-vs-load table as shown: image, force (mN), contact pixels' area (µm² or px), the
+    corrected area, its 95 % interval on the true area, patches, p (MPa)."""
     rows = []
     for r in result["rows"]:
         f = r.get("force_n")
@@ -160,12 +170,14 @@ def table_rows(result: Dict[str, Any]) -> List[List[str]]:
         p = r.get("mean_pressure_pa")
         if area is not None:
             shown = f"{area * 1e12:.2f}"
-            interval = f"{r['area_m2_lo'] * 1e12:.2f}…{r['area_m2_hi'] * 1e12:.2f}"
+            corrected = _um2(r.get("area_corrected_m2"))
+            interval = f"{_um2(r.get('area_m2_lo'))}…{_um2(r.get('area_m2_hi'))}"
         else:
             shown = f"{r.get('area_px', 0)} px"
-            interval = f"{r.get('area_px_lo', 0):g}…{r.get('area_px_hi', 0):g} px"
+            corrected = _px(r.get("area_corrected_px"))
+            interval = f"{_px(r.get('area_px_lo'))}…{_px(r.get('area_px_hi'))} px"
         rows.append([f"{os.path.basename(str(r['image']))} p{r['page']}",
-                     "-" if f is None else f"{f * 1e3:g}", shown, interval,
+                     "-" if f is None else f"{f * 1e3:g}", shown, corrected, interval,
                      str(r["patches"]),
                      "-" if p is None else f"{p * 1e-6:.1f}"])
     return rows
@@ -434,7 +446,8 @@ class LoadSeriesWidget(QWidget):
         unit = "µm²" if result.get("area_unit") == "um2" or any(
             r.get("area_m2") is not None for r in result["rows"]) else "px"
         self.table.setHorizontalHeaderLabels(["image", "force (mN)", f"area ({unit})",
-                                              "95 % interval", "patches", "p (MPa)"])
+                                              "corrected", "95 % interval (true area)",
+                                              "patches", "p (MPa)"])
         for i, row in enumerate(rows):
             for j, text in enumerate(row):
                 self.table.setItem(i, j, QTableWidgetItem(text))
@@ -443,13 +456,19 @@ class LoadSeriesWidget(QWidget):
     def _plot(self, result: Dict[str, Any]) -> None:
         self.figure.clear()
         ax = self.figure.add_subplot(111)
-        pts = [(r["force_n"] * 1e3, r["area_m2"] * 1e12, r["area_m2_lo"] * 1e12,
-                r["area_m2_hi"] * 1e12) for r in result["rows"]
+        pts = [(r["force_n"] * 1e3, r["area_m2"] * 1e12) for r in result["rows"]
                if r.get("force_n") and r.get("area_m2")]
+        corrected = [(r["force_n"] * 1e3, r["area_corrected_m2"] * 1e12,
+                      r["area_m2_lo"] * 1e12, r["area_m2_hi"] * 1e12) for r in result["rows"]
+                     if r.get("force_n") and r.get("area_m2")
+                     and np.isfinite(r.get("area_corrected_m2") or np.nan)]
         if pts:
-            f, a, lo, hi = np.array(pts).T
-            ax.errorbar(f, a, yerr=[a - lo, hi - a], fmt="o", color="tab:blue", capsize=3,
-                        label="measured (Otsu), 95 % interval")
+            f, a = np.array(pts).T
+            ax.plot(f, a, "o", mfc="none", color="tab:gray", label="contact pixels (Otsu)")
+            if corrected:
+                fc, c, lo, hi = np.array(corrected).T
+                ax.errorbar(fc, c, yerr=[c - lo, hi - c], fmt="o", color="tab:blue",
+                            capsize=3, label="corrected, 95 % interval on the true area")
             ax.set_xscale("log")
             ax.set_yscale("log")
             fit = (result.get("fits") or {}).get("power_law")
