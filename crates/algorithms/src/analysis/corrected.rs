@@ -285,10 +285,7 @@ impl SeriesLight {
             .iter()
             .enumerate()
             .map(|(i, im)| {
-                let b = im.budget?;
-                if b.excess.is_nan() || b.excess <= 0.0 {
-                    return None;
-                }
+                let b = im.budget.filter(LightBudget::has_light)?;
                 let noise_var = b.region_pixels as f64 * b.background_variance
                     + gain * b.excess
                     + b.fit_variance;

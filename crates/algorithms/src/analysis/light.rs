@@ -114,6 +114,14 @@ pub struct LightBudget {
     pub peak: f64,
 }
 
+impl LightBudget {
+    /// Whether it holds contact light to correct an area with (a positive excess; the series
+    /// model skips a budget without: [`super::corrected`]).
+    pub fn has_light(&self) -> bool {
+        self.excess > 0.0
+    }
+}
+
 /// The pixel noise over `tiles` (at most [`NOISE_TILES`] of them, evenly spaced): the median of
 /// their within-tile variances (full, finite tiles only), corrected to the mean; `None` without
 /// any.

@@ -132,8 +132,10 @@ pub struct ImageResult {
     pub threshold: Threshold,
     /// What was measured.
     pub measurement: Measurement,
-    /// The interval on its contact area ([`interval`]).
-    pub band: interval::AreaBand,
+    /// The edge band on its contact area ([`interval`]): every image without light budgets;
+    /// with them, an image without one, or every image of a series where an image with contact
+    /// clear of the border has none ([`Analysis::needs_bands`]); else `None`.
+    pub band: Option<interval::AreaBand>,
     /// Its light budget ([`light`]); `None` without light or without background blocks far
     /// from the contact.
     pub light: Option<light::LightBudget>,
@@ -202,12 +204,9 @@ pub fn analyze<S: PlaneSource + ?Sized>(
             let (m, mask) = measure(plane, &thresholds[i])?;
             (m, mask, None)
         };
-        let band = interval::area_band(
-            plane,
-            &mask,
-            interval::EDGE_BAND_HALF_WIDTH,
-            interval::NOISE_WIDENING,
-        );
+        // The band costs several times the rest of the pass: only where no light budget
+        // stands in for it.
+        let band = (!light.is_some_and(|l| l.has_light())).then(|| edge_band(plane, &mask));
         sink(i, plane, &mask)?;
         progress(
             Pass::Measure,
@@ -216,7 +215,7 @@ pub fn analyze<S: PlaneSource + ?Sized>(
         );
         Ok((m, band, light))
     })?;
-    let images = thresholds
+    let mut images: Vec<ImageResult> = thresholds
         .into_iter()
         .zip(measurements)
         .map(|(threshold, (measurement, band, light))| ImageResult {
@@ -226,6 +225,18 @@ pub fn analyze<S: PlaneSource + ?Sized>(
             light,
         })
         .collect();
+    if options.light_budgets && needs_bands(&images) {
+        // A third pass, for the few series whose fields leave no background beyond the light.
+        let bands = source.scan(|i, plane| {
+            Ok(match images[i].band {
+                Some(b) => b,
+                None => edge_band(plane, &classify(plane, &images[i].threshold)?),
+            })
+        })?;
+        for (r, b) in images.iter_mut().zip(bands) {
+            r.band = Some(b);
+        }
+    }
     Ok(Analysis {
         images,
         method: options.method,
@@ -235,6 +246,31 @@ pub fn analyze<S: PlaneSource + ?Sized>(
         sample_type: source.sample_type(),
         light_sigma_px: sigma_px,
         warnings,
+    })
+}
+
+/// The edge band of an image with its contact mask at the default width and noise widening.
+fn edge_band(plane: &Plane, mask: &Mask) -> interval::AreaBand {
+    interval::area_band(
+        plane,
+        mask,
+        interval::EDGE_BAND_HALF_WIDTH,
+        interval::NOISE_WIDENING,
+    )
+}
+
+/// The contact mask of `plane` at `threshold`.
+fn classify(plane: &Plane, threshold: &Threshold) -> Result<Mask> {
+    Ok(measure(plane, threshold)?.1)
+}
+
+/// Whether a series with light budgets needs every image's edge band: an image with contact
+/// clear of the border (one an area–load fit would use) has no light budget, so the series'
+/// intervals cannot all come from the light.
+pub fn needs_bands(images: &[ImageResult]) -> bool {
+    images.iter().any(|r| {
+        let m = &r.measurement;
+        m.contact_pixels > 0 && !m.edge_contact && !r.light.is_some_and(|l| l.has_light())
     })
 }
 
@@ -451,5 +487,73 @@ mod tests {
             &|_, _, _| Ok(())
         )
         .is_err());
+    }
+
+    /// A disc of contact, signal 400 over a background of 100 with ±8 of deterministic
+    /// texture, in a square field of `size` pixels.
+    fn disc(size: usize, radius: f64) -> Plane {
+        let c = size as f64 / 2.0;
+        let codes = (0..size * size)
+            .map(|k| {
+                let (x, y) = ((k % size) as f64 + 0.5 - c, (k / size) as f64 + 0.5 - c);
+                let noise = ((k * 7919) % 17) as f64 - 8.0;
+                let signal = if x * x + y * y < radius * radius {
+                    400.0
+                } else {
+                    0.0
+                };
+                (100.0 + signal + noise) as u16
+            })
+            .collect();
+        Plane::from_u16(size, size, codes)
+    }
+
+    #[test]
+    fn edge_bands_only_where_no_light_budget_stands_in() {
+        let options = AnalysisOptions {
+            psf_sigma_px: Some(1.0),
+            light_budgets: true,
+            ..AnalysisOptions::default()
+        };
+        let run = |planes: &[Plane], options: &AnalysisOptions| {
+            analyze(planes, options, &|_, _, _| {}, &|_, _, _| Ok(())).unwrap()
+        };
+        // A wide field: background blocks far from the contact, a light budget, no band.
+        let wide = [disc(256, 20.0), disc(256, 30.0)];
+        let a = run(&wide, &options);
+        assert!(!needs_bands(&a.images));
+        for r in &a.images {
+            assert!(r.light.is_some_and(|l| l.has_light()) && r.band.is_none());
+        }
+        // A field the contact fills: no background beyond its light, so every image's band.
+        let small = [disc(40, 12.0), disc(40, 15.0)];
+        let a = run(&small, &options);
+        assert!(a
+            .images
+            .iter()
+            .all(|r| r.light.is_none() && r.band.is_some()));
+        // One image whose contact leaves no background beyond its light (a square 12 px from
+        // the border), one with: the series needs every band, the third pass measures them.
+        let mut filled = disc(256, 20.0);
+        if let Samples::Int { codes, .. } = &mut filled.samples {
+            for (k, v) in codes.iter_mut().enumerate() {
+                let (x, y) = (k % 256, k / 256);
+                if (12..244).contains(&x) && (12..244).contains(&y) {
+                    *v = 500 + (k % 5) as u16;
+                }
+            }
+        }
+        let a = run(&[disc(256, 30.0), filled], &options);
+        assert!(a.images[0].light.is_some_and(|l| l.has_light()));
+        assert!(a.images[1].light.is_none() && !a.images[1].measurement.edge_contact);
+        assert!(needs_bands(&a.images) && a.images.iter().all(|r| r.band.is_some()));
+        let own = run(&[disc(256, 30.0)], &AnalysisOptions::default());
+        assert_eq!(a.images[0].band, own.images[0].band);
+        // Without light budgets, the band everywhere.
+        let a = run(&wide, &AnalysisOptions::default());
+        assert!(a
+            .images
+            .iter()
+            .all(|r| r.light.is_none() && r.band.is_some()));
     }
 }

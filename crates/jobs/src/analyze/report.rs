@@ -454,11 +454,15 @@ pub fn table_and_fits(
                     c.lo_px * pixel_area * shrink,
                     c.hi_px * pixel_area * grow,
                 ),
-                None => (
-                    f64::NAN,
-                    r.band.lo_pixels as f64 * pixel_area * shrink,
-                    r.band.hi_pixels as f64 * pixel_area * grow,
-                ),
+                // The analysis measured a band wherever this can happen
+                // (`analysis::needs_bands`).
+                None => r.band.map_or((f64::NAN, f64::NAN, f64::NAN), |b| {
+                    (
+                        f64::NAN,
+                        b.lo_pixels as f64 * pixel_area * shrink,
+                        b.hi_pixels as f64 * pixel_area * grow,
+                    )
+                }),
             };
             let force_mn = image.force_n.map(|f| f * 1e3);
             let pressure = |a: f64| match (unit, force_mn) {
@@ -582,7 +586,8 @@ pub enum IntervalModel {
 }
 
 /// The light model where every image the fits use (contact, none at the border) has a light
-/// budget, else the edge band with the first image that has none.
+/// budget, else the edge band with the first image that has none (the rule of
+/// [`contactscope::analysis::needs_bands`], under which the analysis measured every band).
 fn interval_model(
     series: &Series,
     analysis: &Analysis,
