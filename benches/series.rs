@@ -25,7 +25,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
 
-use contactscope::measure::{measure, patch_stats};
+use contactscope::analysis::light::light_budget;
+use contactscope::measure::{measure, measure_with_tiles, patch_stats};
 use contactscope::synth::{self, SynthParams};
 use contactscope::threshold::{Binning, Histogram, Threshold};
 use contactscope_formats::tiff::write::{encode_u16_stack_compressed, Compression};
@@ -238,6 +239,13 @@ fn series_benches(c: &mut Criterion) {
     let t: Threshold = Threshold::otsu(&h, "bench").unwrap();
     group.bench_function("measure_with_patches", |b| {
         b.iter(|| black_box(measure(&plane, &t).unwrap()))
+    });
+    group.bench_function("measure_with_tiles", |b| {
+        b.iter(|| black_box(measure_with_tiles(&plane, &t).unwrap()))
+    });
+    let (_, _, tiles) = measure_with_tiles(&plane, &t).unwrap();
+    group.bench_function("light_budget", |b| {
+        b.iter(|| black_box(light_budget(&plane, &tiles, 1.0)))
     });
     let (_, mask) = measure(&plane, &t).unwrap();
     group.bench_function("patch_stats_only", |b| {

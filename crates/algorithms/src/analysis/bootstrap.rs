@@ -19,6 +19,7 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 
 use super::fit::{fit_power_law, fit_proportional};
 
@@ -87,6 +88,9 @@ pub fn joint_fit_intervals(
     resample(forces, calibration, |_, r, i| draws[r % draws.len()][i])
 }
 
+/// Resamples drawn, then refitted in parallel, at a time.
+const CHUNK: usize = 250;
+
 /// The bootstrap both intervals share: [`RESAMPLES`] resamples of the images with replacement,
 /// image i of resample r given the area `area(rng, r, i)` times the resample's calibration
 /// factor, each resample refitted.
@@ -108,21 +112,39 @@ fn resample(
     let mut rng = ChaCha8Rng::seed_from_u64(SEED);
     let (mut exponents, mut prefactors, mut slopes) = (Vec::new(), Vec::new(), Vec::new());
     let mut laws = Vec::new();
-    let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
-    for r in 0..RESAMPLES {
-        let scale = calibration_factor(&mut rng, calibration);
-        for k in 0..n {
-            let i = rng.random_range(0..n);
-            x[k] = forces[i];
-            y[k] = scale * area(&mut rng, r, i);
+    // The resamples are drawn in order from one generator (the same numbers on any number of
+    // threads) and refitted in parallel, a chunk at a time.
+    let (mut x, mut y) = (vec![0.0; n * CHUNK], vec![0.0; n * CHUNK]);
+    for first in (0..RESAMPLES).step_by(CHUNK) {
+        let count = CHUNK.min(RESAMPLES - first);
+        for (j, (xs, ys)) in x
+            .chunks_exact_mut(n)
+            .zip(y.chunks_exact_mut(n))
+            .take(count)
+            .enumerate()
+        {
+            let scale = calibration_factor(&mut rng, calibration);
+            for k in 0..n {
+                let i = rng.random_range(0..n);
+                xs[k] = forces[i];
+                ys[k] = scale * area(&mut rng, first + j, i);
+            }
         }
-        if let Some(f) = fit_power_law(&x, &y) {
-            exponents.push(f.exponent);
-            prefactors.push(f.prefactor);
-            laws.push((f.prefactor, f.exponent));
-        }
-        if let Some((s, _)) = fit_proportional(&x, &y) {
-            slopes.push(s);
+        let fits: Vec<_> = x
+            .par_chunks_exact(n)
+            .zip(y.par_chunks_exact(n))
+            .take(count)
+            .map(|(xs, ys)| (fit_power_law(xs, ys), fit_proportional(xs, ys)))
+            .collect();
+        for (law, proportional) in fits {
+            if let Some(f) = law {
+                exponents.push(f.exponent);
+                prefactors.push(f.prefactor);
+                laws.push((f.prefactor, f.exponent));
+            }
+            if let Some((s, _)) = proportional {
+                slopes.push(s);
+            }
         }
     }
     if exponents.len() < RESAMPLES / 2 {

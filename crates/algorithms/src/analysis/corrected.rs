@@ -35,6 +35,7 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
+use rayon::prelude::*;
 
 use super::light::LightBudget;
 use super::Analysis;
@@ -379,13 +380,16 @@ impl SeriesLight {
     /// Every image's corrected area and 95 % interval from the draws; `None` without a budget.
     pub fn corrected(&self, draws: &[Vec<f64>]) -> Vec<Option<CorrectedArea>> {
         self.images
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(i, plan)| {
                 let p = plan.as_ref()?;
                 let mut v: Vec<f64> = draws.iter().map(|d| d[i]).collect();
-                v.sort_by(f64::total_cmp);
-                let at = |q: f64| v[((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1)];
+                // The nearest-rank quantiles, each by selection (what a sort would put there).
+                let mut at = |q: f64| {
+                    let k = ((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1);
+                    *v.select_nth_unstable_by(k, f64::total_cmp).1
+                };
                 let median = at(0.5);
                 Some(CorrectedArea {
                     area_px: median.max(0.0),

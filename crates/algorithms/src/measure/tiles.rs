@@ -175,26 +175,27 @@ pub(super) fn classify_codes_tiled(
             let row = &codes[y * width..(y + 1) * width];
             let mrow = &mut mask[y * width..(y + 1) * width];
             // Segments of at most SUM_BLOCK pixels keep the u32 class sums exact.
+            // One loop: the pixel's class, the class sums and its column's running sums.
             for start in (0..width).step_by(SUM_BLOCK) {
                 let end = (start + SUM_BLOCK).min(width);
                 let (mut n, mut sc, mut sa) = (0u32, 0u32, 0u32);
-                for (m, &c) in mrow[start..end].iter_mut().zip(&row[start..end]) {
-                    let is_contact = c > k;
-                    *m = u8::from(is_contact);
+                for (((m, &c), s), cc) in mrow[start..end]
+                    .iter_mut()
+                    .zip(&row[start..end])
+                    .zip(&mut col_sum[start..end])
+                    .zip(&mut col_contact[start..end])
+                {
+                    let is_contact = u8::from(c > k);
+                    *m = is_contact;
+                    *cc += is_contact;
+                    *s += u32::from(c);
                     n += u32::from(is_contact);
-                    sc += if is_contact { u32::from(c) } else { 0 };
+                    sc += u32::from(c) * u32::from(is_contact);
                     sa += u32::from(c);
                 }
                 n_contact += u64::from(n);
                 s_contact += u64::from(sc);
                 s_all += u64::from(sa);
-            }
-            // The columns' running sums: two plain vertical adds.
-            for (s, &c) in col_sum.iter_mut().zip(row) {
-                *s += u32::from(c);
-            }
-            for (cc, &m) in col_contact.iter_mut().zip(mrow.iter()) {
-                *cc += m;
             }
         }
         tiles.add_tile_row(ty, y1 - y0, &col_sum, &col_contact, f64::from(offset));
