@@ -11,10 +11,10 @@
 //!   `cloud` stress case (sub-PSF patches at every load, outside the paper's regime). Solved ramps
 //!   are cached in `--cache` (default `target/solved-ramps`): the first run solves them.
 //!
-//! Every series is analysed as the library does it (`analyze` still reports the edge band of
-//! `benches/intervals.rs`) — one global Otsu threshold, each image measured with its light
-//! budget, the series' corrected areas drawn jointly
-//! ([`correct_series`]), the exponent's interval by the bootstrap over those draws
+//! Every series is analysed as `analyze` does it when every image has a light budget (the edge
+//! band's coverage is `benches/intervals.rs`) — one global Otsu threshold, each image measured
+//! with its light budget, the series' corrected areas drawn jointly ([`correct_series`]), the
+//! exponent's interval by the bootstrap over those draws
 //! ([`joint_fit_intervals`]) — with the PSF given. Printed per generator, scale and cell (PSF FWHM,
 //! pixel, photons at contact): series, and per load rank (the two lightest loads, the middle
 //! four, the two heaviest) the share of intervals holding the true area and their median
