@@ -198,7 +198,12 @@ pub fn area_plot(outcome: &AnalyzeOutcome, title: &str) -> crate::plot::Chart {
         .collect();
     if !bars.is_empty() {
         curves.push(Curve {
-            label: "95 % interval of the true area (light budget)".into(),
+            label: if table.rows.iter().any(|r| r.area_corrected.is_finite()) {
+                "95 % interval of the true area (light budget)"
+            } else {
+                "95 % interval of the area (edge band)"
+            }
+            .into(),
             xy: bars,
         });
     }
