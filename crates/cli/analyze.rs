@@ -232,7 +232,11 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
             .map_or(String::new(), |(lo, hi)| {
                 format!(" (95 % interval {:.1}…{:.1} MPa)", 1e3 / hi, 1e3 / lo)
             });
-        println!("proportional fit: A = N/p, p = {p:.1} MPa{ci}");
+        let corrected = outcome
+            .fits
+            .proportional_corrected_mpa
+            .map_or(String::new(), |c| format!("; corrected p = {c:.1} MPa"));
+        println!("proportional fit: A = N/p, p = {p:.1} MPa (contact pixels){corrected}{ci}");
     }
     println!("wrote {} files to {}:", written.len(), out.display());
     for path in written.iter().filter(|p| !is_per_image(p)) {

@@ -76,6 +76,24 @@ fn area_intervals_hold_the_true_area_of_synthetic_series() {
         assert!(ci[0] < ci[1] && ci[1] - ci[0] < 0.1, "{ci:?}");
         let estimate = law["exponent_corrected"].as_f64().unwrap();
         assert!(ci[0] <= estimate && estimate <= ci[1], "{estimate} {ci:?}");
+        // So do the prefactor's and the pressure's: each estimate from the corrected areas.
+        for (estimate, interval) in [
+            (
+                &law["prefactor_corrected_um2_per_mN_pow_exponent"],
+                &law["prefactor_um2_per_mN_pow_exponent_ci95"],
+            ),
+            (
+                &summary["fits"]["proportional"]["pressure_corrected_MPa"],
+                &summary["fits"]["proportional"]["pressure_MPa_ci95"],
+            ),
+        ] {
+            let (e, lo, hi) = (
+                estimate.as_f64().unwrap(),
+                interval[0].as_f64().unwrap(),
+                interval[1].as_f64().unwrap(),
+            );
+            assert!(lo <= e && e <= hi, "{e} outside {lo}…{hi}");
+        }
         let (n, a): (Vec<f64>, Vec<f64>) = column(&th, &tr, "force_mN")
             .into_iter()
             .zip(truth.iter().copied())

@@ -288,6 +288,9 @@ pub struct Fits {
     pub intervals: Option<FitIntervals>,
     /// The power law fitted to the corrected areas (the estimate the intervals are about).
     pub power_law_corrected: Option<PowerLawFit>,
+    /// The proportional law's pressure from the corrected areas, MPa (the estimate its interval
+    /// is about).
+    pub proportional_corrected_mpa: Option<f64>,
 }
 
 impl Serialize for Fits {
@@ -316,7 +319,7 @@ impl Serialize for Fits {
             "proportional",
             &self
                 .proportional_mpa
-                .map(|(p, n)| Proportional(p, n, pressure_ci)),
+                .map(|(p, n)| Proportional(p, n, pressure_ci, self.proportional_corrected_mpa)),
         )?;
         m.serialize_entry(
             "mean_pressure_MPa",
@@ -387,13 +390,14 @@ impl Serialize for PowerLawOf<'_> {
     }
 }
 
-struct Proportional(f64, usize, Option<(f64, f64)>);
+struct Proportional(f64, usize, Option<(f64, f64)>, Option<f64>);
 
 impl Serialize for Proportional {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut m = s.serialize_map(Some(4))?;
+        let mut m = s.serialize_map(Some(5))?;
         m.serialize_entry("model", "area = force / pressure")?;
         m.serialize_entry("pressure_MPa", &Q(self.0, Unit::Mpa))?;
+        m.serialize_entry("pressure_corrected_MPa", &self.3.map(|p| Q(p, Unit::Mpa)))?;
         m.serialize_entry(
             "pressure_MPa_ci95",
             &self.2.map(|(lo, hi)| Interval(lo, hi, Unit::Mpa)),
@@ -510,6 +514,7 @@ pub fn table_and_fits(
         .map(|(i, _)| i)
         .collect();
     let fit_forces: Vec<f64> = in_fit.iter().filter_map(|&i| rows[i].force_mn).collect();
+    let corrected_areas: Vec<f64> = in_fit.iter().map(|&i| rows[i].area_corrected).collect();
     let (intervals, power_law_corrected) = if fit_forces.len() != in_fit.len() {
         (None, None)
     } else if light {
@@ -518,10 +523,9 @@ pub fn table_and_fits(
             .iter()
             .map(|d| in_fit.iter().map(|&i| d[i] * pixel_area).collect())
             .collect();
-        let corrected: Vec<f64> = in_fit.iter().map(|&i| rows[i].area_corrected).collect();
         (
             joint_fit_intervals(&fit_forces, &draws, u),
-            fit_power_law(&fit_forces, &corrected),
+            fit_power_law(&fit_forces, &corrected_areas),
         )
     } else {
         // The bands alone: the calibration enters the bootstrap as one factor for all images.
@@ -537,6 +541,13 @@ pub fn table_and_fits(
             ),
             None,
         )
+    };
+    // As `proportional_mpa` below, from the corrected areas of the same images.
+    let proportional_corrected_mpa = match (unit, &power_law_corrected) {
+        (AreaUnit::SquareMicrometre, Some(_)) => fit_proportional(&fit_forces, &corrected_areas)
+            .filter(|(s, _)| *s > 0.0)
+            .map(|(slope, _)| 1e3 / slope),
+        _ => None,
     };
     let proportional_mpa = match unit {
         AreaUnit::SquareMicrometre => fit_proportional(&forces, &areas)
@@ -555,6 +566,7 @@ pub fn table_and_fits(
         proportional_mpa,
         intervals,
         power_law_corrected,
+        proportional_corrected_mpa,
         pressure_range_mpa: (!pressures.is_empty()).then(|| {
             (
                 pressures.iter().copied().fold(f64::INFINITY, f64::min),
