@@ -38,6 +38,7 @@ use contactscope::analysis::corrected::{correct_series, Assumptions};
 use contactscope::analysis::fit::fit_power_law;
 use contactscope::analysis::{analyze, AnalysisOptions};
 use contactscope::image::Plane;
+use contactscope::optics::blur::FWHM_PER_SIGMA;
 use contactscope::synth::solved::{
     image_ramp, solve_ramp, Camera, ContactRamp, PatchScale, RampSpec,
 };
@@ -230,7 +231,7 @@ fn table(
             for photons in PHOTONS {
                 let tallies: Vec<Tally> = (0..seeds)
                     .into_par_iter()
-                    .map(|seed| score(&make(psf, px, photons, seed), psf / 2.354_820 / px))
+                    .map(|seed| score(&make(psf, px, photons, seed), psf / FWHM_PER_SIGMA / px))
                     .collect();
                 let mut t = Tally::default();
                 for x in tallies {

@@ -291,6 +291,13 @@ fn without_pixel_size_areas_are_in_pixels_with_a_warning() {
     let (h, r) = read_csv(&out_dir.join("areas.csv"));
     assert!(h.contains(&"area_px".to_string()) && !h.contains(&"mean_pressure_MPa".to_string()));
     assert_eq!(column(&h, &r, "area_px"), column(&h, &r, "contact_pixels"));
+    // The PSF the intervals took is in pixels only: no micrometres without a pixel size.
+    let summary: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
+    let psf = &summary["area_interval"];
+    assert!(psf["psf_fwhm_um"].is_null(), "{psf}");
+    let px = psf["psf_fwhm_px"].as_f64().unwrap();
+    assert!((px - 2.5 * 2.354_820).abs() < 1e-3, "{px}");
 }
 
 #[test]

@@ -157,7 +157,9 @@ fn corrected_areas_hold_the_truth_where_the_psf_biases_the_pixel_count() {
                 .map(|i| Plane::from_u16(params.width, params.height, i.codes.clone()))
                 .collect();
             let options = AnalysisOptions {
-                psf_sigma_px: Some(750e-9 / 2.354_820 / params.pixel_size_m),
+                psf_sigma_px: Some(
+                    750e-9 / contactscope::optics::blur::FWHM_PER_SIGMA / params.pixel_size_m,
+                ),
                 light_budgets: true,
                 ..AnalysisOptions::default()
             };

@@ -3,7 +3,10 @@
 //!
 //! Pass 1 visits every image once and accumulates the series histogram (per-image histograms
 //! merged into one; for float data the finite range first, then a second histogram pass). The
-//! threshold is chosen from the pooled histogram. Pass 2 classifies and measures each image.
+//! threshold is chosen from the pooled histogram. Pass 2 classifies and measures each image
+//! (with its light budget or its edge band: [`ImageResult`]); a series with light budgets whose
+//! fields leave an image without one gets a third pass for every image's edge band
+//! ([`needs_bands`]).
 //!
 //! The analysis never opens a file: it asks its source for planes. A slice of in-memory
 //! [`Plane`]s is a source; the file-backed source of a load series
@@ -40,8 +43,8 @@ pub struct AnalysisOptions {
     /// `None`: not known, and [`UNKNOWN_PSF_SIGMA_PX`] (or the widest PSF of a confocal
     /// microscope, [`corrected::UNKNOWN_PSF_FWHM_M`], with a pixel size) is used.
     pub psf_sigma_px: Option<f64>,
-    /// Whether each image's light budget is measured ([`ImageResult::light`]; about 0.6 ms of
-    /// one core per 1024² image); off by default.
+    /// Whether each image's light budget is measured ([`ImageResult::light`]; about 1 ms of one
+    /// core per 1024² image, the tile sums and the budget); off by default.
     pub light_budgets: bool,
 }
 

@@ -123,6 +123,17 @@ pub struct AnalyzeOutcome {
     pub analysis: Analysis,
 }
 
+/// The PSF the light budgets took.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Psf {
+    /// FWHM, m; `None` without a pixel size.
+    pub fwhm_m: Option<f64>,
+    /// FWHM, pixels.
+    pub fwhm_px: f64,
+    /// Where it came from, in words.
+    pub source: &'static str,
+}
+
 /// The definition of the per-image area intervals (`docs/methods.md`, "Area intervals").
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AreaIntervalFacts {
@@ -135,9 +146,11 @@ pub struct AreaIntervalFacts {
     pub why_edge_band: Option<String>,
     /// The nominal coverage, percent.
     pub level_pct: f64,
-    /// The PSF FWHM the light budgets took, µm.
-    #[serde(serialize_with = "lab::m_as_um", rename = "psf_fwhm_um")]
-    pub psf_fwhm_m: f64,
+    /// The PSF FWHM the light budgets took, µm; `None` without a pixel size (see `psf_fwhm_px`).
+    #[serde(serialize_with = "lab::opt_m_as_um", rename = "psf_fwhm_um")]
+    pub psf_fwhm_m: Option<f64>,
+    /// The same in pixels, the width the light budgets used.
+    pub psf_fwhm_px: f64,
     /// Where it came from.
     pub psf_source: &'static str,
     /// The range of γ in s ∝ N^γ (the contact signal's trend with load) the draws took: the
@@ -167,9 +180,8 @@ pub struct AreaIntervalFacts {
 }
 
 impl AreaIntervalFacts {
-    /// The facts of intervals from `model`, with the PSF FWHM taken (m) and where it came
-    /// from, carrying the pixel size's relative uncertainty `u` (0: none).
-    pub fn new(model: &IntervalModel, psf: (f64, &'static str), u: f64) -> Self {
+    /// The facts of intervals from `model`, with the PSF taken, carrying the pixel size's relative uncertainty `u` (0: none).
+    pub fn new(model: &IntervalModel, psf: Psf, u: f64) -> Self {
         use contactscope::analysis::interval::{EDGE_BAND_HALF_WIDTH, NOISE_WIDENING};
         let light = match model {
             IntervalModel::Light(l) => Some(l),
@@ -196,8 +208,9 @@ impl AreaIntervalFacts {
                 IntervalModel::Light(_) => None,
             },
             level_pct: 95.0,
-            psf_fwhm_m: psf.0,
-            psf_source: psf.1,
+            psf_fwhm_m: psf.fwhm_m,
+            psf_fwhm_px: psf.fwhm_px,
+            psf_source: psf.source,
             signal_trend_exponent: light.map(|l| l.gamma_range()),
             porosity: light.map(|l| l.assumptions().porosity),
             draws: light.map(|_| contactscope::analysis::corrected::DRAWS),
@@ -342,21 +355,6 @@ pub fn run_open(
     series::refuse_maps(series)?;
     let mut warnings = Vec::new();
     let pixel_size = series::pixel_size(series, request.pixel_size_m, &mut warnings)?;
-    let psf = match (request.psf_fwhm_m, pixel_size) {
-        (Some(f), Some(_)) => (f, "given"),
-        (Some(f), None) => {
-            warnings.push(format!(
-                "{} is not used without a pixel size: the area intervals take a PSF of {} pixels",
-                Param::PsfFwhm,
-                short(analysis::UNKNOWN_PSF_SIGMA_PX * FWHM_PER_SIGMA)
-            ));
-            (f, "given, not used: no pixel size")
-        }
-        (None, _) => (
-            analysis::corrected::UNKNOWN_PSF_FWHM_M,
-            "not given: a width above a confocal microscope's taken",
-        ),
-    };
     let options = AnalysisOptions {
         method: request.method,
         pixel_size,
@@ -366,6 +364,27 @@ pub fn run_open(
             .map(|(f, p)| f / FWHM_PER_SIGMA / p.x_m.min(p.y_m)),
         light_budgets: true,
     };
+    // What the light budgets take (`AnalysisOptions::light_sigma_px`), in both units.
+    let fwhm_px = options.light_sigma_px() * FWHM_PER_SIGMA;
+    let psf = Psf {
+        fwhm_m: pixel_size.map(|p| fwhm_px * p.x_m.min(p.y_m)),
+        fwhm_px,
+        source: match (request.psf_fwhm_m, pixel_size) {
+            (Some(_), Some(_)) => "given",
+            (None, Some(_)) => "not given: 1 µm, wider than a confocal microscope's",
+            (_, None) => {
+                "no pixel size: psf_fwhm_px taken, wider than a confocal \
+                          microscope's at 200 nm pixels"
+            }
+        },
+    };
+    if request.psf_fwhm_m.is_some() && pixel_size.is_none() {
+        warnings.push(format!(
+            "{} is not used without a pixel size: the area intervals take a PSF of {} pixels",
+            Param::PsfFwhm,
+            short(fwhm_px)
+        ));
+    }
     let mut analysis = analysis::analyze(
         &open.planes(request.memory_budget),
         &options,
