@@ -62,6 +62,7 @@ pub fn run(args: Args) -> Result<()> {
         i.channels,
         i.channel_layout.describe()
     );
+    println!("axes:         {}", tiff_axes(&i.axes));
     println!(
         "compression:  {} (predictor: {}), {}{}, {}-endian",
         i.compression,
@@ -91,6 +92,53 @@ pub fn run(args: Args) -> Result<()> {
         println!("note:         {note}");
     }
     Ok(())
+}
+
+/// `T 4 × Z 2 × C 2 from OME-XML; z step 0.5 µm; channels 0 'fluo', 1 'refl'` and what a
+/// load series takes from them.
+fn tiff_axes(a: &contactscope_formats::tiff::TiffAxes) -> String {
+    use contactscope_formats::tiff::AxesSource;
+    let mut s = format!(
+        "T {} × Z {} × C {} from {}",
+        a.t,
+        a.z,
+        a.c,
+        a.source.describe()
+    );
+    if let Some(step) = a.z_step_m {
+        s.push_str(&format!("; z step {}", units::format_length(step)));
+    }
+    if let Some(dt) = a.time_increment_s {
+        s.push_str(&format!("; {dt} s between time points"));
+    }
+    if a.channel_names.iter().any(Option::is_some) {
+        let names: Vec<String> = a
+            .channel_names
+            .iter()
+            .enumerate()
+            .map(|(k, n)| match n {
+                Some(n) => format!("{k} '{n}'"),
+                None => k.to_string(),
+            })
+            .collect();
+        s.push_str(&format!("; channels {}", names.join(", ")));
+    }
+    let loads = match (a.source, a.t > 1, a.z > 1) {
+        (AxesSource::Pages, true, _) => "; a load series takes the pages in file order",
+        (_, true, true) => "; a load series takes the time points of one --z",
+        (_, true, false) => "; a load series takes the time points",
+        (_, false, true) if a.is_z_stack() => "; a z stack: a load series only with --load-axis z",
+        (_, false, true) => "; a load series takes the focal planes",
+        _ => "",
+    };
+    s.push_str(loads);
+    if !a.other_files.is_empty() {
+        s.push_str(&format!(
+            "; planes in other files of the OME set: {}",
+            a.other_files.join(", ")
+        ));
+    }
+    s
 }
 
 /// A TIFF by its signature (classic or BigTIFF, either byte order); unreadable files are left to

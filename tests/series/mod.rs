@@ -2,6 +2,7 @@
 //! truth, on real TIFFs, and along the load axes of CZI, ND2 and LIF files.
 
 mod analysis;
+mod axes;
 mod first_hour;
 mod ground_truth;
 mod intervals;

@@ -12,6 +12,7 @@
 use std::path::PathBuf;
 
 use contactscope::analysis::global_threshold;
+use contactscope_formats::microscopy::select::{LoadAxis, Selection};
 use contactscope_formats::tiff::TiffReader;
 use contactscope_formats::Error;
 use contactscope_jobs::series;
@@ -73,7 +74,12 @@ fn threshold_of(
     paths: &[PathBuf],
     channel: Option<usize>,
 ) -> contactscope_jobs::Result<(f64, u64)> {
-    let s = series::from_files(paths, channel)?;
+    // A z stack (ImageJ `slices` with a `spacing`, no frames) is a series only along z.
+    let z_stack = paths
+        .iter()
+        .any(|p| p.to_string_lossy().contains("xyz") && !p.to_string_lossy().contains("xyt"));
+    let along = z_stack.then_some(LoadAxis::Z);
+    let s = series::from_files_selected(paths, &Selection::channel(channel), along)?;
     let (t, pixels, _) = global_threshold(&s.planes(0), &|_, _, _| {})?;
     Ok((t.value, pixels))
 }
@@ -107,11 +113,26 @@ fn multi_channel_files_need_a_channel() {
         assert!(text.contains(&format!("{channels} channels")), "{text}");
         assert!(threshold_of(&[dir.join(file)], Some(channels)).is_err());
     }
-    // The hyperstack's channel 1 is the other 45 pages.
-    let s =
-        series::from_files(&[dir.join("neubias/xyzc_16bit__dna_conf_wf.tif")], Some(1)).unwrap();
+    // The hyperstack's channel 1 is the other 45 pages, along z.
+    let dna = dir.join("neubias/xyzc_16bit__dna_conf_wf.tif");
+    let s = series::from_files_selected(
+        std::slice::from_ref(&dna),
+        &Selection::channel(Some(1)),
+        Some(LoadAxis::Z),
+    )
+    .unwrap();
     assert_eq!(s.images.len(), 45);
     assert!(s.images.iter().all(|i| i.page % 2 == 1));
+    // Without the load axis, the z stack is refused, naming the channels too.
+    let err = series::from_files(std::slice::from_ref(&dna), None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("z stack (45 focal planes")
+            && err.contains("--load-axis z")
+            && err.contains("2 channels"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -326,7 +326,7 @@ fn unselected_axes_and_mismatched_counts_are_clear_errors() {
     let airy = dir.join("czi/LSM880_AiryScan.czi");
     let e = err(&["threshold", s(&airy), "--channel", "0"]);
     assert!(e.contains("axis H") && e.contains("Airyscan"), "{e}");
-    // A TIFF has no z/t/series to choose.
+    // A single-page TIFF has one z plane (a TIFF's axes are its metadata's).
     let tiff = tmp.path().join("one.tif");
     std::fs::write(
         &tiff,
@@ -334,7 +334,7 @@ fn unselected_axes_and_mismatched_counts_are_clear_errors() {
     )
     .unwrap();
     let e = err(&["threshold", s(&tiff), "--z", "1"]);
-    assert!(e.contains("--z 1") && e.contains("TIFF"), "{e}");
+    assert!(e.contains("--z 1") && e.contains("1 z planes"), "{e}");
     // info: --series beyond the file, and a restricted listing.
     let e = err(&["info", s(&lif), "--series", "3"]);
     assert!(e.contains("--series 3") && e.contains("3 series"), "{e}");

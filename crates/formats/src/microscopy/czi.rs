@@ -639,6 +639,7 @@ fn series_info(
         },
         channels,
         rows: super::Rows::Y,
+        tiff_axes: None,
     })
 }
 

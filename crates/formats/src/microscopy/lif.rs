@@ -357,6 +357,7 @@ fn describe(
         },
         channels: vec![ChannelInfo::default(); channels.len()],
         rows: super::Rows::Y,
+        tiff_axes: None,
     };
     Ok((
         info,

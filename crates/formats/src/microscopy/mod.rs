@@ -30,6 +30,8 @@ pub mod select;
 pub mod summary;
 mod tiff;
 
+pub use tiff::{series_of_tiff, LoadDefault};
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -194,6 +196,9 @@ pub struct SeriesInfo {
     /// What the image rows are: y, or the scanned axis of a scan without y (module docs).
     #[serde(skip_serializing_if = "Rows::is_y")]
     pub rows: Rows,
+    /// Where a TIFF's axes come from (OME-XML, ImageJ, plain pages); `None` for other formats.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tiff_axes: Option<crate::tiff::AxesSource>,
 }
 
 impl SeriesInfo {
@@ -396,6 +401,14 @@ impl MicroscopyFile {
             stored: series,
             backend,
         })
+    }
+
+    /// The TIFF header facts, for a TIFF.
+    pub fn tiff_info(&self) -> Option<&crate::tiff::TiffInfo> {
+        match &self.backend {
+            Backend::Tiff(r) => Some(r.info()),
+            _ => None,
+        }
     }
 
     /// Whether decoding a plane costs more than reading its bytes (CZI zstd subblocks, ND2
@@ -620,6 +633,7 @@ mod tests {
             pixel_size: VoxelSize::default(),
             channels: vec![],
             rows: Rows::Y,
+            tiff_axes: None,
         };
         let p = Path::new("x.czi");
         assert!(all[11].check(p, &series).is_ok());
@@ -666,6 +680,7 @@ mod tests {
             },
             channels: vec![],
             rows: Rows::Y,
+            tiff_axes: None,
         };
         // X–Z–T: one X–Z image per t, y pixel size the z step.
         let xz = series((3, 128, 1)).as_line_scan();

@@ -387,5 +387,6 @@ fn series_info(
         },
         channels,
         rows: super::Rows::Y,
+        tiff_axes: None,
     }
 }

@@ -11,9 +11,9 @@
 //! [`Selection::extra`]); one longer than 1 and not chosen is named in the same error (`info`
 //! lists them).
 //!
-//! TIFF files keep their own model (every page of the chosen channel is one image, see
-//! `contactscope_jobs::series`): on a TIFF only `--channel` applies, and a non-zero `--series`, `--z`
-//! or `--t` is refused.
+//! TIFF files have the same axes, from their OME-XML or ImageJ description
+//! ([`crate::tiff::axes`]); a TIFF's load axis, when none is named, is its time points, else its
+//! focal planes, and a z stack is refused ([`super::LoadDefault`]).
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -22,7 +22,7 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
-use super::{ChannelInfo, MicroscopyFile, MicroscopyFormat, PlaneIndex, SeriesInfo};
+use super::{ChannelInfo, LoadDefault, MicroscopyFile, MicroscopyFormat, PlaneIndex, SeriesInfo};
 use crate::error::{Error, Location, Result};
 use crate::image::{pixel_size_or, Image, PixelSize, PixelSizeSource};
 use crate::param::Param;
@@ -122,20 +122,6 @@ impl ChannelChoice {
             }
         }
     }
-
-    /// The index of a choice on a file whose channels have no names (TIFF): a name is refused.
-    pub fn index_only(&self, path: &Path) -> Result<usize> {
-        match self {
-            ChannelChoice::Index(i) => Ok(*i),
-            ChannelChoice::Name(name) => Err(Error::bad_input(
-                Location::file(path),
-                format!(
-                    "{}: a TIFF's channels are chosen by index (0, 1, …); names are read from CZI, ND2 and LIF files",
-                    Param::Channel.with_value(name)
-                ),
-            )),
-        }
-    }
 }
 
 /// `0 'TL', 1 'AF488'` (at most eight, then a count), or `None` when no channel has a name.
@@ -229,34 +215,6 @@ impl Selection {
         }
     }
 
-    /// The channel index on a TIFF (whose channels have no names).
-    pub fn tiff_channel(&self, path: &Path) -> Result<Option<usize>> {
-        self.channel
-            .as_ref()
-            .map(|c| c.index_only(path))
-            .transpose()
-    }
-
-    /// Refuse flags that do not apply to a TIFF file (a non-zero series, z or t).
-    pub fn check_tiff(&self, path: &Path) -> Result<()> {
-        for (flag, value) in [
-            (Param::Series, self.series),
-            (Param::Z, self.z),
-            (Param::T, self.t),
-        ] {
-            if let Some(v) = value.filter(|v| *v > 0) {
-                return Err(Error::bad_input(
-                    Location::file(path),
-                    format!(
-                        "{}: a TIFF's pages are its images; {flag} applies to CZI, ND2 and LIF files",
-                        flag.with_value(v)
-                    ),
-                ));
-            }
-        }
-        Ok(())
-    }
-
     /// The planes of `file` this selection names, in load order: one plane without a load axis,
     /// every plane along `along` otherwise.
     pub fn planes(
@@ -264,13 +222,29 @@ impl Selection {
         file: &MicroscopyFile,
         along: Option<LoadAxis>,
     ) -> Result<Vec<SelectedPlane>> {
-        let path = &file.path;
+        if let Some(info) = file.tiff_info() {
+            return Ok(self
+                .tiff_planes(info, along, LoadDefault::None)?
+                .into_iter()
+                .map(|(plane, _)| plane)
+                .collect());
+        }
+        self.planes_in(&file.path, &file.series, along)
+    }
+
+    /// [`Selection::planes`] over the series of a file at `path`.
+    pub(crate) fn planes_in(
+        &self,
+        path: &Path,
+        all_series: &[SeriesInfo],
+        along: Option<LoadAxis>,
+    ) -> Result<Vec<SelectedPlane>> {
         let bad = |reason: String| Error::bad_input(Location::file(path), reason);
-        let n_series = file.series.len();
+        let n_series = all_series.len();
         if n_series == 0 {
             return Err(bad("the file holds no image series".into()));
         }
-        if let Some(reason) = self.unchosen(file, along) {
+        if let Some(reason) = self.unchosen(all_series, along) {
             return Err(bad(reason));
         }
         let series: Vec<usize> = if along == Some(LoadAxis::Series) {
@@ -287,7 +261,7 @@ impl Selection {
         };
         let mut out = Vec::new();
         for (k, &s) in series.iter().enumerate() {
-            let info = &file.series[s];
+            let info = &all_series[s];
             let extra = self.extra_index(path, info)?;
             let a = &info.axes;
             let what = |axis: &'static str| match n_series {
@@ -343,13 +317,13 @@ impl Selection {
     /// Every axis longer than 1 that is neither chosen nor the load axis, in one message
     /// (`None` when there is none): the series, then the channels (with their names), z, t and
     /// the extra axes of the chosen series (series 0 when the series is not chosen either).
-    fn unchosen(&self, file: &MicroscopyFile, along: Option<LoadAxis>) -> Option<String> {
-        let n_series = file.series.len();
+    fn unchosen(&self, all_series: &[SeriesInfo], along: Option<LoadAxis>) -> Option<String> {
+        let n_series = all_series.len();
         // (what, flag and values)
         let mut items: Vec<(String, String)> = Vec::new();
         if n_series > 1 && self.series.is_none() && along != Some(LoadAxis::Series) {
-            let names = listing(file.series.iter().map(|s| Some(s.name.as_str())));
-            let names = if file.series.iter().any(|s| !s.name.trim().is_empty()) {
+            let names = listing(all_series.iter().map(|s| Some(s.name.as_str())));
+            let names = if all_series.iter().any(|s| !s.name.trim().is_empty()) {
                 format!(" ({names})")
             } else {
                 String::new()
@@ -367,7 +341,7 @@ impl Selection {
             return None;
         }
         let index = self.series.unwrap_or(0);
-        let info = file.series.get(index)?;
+        let info = all_series.get(index)?;
         let a = &info.axes;
         let of = if n_series > 1 && self.series.is_none() {
             format!(" in series {index}")
@@ -542,10 +516,11 @@ pub fn is_tiff(path: &Path) -> bool {
     )
 }
 
-/// The selected planes of any confocal file as [`Image`]s, in load order: for a TIFF, every page
-/// of the channel (as [`crate::tiff::read_pages`]); for CZI, ND2 and LIF, the planes
-/// [`Selection::planes`] names. `page` of each image is its position along the load axis for
-/// vendor files. Pixel size: the override, else the file's metadata.
+/// The selected planes of any confocal file as [`Image`]s, in load order: the planes
+/// [`Selection::planes`] names (a TIFF's along its time points, else its focal planes, when no
+/// load axis is named: [`LoadDefault::AnyStack`]). `page` of each image is its IFD in a TIFF,
+/// its position along the load axis in other files. Pixel size: the override, else the file's
+/// metadata.
 pub fn read_images(
     path: &Path,
     selection: &Selection,
@@ -553,8 +528,7 @@ pub fn read_images(
     pixel_size_m: Option<(f64, f64)>,
 ) -> Result<Vec<Image>> {
     if is_tiff(path) {
-        selection.check_tiff(path)?;
-        return crate::tiff::read_pages(path, selection.tiff_channel(path)?, pixel_size_m);
+        return read_tiff_planes(path, selection, along, LoadDefault::AnyStack, pixel_size_m);
     }
     let mut file = MicroscopyFile::open(path)?;
     let planes = selection.planes(&file, along)?;
@@ -577,15 +551,55 @@ pub fn read_images(
     Ok(images)
 }
 
-/// The one image a selection names (a TIFF must have a single page).
+/// The planes of a TIFF a selection names, as [`Image`]s whose `page` is the IFD.
+fn read_tiff_planes(
+    path: &Path,
+    selection: &Selection,
+    along: Option<LoadAxis>,
+    default: LoadDefault,
+    pixel_size_m: Option<(f64, f64)>,
+) -> Result<Vec<Image>> {
+    let mut reader = crate::tiff::TiffReader::open(path)?;
+    let info = reader.info().clone();
+    let pixel_size = pixel_size_or(info.pixel_size, pixel_size_m);
+    let planes = selection.tiff_planes(&info, along, default)?;
+    planes
+        .into_iter()
+        .map(|(_, (page, sample))| {
+            let plane = reader.read_page(page, sample)?;
+            Ok(Image {
+                values: plane.to_f64(),
+                width: plane.width,
+                height: plane.height,
+                pixel_size,
+                path: path.to_path_buf(),
+                page,
+            })
+        })
+        .collect()
+}
+
+/// The one image a selection names (a TIFF of pages without axis metadata must have one page).
 pub fn read_one_image(
     path: &Path,
     selection: &Selection,
     pixel_size_m: Option<(f64, f64)>,
 ) -> Result<Image> {
     if is_tiff(path) {
-        selection.check_tiff(path)?;
-        return crate::tiff::read_image(path, selection.tiff_channel(path)?, pixel_size_m);
+        let info = crate::tiff::TiffReader::open(path)?.info().clone();
+        if info.axes.source == crate::tiff::AxesSource::Pages && selection.t.is_none() {
+            return crate::tiff::read_image(
+                path,
+                selection
+                    .channel
+                    .as_ref()
+                    .map(|c| c.resolve(path, &[]))
+                    .transpose()?,
+                pixel_size_m,
+            );
+        }
+        let mut images = read_tiff_planes(path, selection, None, LoadDefault::None, pixel_size_m)?;
+        return Ok(images.remove(0));
     }
     let mut images = read_images(path, selection, None, pixel_size_m)?;
     Ok(images.remove(0))

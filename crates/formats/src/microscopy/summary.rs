@@ -57,6 +57,10 @@ pub struct SeriesSummary {
     /// What the image rows are: y, or the scanned axis of a scan without y (absent for y).
     #[serde(skip_serializing_if = "Rows::is_y")]
     pub rows: Rows,
+    /// Where a TIFF's axes come from (`ome`, `imagej`, `pages`: no axis metadata); absent for
+    /// other formats.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axes_from: Option<crate::tiff::AxesSource>,
     /// The voxel size in metres as the file states it (`pixel_size_um` is this in µm), for
     /// callers that write it in other units.
     #[serde(skip)]
@@ -232,6 +236,7 @@ pub fn info_summary_selected(
             },
             pixel_size_source: info.pixel_size.source.clone(),
             rows: info.rows,
+            axes_from: info.tiff_axes,
             pixel_size_m: info.pixel_size.clone(),
             planes,
         });

@@ -20,6 +20,10 @@ pub struct ImageJDescription {
     pub slices: Option<usize>,
     /// `frames=`.
     pub frames: Option<usize>,
+    /// `spacing=`: the z step in `unit`s.
+    pub spacing: Option<f64>,
+    /// `finterval=`: seconds between frames.
+    pub finterval: Option<f64>,
     /// `quantity=`: what the values are (contactscope's maps: `height`, `pressure`, `gap`,
     /// `plastic_displacement`, `contact`, `contact_mask`, `intensity`).
     pub quantity: Option<String>,
@@ -47,6 +51,8 @@ pub fn parse_imagej(description: &str) -> Option<ImageJDescription> {
             "channels" => meta.channels = value.trim().parse().ok(),
             "slices" => meta.slices = value.trim().parse().ok(),
             "frames" => meta.frames = value.trim().parse().ok(),
+            "spacing" => meta.spacing = value.trim().parse().ok(),
+            "finterval" => meta.finterval = value.trim().parse().ok(),
             "quantity" => meta.quantity = Some(value.trim().to_string()),
             "vunit" => meta.value_unit = Some(value.trim().to_string()),
             _ => {}

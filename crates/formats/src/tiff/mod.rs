@@ -2,12 +2,14 @@
 //! ImageJ/OME metadata parsers ([`metadata`]) and the writer ([`mod@write`]); plus the single images
 //! and z stacks of the optics commands as [`Image`]s ([`read_pages`], [`read_image`]).
 
+pub mod axes;
 pub mod metadata;
 pub mod read;
 pub mod write;
 
 use std::path::Path;
 
+pub use axes::{AxesSource, TiffAxes};
 pub use read::{ChannelLayout, TiffInfo, TiffReader};
 pub use write::{
     encode_f32_stack, encode_u16_stack, encode_u16_stack_compressed, encode_u8_stack, Compression,

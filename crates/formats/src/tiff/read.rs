@@ -15,6 +15,7 @@ use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::tags::Tag;
 use tiff::{ColorType, TiffError};
 
+use super::axes::{AxesSource, TiffAxes};
 use super::metadata::{self, ImageJDescription};
 use crate::error::{Error, Location, Result};
 use crate::image::{PixelSize, PixelSizeSource, Plane, SampleType, Samples};
@@ -34,6 +35,8 @@ pub enum ChannelLayout {
     Planar,
     /// An ImageJ hyperstack: one channel per page, channel index fastest.
     ImageJPages,
+    /// An OME-TIFF: one channel per page, in the XML's `DimensionOrder`.
+    OmePages,
 }
 
 impl ChannelLayout {
@@ -44,6 +47,7 @@ impl ChannelLayout {
             ChannelLayout::Contiguous => "interleaved samples per pixel",
             ChannelLayout::Planar => "one plane per sample (planar)",
             ChannelLayout::ImageJPages => "ImageJ hyperstack, one page per channel",
+            ChannelLayout::OmePages => "OME-TIFF, one page per channel",
         }
     }
 }
@@ -63,7 +67,7 @@ pub struct TiffInfo {
     pub sample_type: SampleType,
     /// Bits per sample as stored.
     pub bits_per_sample: u8,
-    /// Number of channels (samples per pixel, or ImageJ `channels=`).
+    /// Number of channels (samples per pixel, ImageJ `channels=` or OME `SizeC`).
     pub channels: usize,
     /// How the channels are stored.
     pub channel_layout: ChannelLayout,
@@ -88,21 +92,14 @@ pub struct TiffInfo {
     pub value_unit: Option<String>,
     /// Notes about ignored or doubtful metadata.
     pub notes: Vec<String>,
+    /// Channels, focal planes and time points, and the page of each plane.
+    pub axes: TiffAxes,
 }
 
 impl TiffInfo {
-    /// The IFD indices that hold `channel` (all pages unless the channels are ImageJ pages).
+    /// The IFD indices that hold `channel`, time points slowest, then focal planes.
     pub fn pages_of_channel(&self, channel: usize) -> Vec<usize> {
-        match self.channel_layout {
-            ChannelLayout::ImageJPages => self
-                .pages
-                .iter()
-                .copied()
-                .skip(channel)
-                .step_by(self.channels)
-                .collect(),
-            _ => self.pages.clone(),
-        }
+        self.axes.pages_of_channel(channel)
     }
 }
 
@@ -249,7 +246,8 @@ impl TiffReader {
         }
         let (width, height) = (width as usize, height as usize);
         let spp = samples_per_pixel as usize;
-        let channel = if spp > 1 { channel } else { 0 };
+        // Channels of several page-channels of several samples each count samples fastest.
+        let channel = if spp > 1 { channel % spp } else { 0 };
         if channel >= spp {
             return Err(Error::bad_input(
                 at,
@@ -449,11 +447,21 @@ fn read_info<R: Read + Seek>(path: &Path, decoder: &mut Decoder<R>) -> Result<Ti
     };
     let pages = list_pages(decoder, path)?;
 
-    let (channels, channel_layout) = match (spp, imagej.as_ref().and_then(|m| m.channels)) {
-        (1, Some(c)) if c > 1 && pages.len() % c == 0 => (c, ChannelLayout::ImageJPages),
-        (1, _) => (1, ChannelLayout::Single),
-        (s, _) if planar => (s as usize, ChannelLayout::Planar),
-        (s, _) => (s as usize, ChannelLayout::Contiguous),
+    let axes = TiffAxes::from_metadata(
+        path,
+        &pages,
+        spp as usize,
+        description.as_deref(),
+        imagej.as_ref(),
+        &mut notes,
+    );
+    let channels = axes.c;
+    let channel_layout = match (spp, axes.source) {
+        (1, _) if channels == 1 => ChannelLayout::Single,
+        (1, AxesSource::Ome) => ChannelLayout::OmePages,
+        (1, _) => ChannelLayout::ImageJPages,
+        _ if planar => ChannelLayout::Planar,
+        _ => ChannelLayout::Contiguous,
     };
     let description_kind = match (&description, &imagej) {
         (_, Some(_)) => "ImageJ",
@@ -480,6 +488,7 @@ fn read_info<R: Read + Seek>(path: &Path, decoder: &mut Decoder<R>) -> Result<Ti
         quantity: imagej.as_ref().and_then(|m| m.quantity.clone()),
         value_unit: imagej.as_ref().and_then(|m| m.value_unit.clone()),
         notes,
+        axes,
     })
 }
 

@@ -98,6 +98,9 @@ impl Serialize for SeriesJson<'_> {
         m.serialize_entry("channels", &channels)?;
         m.serialize_entry("pixel_size_um", &VoxelJson(series))?;
         m.serialize_entry("pixel_size_source", &series.pixel_size_source)?;
+        if let Some(from) = &series.axes_from {
+            m.serialize_entry("axes_from", from)?;
+        }
         if !series.rows.is_y() {
             m.serialize_entry("rows", &series.rows)?;
         }

@@ -35,12 +35,15 @@ pub struct SeriesFile {
     pub notes: Vec<String>,
     /// The TIFF header facts (TIFF files only).
     pub tiff: Option<TiffInfo>,
-    /// The selected planes (CZI, ND2 and LIF files only), in load order.
+    /// The selected planes, in load order.
     pub planes: Vec<SelectedPlane>,
+    /// The IFD of each selected plane (TIFF files only).
+    pub tiff_pages: Vec<usize>,
 }
 
 impl SeriesFile {
-    pub(super) fn from_tiff(info: TiffInfo) -> Self {
+    pub(super) fn from_tiff(info: TiffInfo, planes: Vec<(SelectedPlane, (usize, usize))>) -> Self {
+        let (planes, tiff_pages) = planes.into_iter().map(|(p, (page, _))| (p, page)).unzip();
         SeriesFile {
             path: info.path.clone(),
             format: MicroscopyFormat::Tiff,
@@ -52,7 +55,8 @@ impl SeriesFile {
             pixel_size: info.pixel_size,
             notes: info.notes.clone(),
             tiff: Some(info),
-            planes: Vec::new(),
+            planes,
+            tiff_pages,
         }
     }
 
@@ -105,6 +109,7 @@ impl SeriesFile {
             notes: Vec::new(),
             tiff: None,
             planes,
+            tiff_pages: Vec::new(),
         })
     }
 
@@ -118,15 +123,11 @@ impl SeriesFile {
         )
     }
 
-    /// (page, plane) of every image this file gives to a series built from files: every page
-    /// of the channel for a TIFF, the selected planes otherwise.
-    pub(super) fn images(&self, channel: usize) -> Vec<(usize, Option<SelectedPlane>)> {
+    /// (page, plane) of every image this file gives to a series built from files: the IFD of
+    /// each selected plane of a TIFF, the selected planes otherwise.
+    pub(super) fn images(&self) -> Vec<(usize, Option<SelectedPlane>)> {
         match &self.tiff {
-            Some(info) => info
-                .pages_of_channel(channel)
-                .into_iter()
-                .map(|p| (p, None))
-                .collect(),
+            Some(_) => self.tiff_pages.iter().map(|&p| (p, None)).collect(),
             None => self
                 .planes
                 .iter()

@@ -1,7 +1,7 @@
 //! A load series: which page of which file is which load step, and its normal force.
 //!
 //! Inputs are one multi-page TIFF, several files, a directory of TIFFs (natural sort order, so
-//! `img2` comes before `img10`) or a manifest CSV with columns `file`, optional `page`,
+//! `img2` comes before `img10` and `load_1.25mN` before `load_1.5mN`: [`natural_cmp`]) or a manifest CSV with columns `file`, optional `page`,
 //! `force_mN` and optional `friction_mN`, paths relative to the manifest's folder.
 //! Pages are zero-based TIFF page (IFD) indices, as tifffile numbers them.
 //!
@@ -15,7 +15,6 @@
 //! ([`contactscope::analysis::analyze`]) reads through, and [`pixel_size`] the series' pixel size from
 //! the files' metadata or an override.
 
-use std::cmp::Ordering;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -25,12 +24,14 @@ use serde::Serialize;
 
 mod file;
 mod input;
+mod order;
 mod pixel;
 
 pub use file::SeriesFile;
 pub use input::{
     is_manifest, load, LoadedSeries, MemorySeries, Micrographs, OpenSeries, Planes, SeriesSpec,
 };
+pub use order::natural_cmp;
 pub use pixel::{
     pixel_size, pixel_size_warnings, PIXEL_SIZE_CONTRADICTION, SUB_DIFFRACTION_PIXEL_M,
 };
@@ -39,7 +40,7 @@ use crate::error::{Error, Location, Result};
 use contactscope::analysis::PlaneSource;
 use contactscope::image::{Plane, SampleType};
 use contactscope_formats::microscopy::select::{ChannelChoice, LoadAxis, SelectedPlane, Selection};
-use contactscope_formats::microscopy::MicroscopyFile;
+use contactscope_formats::microscopy::{LoadDefault, MicroscopyFile};
 use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
 use contactscope_formats::tiff::{TiffInfo, TiffReader};
@@ -82,43 +83,6 @@ impl Series {
     pub fn info_of(&self, path: &Path) -> Option<&SeriesFile> {
         self.files.iter().find(|f| f.path == path)
     }
-}
-
-/// Compare names so that digit runs compare by value: `img2` < `img10`.
-pub fn natural_cmp(a: &str, b: &str) -> Ordering {
-    let (mut a, mut b) = (a, b);
-    loop {
-        match (a.chars().next(), b.chars().next()) {
-            (None, None) => return Ordering::Equal,
-            (None, Some(_)) => return Ordering::Less,
-            (Some(_), None) => return Ordering::Greater,
-            (Some(x), Some(y)) if x.is_ascii_digit() && y.is_ascii_digit() => {
-                let (da, ra) = split_digits(a);
-                let (db, rb) = split_digits(b);
-                let (ta, tb) = (da.trim_start_matches('0'), db.trim_start_matches('0'));
-                let ord = ta
-                    .len()
-                    .cmp(&tb.len())
-                    .then(ta.cmp(tb))
-                    .then(da.len().cmp(&db.len()));
-                if ord != Ordering::Equal {
-                    return ord;
-                }
-                (a, b) = (ra, rb);
-            }
-            (Some(x), Some(y)) => {
-                if x != y {
-                    return x.cmp(&y);
-                }
-                (a, b) = (&a[x.len_utf8()..], &b[y.len_utf8()..]);
-            }
-        }
-    }
-}
-
-fn split_digits(s: &str) -> (&str, &str) {
-    let end = s.find(|c: char| !c.is_ascii_digit()).unwrap_or(s.len());
-    s.split_at(end)
 }
 
 fn is_image_name(path: &Path) -> bool {
@@ -218,45 +182,24 @@ fn refuse_map(info: &TiffInfo) -> Result<()> {
     ))
 }
 
-/// Resolve the channel of a TIFF file.
-fn tiff_channel(info: &TiffInfo, channel: Option<usize>) -> Result<usize> {
-    match channel {
-        None if info.channels > 1 => Err(Error::bad_input(
-            Location::file(&info.path),
-            format!(
-                "file has {} channels ({}); choose one with {}",
-                info.channels,
-                info.channel_layout.describe(),
-                Param::Channel.with_value(format!("0..{}", info.channels - 1))
-            ),
-        )),
-        Some(c) if c >= info.channels => Err(Error::bad_input(
-            Location::file(&info.path),
-            format!(
-                "channel {c} requested but the file has {} channel(s) (0..{})",
-                info.channels,
-                info.channels - 1
-            ),
-        )),
-        c => Ok(c.unwrap_or(0)),
-    }
-}
-
 /// Header facts of several files, opened once each, in first-use order.
 struct FileTable {
     files: Vec<SeriesFile>,
     index: HashMap<PathBuf, usize>,
     selection: Selection,
     load_axis: Option<LoadAxis>,
+    /// The files come from a manifest (which names their pages).
+    manifest: bool,
 }
 
 impl FileTable {
-    fn new(selection: Selection, load_axis: Option<LoadAxis>) -> Self {
+    fn new(selection: Selection, load_axis: Option<LoadAxis>, manifest: bool) -> Self {
         FileTable {
             files: Vec::new(),
             index: HashMap::new(),
             selection,
             load_axis,
+            manifest,
         }
     }
 
@@ -265,10 +208,14 @@ impl FileTable {
             return Ok(&self.files[i]);
         }
         let file = if contactscope_formats::microscopy::select::is_tiff(path) {
-            self.selection.check_tiff(path)?;
             let info = TiffReader::open(path)?.info().clone();
-            tiff_channel(&info, self.selection.tiff_channel(path)?)?;
-            SeriesFile::from_tiff(info)
+            // A manifest names a TIFF's pages one by one: a z stack's too.
+            let default = match self.manifest {
+                true => LoadDefault::AnyStack,
+                false => LoadDefault::Series,
+            };
+            let planes = self.selection.tiff_planes(&info, self.load_axis, default)?;
+            SeriesFile::from_tiff(info, planes)
         } else {
             SeriesFile::from_vendor(path, &self.selection, self.load_axis)?
         };
@@ -278,8 +225,8 @@ impl FileTable {
         Ok(self.files.last().expect("just pushed"))
     }
 
-    /// The channel index read: the chosen index; for a channel chosen by name (CZI, ND2, LIF
-    /// only: a TIFF refuses names in [`FileTable::get`]) the index it named in the first file.
+    /// The channel index read: the chosen index; for a channel chosen by name the index it
+    /// named in the first file.
     fn channel(&self) -> usize {
         match &self.selection.channel {
             None => 0,
@@ -316,11 +263,10 @@ pub fn from_files_selected(
     selection: &Selection,
     load_axis: Option<LoadAxis>,
 ) -> Result<Series> {
-    let mut table = FileTable::new(selection.clone(), load_axis);
+    let mut table = FileTable::new(selection.clone(), load_axis, false);
     let mut images = Vec::new();
     for path in collect_files(inputs)? {
-        let channel = table.channel();
-        let planes = table.get(&path)?.images(channel);
+        let planes = table.get(&path)?.images();
         images.extend(planes.into_iter().map(|(page, plane)| ImageRef {
             path: path.clone(),
             page,
@@ -447,7 +393,7 @@ pub fn from_manifest_selected(
     };
     let (page_col, friction_col) = (column("page"), force_column("friction")?);
     let base = manifest.parent().unwrap_or(Path::new("."));
-    let mut table = FileTable::new(selection.clone(), load_axis);
+    let mut table = FileTable::new(selection.clone(), load_axis, true);
     let mut images = Vec::new();
     for (i, row) in reader.records().enumerate() {
         let line = i + 2;
@@ -508,7 +454,7 @@ fn resolve_page(
     at: &Location,
 ) -> Result<(usize, Option<SelectedPlane>)> {
     let channel = table.channel();
-    let images = table.get(path)?.images(channel);
+    let images = table.get(path)?.images();
     let pages: Vec<usize> = images.iter().map(|(p, _)| *p).collect();
     let text = page_col.and_then(|c| row.get(c)).unwrap_or("").trim();
     if text.is_empty() {
@@ -749,18 +695,6 @@ fn work_units(images: &[ImageRef], threads: usize) -> Vec<Vec<usize>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn natural_order() {
-        let mut names = vec!["img10.tif", "img2.tif", "img1.tif", "img02.tif", "a.tif"];
-        names.sort_by(|a, b| natural_cmp(a, b));
-        assert_eq!(
-            names,
-            ["a.tif", "img1.tif", "img2.tif", "img02.tif", "img10.tif"]
-        );
-        assert_eq!(natural_cmp("T00009", "T00010"), Ordering::Less);
-        assert_eq!(natural_cmp("x", "x"), Ordering::Equal);
-    }
 
     #[test]
     fn page_lists_read_well() {

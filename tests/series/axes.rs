@@ -1,0 +1,198 @@
+//! A TIFF's pages read by the axes its metadata states (issue: "no wrong number from a file's
+//! axes"): an OME-TIFF's channels are not pooled into one series, an ImageJ hyperstack's focal
+//! planes are not taken for loads, a z stack is not a load series unless told so.
+//!
+//! The files are written here page by page with the ImageDescription each writer would give
+//! (OME-XML as tifffile writes it for axes TCYX; ImageJ's `channels/slices/frames`), and each
+//! result is compared with the same planes written as a plain single-channel TIFF.
+
+use std::path::Path;
+
+use tiff::encoder::{colortype, TiffEncoder};
+use tiff::tags::Tag;
+
+use crate::common::{run, run_ok, stderr};
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("UTF-8 path")
+}
+
+const W: usize = 48;
+
+/// A 48² plane: background 300 + a small ripple, a disk of radius `r` at `level` above it.
+fn disk(r: f64, level: u16, shift: u16) -> Vec<u16> {
+    (0..W * W)
+        .map(|i| {
+            let (x, y) = ((i % W) as f64 - 23.5, (i / W) as f64 - 23.5);
+            let ripple = ((i * 7919) % 23) as u16;
+            300 + shift + ripple + if x * x + y * y < r * r { level } else { 0 }
+        })
+        .collect()
+}
+
+/// Pages with `description` on the first one (uncompressed, 16-bit grey).
+fn write_tiff(path: &Path, pages: &[Vec<u16>], description: &str) {
+    let file = std::fs::File::create(path).unwrap();
+    let mut enc = TiffEncoder::new(file).unwrap();
+    for (k, page) in pages.iter().enumerate() {
+        let mut image = enc
+            .new_image::<colortype::Gray16>(W as u32, W as u32)
+            .unwrap();
+        if k == 0 {
+            image
+                .encoder()
+                .write_tag(Tag::ImageDescription, description)
+                .unwrap();
+        }
+        image.write_data(page).unwrap();
+    }
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+fn threshold(dir: &Path) -> f64 {
+    summary(dir)["threshold"]["value"].as_f64().unwrap()
+}
+
+fn areas(dir: &Path) -> Vec<f64> {
+    let (header, rows) = crate::common::read_csv(&dir.join("areas.csv"));
+    crate::common::column(&header, &rows, "contact_pixels")
+}
+
+/// analyze into `out`; the command must succeed.
+fn analyze(file: &Path, out: &Path, extra: &[&str]) {
+    let mut args = vec!["analyze", s(file), "--pixel-size", "200nm", "--out", s(out)];
+    args.extend_from_slice(extra);
+    run_ok(&args);
+}
+
+fn refused(args: &[&str]) -> String {
+    let out = run(args);
+    assert!(!out.status.success(), "{args:?} should fail");
+    stderr(&out)
+}
+
+#[test]
+fn ome_tiff_channels_are_channels_not_pages() {
+    let tmp = tempfile::tempdir().unwrap();
+    let radii = [4.0, 7.0, 10.0, 13.0];
+    // TCYX: channel 0 fluorescence (disks growing with the load), channel 1 a bright reflection.
+    let fluo: Vec<Vec<u16>> = radii.iter().map(|&r| disk(r, 2000, 0)).collect();
+    let refl: Vec<Vec<u16>> = radii.iter().map(|_| disk(20.0, 800, 1200)).collect();
+    let pages: Vec<Vec<u16>> = (0..4)
+        .flat_map(|t| [fluo[t].clone(), refl[t].clone()])
+        .collect();
+    let xml = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?><OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06" Creator="tifffile.py 2026.3.3"><Image ID="Image:0" Name="Image0"><Pixels ID="Pixels:0" DimensionOrder="XYCZT" Type="uint16" SizeX="{W}" SizeY="{W}" SizeC="2" SizeZ="1" SizeT="4" PhysicalSizeX="0.2" PhysicalSizeXUnit="um" PhysicalSizeY="0.2" PhysicalSizeYUnit="um"><Channel ID="Channel:0:0" Name="fluo" SamplesPerPixel="1"/><Channel ID="Channel:0:1" Name="refl" SamplesPerPixel="1"/><TiffData IFD="0" PlaneCount="8"/></Pixels></Image></OME>"#
+    );
+    let ome = tmp.path().join("tcyx.ome.tif");
+    write_tiff(&ome, &pages, &xml);
+    let plain = tmp.path().join("fluo.tif");
+    write_tiff(&plain, &fluo, "plain pages");
+
+    // info names the axes and the channels.
+    let info = run_ok(&["info", s(&ome), "--json"]);
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    let series = &info["series"][0];
+    assert_eq!(series["axes"]["C"], 2);
+    assert_eq!(series["axes"]["T"], 4);
+    assert_eq!(series["channels"][1]["name"], "refl");
+    assert_eq!(series["axes_from"], "ome");
+
+    // Without a channel: one refusal naming both channels.
+    let forces = "4,10,20,40mN";
+    let e = refused(&["analyze", s(&ome), "--forces", forces]);
+    assert!(e.contains("2 channels") && e.contains("'fluo'"), "{e}");
+    // By name and by index: the fluorescence alone, as the plain file gives it.
+    let (by_name, by_index, alone) = (
+        tmp.path().join("name"),
+        tmp.path().join("index"),
+        tmp.path().join("alone"),
+    );
+    analyze(&ome, &by_name, &["--channel", "fluo", "--forces", forces]);
+    analyze(&ome, &by_index, &["--channel", "0", "--forces", forces]);
+    analyze(&plain, &alone, &["--forces", forces]);
+    assert_eq!(threshold(&by_name), threshold(&alone));
+    assert_eq!(areas(&by_name), areas(&alone));
+    assert_eq!(areas(&by_index), areas(&alone));
+    // The reflection channel is a channel of its own, chosen by index.
+    let refl_dir = tmp.path().join("refl");
+    analyze(&ome, &refl_dir, &["--channel", "1", "--forces", forces]);
+    assert_ne!(threshold(&refl_dir), threshold(&alone));
+}
+
+#[test]
+fn imagej_hyperstack_focal_planes_are_not_loads() {
+    let tmp = tempfile::tempdir().unwrap();
+    let radii = [4.0, 7.0, 10.0, 13.0];
+    // 4 time points × 2 focal planes (ImageJ order: slice fastest here, one channel).
+    let focus: Vec<Vec<u16>> = radii.iter().map(|&r| disk(r, 2000, 0)).collect();
+    let blurred: Vec<Vec<u16>> = radii.iter().map(|_| disk(18.0, 150, 0)).collect();
+    let pages: Vec<Vec<u16>> = (0..4)
+        .flat_map(|t| [focus[t].clone(), blurred[t].clone()])
+        .collect();
+    let hyper = tmp.path().join("tzyx.tif");
+    write_tiff(
+        &hyper,
+        &pages,
+        "ImageJ=1.54f\nimages=8\nslices=2\nframes=4\nhyperstack=true\nunit=micron\nspacing=0.5\nloop=false\n",
+    );
+    let plain = tmp.path().join("focus.tif");
+    write_tiff(&plain, &focus, "plain pages");
+    let forces = "4,10,20,40mN";
+    let e = refused(&["analyze", s(&hyper), "--forces", forces]);
+    assert!(e.contains("2 z planes") && e.contains("--z 0..1"), "{e}");
+    let (z0, z1, alone) = (
+        tmp.path().join("z0"),
+        tmp.path().join("z1"),
+        tmp.path().join("alone"),
+    );
+    analyze(
+        &hyper,
+        &z0,
+        &["--load-axis", "t", "--z", "0", "--forces", forces],
+    );
+    analyze(&plain, &alone, &["--forces", forces]);
+    assert_eq!(threshold(&z0), threshold(&alone));
+    assert_eq!(areas(&z0), areas(&alone));
+    // The other focal plane is there too, and is another image.
+    analyze(&hyper, &z1, &["--z", "1", "--forces", forces]);
+    assert_ne!(areas(&z1), areas(&alone));
+}
+
+#[test]
+fn a_z_stack_is_a_load_series_only_when_told() {
+    let tmp = tempfile::tempdir().unwrap();
+    let pages: Vec<Vec<u16>> = [4.0, 7.0, 10.0, 13.0]
+        .iter()
+        .map(|&r| disk(r, 2000, 0))
+        .collect();
+    let stack = tmp.path().join("zstack.tif");
+    write_tiff(
+        &stack,
+        &pages,
+        "ImageJ=1.53f\nimages=4\nslices=4\nunit=micron\nspacing=0.5\nloop=false\n",
+    );
+    let forces = "4,10,20,40mN";
+    let e = refused(&["analyze", s(&stack), "--forces", forces]);
+    assert!(
+        e.contains("zstack.tif")
+            && e.contains("z stack (4 focal planes 0.5 µm apart")
+            && e.contains("--load-axis z"),
+        "{e}"
+    );
+    let out = tmp.path().join("z");
+    analyze(&stack, &out, &["--load-axis", "z", "--forces", forces]);
+    assert_eq!(areas(&out).len(), 4);
+    // ImageJ slices without a spacing (how contactscope itself has written series) stay a
+    // series.
+    let slices = tmp.path().join("slices.tif");
+    write_tiff(
+        &slices,
+        &pages,
+        "ImageJ=1.11a\nimages=4\nslices=4\nloop=false\n",
+    );
+    analyze(&slices, &tmp.path().join("s"), &["--forces", forces]);
+}
