@@ -10,7 +10,7 @@ use contactscope_jobs::hertz::HertzRequest;
 use contactscope_jobs::table::value_pm;
 
 use super::args::{default_out, load_forces, Forces, OutputFolder};
-use super::common::{command_line, print_written};
+use super::common::{command_line, print_warnings, print_written};
 
 default_out!(Out, "contactscope-out/hertz");
 
@@ -58,6 +58,7 @@ pub fn run(args: Args) -> Result<()> {
             p.contact_radius_m * 1e6
         );
     }
+    print_warnings(&outcome.warnings);
     print_written(written.len(), &args.out.out);
     Ok(())
 }

@@ -558,3 +558,114 @@ fn a_solver_that_does_not_converge_names_the_map() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(!out.exists());
 }
+
+/// Physics checks on every result (`docs/conventions.md`, "Plausible results"): a number no
+/// contact can give is kept, with a warning naming the likely cause.
+#[test]
+fn impossible_results_are_warned_of_with_their_likely_cause() {
+    let dir = tempfile::tempdir().unwrap();
+    // Forces listed from the largest load: the area falls as the load rises.
+    let series = fixture_series().join("series.tif");
+    let out = dir.path().join("reversed");
+    let o = run_ok(&[
+        "analyze",
+        s(&series),
+        "--forces",
+        "100,63,40,25,16,10,6,4mN",
+        "--out",
+        s(&out),
+    ]);
+    let err = stderr(&o);
+    assert!(
+        err.contains("area falls as the load rises") && err.contains("wrong order"),
+        "{err}"
+    );
+    let warnings = json(&out.join("summary.json"))["warnings"].to_string();
+    assert!(warnings.contains("wrong order"), "{warnings}");
+    // In load order: no such warning.
+    let o = run_ok(&[
+        "analyze",
+        s(&series),
+        "--forces",
+        "4,6,10,16,25,40,63,100mN",
+        "--out",
+        s(&dir.path().join("ordered")),
+    ]);
+    assert!(!stderr(&o).contains("wrong order"), "{}", stderr(&o));
+
+    // A squeeze test in mN under a header that says N: E* a thousand times too stiff.
+    let mut csv = String::from("force_N,displacement_um\n");
+    let (r, e_star) = (290e-6_f64, 3.7e9_f64);
+    for i in 1..=20 {
+        let p = 2e-3 * f64::from(i);
+        let delta = (3.0 * p / (4.0 * e_star * r.sqrt())).powf(2.0 / 3.0);
+        csv.push_str(&format!("{},{}\n", p * 1e3, 2.0 * delta * 1e6));
+    }
+    let squeeze = dir.path().join("squeeze.csv");
+    std::fs::write(&squeeze, csv).unwrap();
+    let out = dir.path().join("hertz");
+    let o = run_ok(&["hertz", s(&squeeze), "--radius", "290um", "--out", s(&out)]);
+    let err = stderr(&o);
+    assert!(
+        err.contains("contact modulus E*") && err.contains("_N") && err.contains("squeeze.csv"),
+        "{err}"
+    );
+    let hertz = json(&out.join("hertz.json"));
+    assert!(hertz["warnings"][0].as_str().unwrap().contains("diamond"));
+
+    // A friction trace whose friction_N column holds mN: μ in the hundreds.
+    let mut trace = String::from("time_s,friction_N,normal_force_mN\n");
+    for i in 0..=200 {
+        let t = f64::from(i) * 0.5;
+        let f = if t <= 50.0 { 0.4 * t } else { 14.0 };
+        let wiggle = 0.01 * ((i * 37) % 7) as f64;
+        trace.push_str(&format!("{t},{},40\n", f + wiggle));
+    }
+    let trace_path = dir.path().join("trace.csv");
+    std::fs::write(&trace_path, trace).unwrap();
+    let o = run_ok(&[
+        "friction",
+        s(&trace_path),
+        "--out",
+        s(&dir.path().join("friction")),
+    ]);
+    let err = stderr(&o);
+    assert!(
+        err.contains("static friction coefficient μ") && err.contains("trace.csv"),
+        "{err}"
+    );
+}
+
+/// Heights stored in µm but read as metres: an rms height of metres and slopes in the
+/// thousands are named, with the option that fixes them.
+#[test]
+fn heights_in_the_wrong_unit_are_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::new();
+    for y in 0..32 {
+        let row: Vec<String> = (0..32)
+            .map(|x| format!("{:.4}", 0.1 * ((x * 7 + y * 13) % 11) as f64 - 0.5))
+            .collect();
+        text.push_str(&row.join(" "));
+        text.push('\n');
+    }
+    let map = dir.path().join("heights_um.txt");
+    std::fs::write(&map, text).unwrap();
+    let o = run_ok(&["topography", s(&map), "--pixel-size", "100nm"]);
+    let err = stderr(&o);
+    assert!(
+        err.contains("rms height") && err.contains("--height-unit"),
+        "{err}"
+    );
+    assert!(err.contains("rms slope"), "{err}");
+    // Told the unit: no warning.
+    let o = run_ok(&[
+        "topography",
+        s(&map),
+        "--pixel-size",
+        "100nm",
+        "--height-unit",
+        "1um",
+    ]);
+    assert!(!stderr(&o).contains("rms height"), "{}", stderr(&o));
+}

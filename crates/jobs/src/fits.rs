@@ -152,6 +152,11 @@ pub fn power_law_warnings(fit: Option<&PowerLawFit>, points: &[LoadPoint]) -> Ve
         };
     };
     let mut out = Vec::new();
+    // Physics check (`crate::physics`): β < 0, significant when 2 standard errors below 0.
+    let significant = fit
+        .exponent_se
+        .is_some_and(|se| fit.exponent + 2.0 * se < 0.0);
+    out.extend(crate::physics::falling_area(fit.exponent, significant));
     if fit.distinct_forces < 3 {
         out.push(format!(
             "the power law rests on {} point(s) at {} distinct force(s): a line through two \

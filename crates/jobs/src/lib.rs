@@ -27,6 +27,7 @@ pub mod heights;
 pub mod images;
 pub mod lab;
 pub mod mechanics_csv;
+pub mod physics;
 #[cfg(feature = "plots")]
 pub mod plot;
 pub mod provenance;

@@ -23,7 +23,8 @@ pub const PIXEL_SIZE_TOLERANCE: f64 = 0.01;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Flag {
     /// `failed`, `edge_contact`, `weak_fit`, `threshold_outlier`, `pixel_size_default`,
-    /// `pixel_size_vs_metadata`, `no_pixel_size`, `no_forces`, `warnings`, `fit_warnings`.
+    /// `pixel_size_vs_metadata`, `no_pixel_size`, `no_forces`, `physics`, `warnings`,
+    /// `fit_warnings`.
     pub code: &'static str,
     /// In words, with this series' numbers.
     pub text: String,
@@ -39,6 +40,7 @@ pub const CODES: &[&str] = &[
     "pixel_size_vs_metadata",
     "no_pixel_size",
     "no_forces",
+    "physics",
     "warnings",
     "fit_warnings",
 ];
@@ -148,6 +150,25 @@ fn series_flags(record: &Record, thresholds: &ThresholdStats) -> Vec<Flag> {
     }
     if result.images.iter().all(|i| i.force_mn.is_none()) {
         flag("no_forces", "no forces: areas per image, no fits".into());
+    }
+    // Physics checks (`crate::physics`): an area that falls as the load rises, pressures beyond
+    // any contact.
+    let physics: Vec<String> = result
+        .power_law
+        .as_ref()
+        .and_then(|p| {
+            let significant = p.exponent_se.is_some_and(|se| p.exponent + 2.0 * se < 0.0);
+            crate::physics::falling_area(p.exponent, significant)
+        })
+        .into_iter()
+        .chain(result.mean_pressure_range_mpa.iter().flat_map(|&(lo, hi)| {
+            [lo, hi].into_iter().filter_map(|p| {
+                crate::physics::check(crate::physics::Checked::MeanPressure, p * 1e6)
+            })
+        }))
+        .collect();
+    if !physics.is_empty() {
+        flag("physics", physics.join("; "));
     }
     if !result.warnings.is_empty() {
         flag(

@@ -286,6 +286,15 @@ pub fn run(request: &FrictionRequest) -> Result<FrictionOutcome> {
         .iter()
         .map(|path| analyse_trace(path, request, &mut warnings))
         .collect::<Result<Vec<_>>>()?;
+    // Physics checks (`crate::physics`): μ outside any dry contact's range names the likely unit.
+    for t in &traces {
+        for (kind, mu) in [("static", t.mu_static()), ("kinetic", t.mu_kinetic())] {
+            if let Some(w) = crate::physics::check(crate::physics::Checked::FrictionCoefficient, mu)
+            {
+                warnings.push(format!("{}: {kind} {w}", t.file.display()));
+            }
+        }
+    }
     if let Some(path) = &request.areas {
         let areas = read_areas_csv(path)?;
         match_areas(&mut traces, &areas, request.force_tolerance, path)?;

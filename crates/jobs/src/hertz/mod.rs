@@ -103,6 +103,8 @@ pub struct HertzOutcome {
     pub offset_fit: Option<HertzFit>,
     /// The Hertz contact at each load asked for.
     pub predicted: Vec<HertzPrediction>,
+    /// Physics checks that failed ([`crate::physics`]): E* outside any solid's range.
+    pub warnings: Vec<String>,
 }
 
 impl HertzOutcome {
@@ -181,6 +183,7 @@ impl Serialize for HertzOutcome {
         m.serialize_entry("offset_fit", &self.offset_fit.as_ref().map(OffsetFitJson))?;
         m.serialize_entry("predicted", &self.predicted)?;
         m.serialize_entry("points", &self.fit_points())?;
+        m.serialize_entry("warnings", &self.warnings)?;
         m.end()
     }
 }
@@ -208,6 +211,10 @@ pub fn run(request: &HertzRequest) -> Result<HertzOutcome> {
             }
         })
         .collect();
+    let warnings = crate::physics::check(crate::physics::Checked::ContactModulus, fit.e_star_pa)
+        .map(|w| format!("{}: {w}", request.input.display()))
+        .into_iter()
+        .collect();
     Ok(HertzOutcome {
         input: request.input.clone(),
         radius_m: request.radius_m,
@@ -215,5 +222,6 @@ pub fn run(request: &HertzRequest) -> Result<HertzOutcome> {
         fit,
         offset_fit,
         predicted,
+        warnings,
     })
 }

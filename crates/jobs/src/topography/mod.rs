@@ -254,11 +254,13 @@ pub fn run(request: &TopographyRequest) -> Result<TopographyOutcome> {
         .chain(source.fill(&mut map))
         .collect();
     let detrend = source.detrend;
+    let mut notes = notes;
     match usable(path, map) {
         Ok(mut topography) => {
             topography.detrend(detrend);
             let stats = SurfaceStats::finite_differences(&topography)
                 .map_err(|e| Error::bad_input(Location::file(path), e.to_string()))?;
+            notes.extend(physics_notes(path, stats.h_rms_m, Some(stats.h_prime_rms)));
             Ok(TopographyOutcome {
                 summary: TopographyDescription {
                     stored,
@@ -278,13 +280,27 @@ pub fn run(request: &TopographyRequest) -> Result<TopographyOutcome> {
         // outside the plausible ranges): its summary as stored still stands, with the reason
         // it cannot be used for a contact calculation.
         Err(e) => Ok(TopographyOutcome {
+            notes: {
+                notes.extend(physics_notes(path, stored.h_rms_m, None));
+                notes
+            },
             summary: TopographyDescription {
                 stored,
                 detrended: None,
                 note: Some(e.to_string()),
             },
-            notes,
             heights: None,
         }),
     }
+}
+
+/// The physics checks of a height map ([`crate::physics`]): an rms height over 1 mm or an rms
+/// slope over 10 names the likely unit.
+fn physics_notes(path: &std::path::Path, h_rms_m: f64, slope_rms: Option<f64>) -> Vec<String> {
+    use crate::physics::{check, Checked};
+    check(Checked::HeightRms, h_rms_m)
+        .into_iter()
+        .chain(slope_rms.and_then(|s| check(Checked::SlopeRms, s)))
+        .map(|w| format!("{}: {w}", path.display()))
+        .collect()
 }
