@@ -96,3 +96,46 @@ fn a_walk_writes_the_samplesheet_it_used() {
         stderr(&o)
     );
 }
+
+/// A folder of micrographs the walk does not take (no manifest, no matching pattern) is named
+/// with the options that would take it, on the terminal and in batch.json; never skipped in
+/// silence.
+#[test]
+fn folders_of_tiffs_the_walk_does_not_take_are_listed_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let archive = dir.join("archive");
+    synth(&archive.join("glass"), "run1", 1, &[]);
+    let plain = synth(&archive, "plain", 2, &[]);
+    std::fs::remove_file(plain.join("manifest.csv")).unwrap();
+    let args = ["archive", "--pixel-size", "200nm", "--out", "results"];
+    let o = batch(dir, &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(counts(&stdout), (1, 0), "{stdout}");
+    let err = stderr(&o);
+    assert!(
+        err.contains("not a series")
+            && err.contains("plain")
+            && err.contains("--tiff-folders")
+            && err.contains("--pattern"),
+        "{err}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("results/batch.json")).unwrap()).unwrap();
+    assert!(json["warnings"].to_string().contains("plain"), "{json}");
+    // Taken when asked: the folder is a series of its own.
+    let args = [
+        "archive",
+        "--tiff-folders",
+        "--forces",
+        "1,2,4,8mN",
+        "--pixel-size",
+        "200nm",
+        "--out",
+        "results2",
+    ];
+    let o = batch(dir, &args);
+    assert!(!stderr(&o).contains("not a series"), "{}", stderr(&o));
+    assert_eq!(counts(&String::from_utf8_lossy(&o.stdout)).0, 2);
+}

@@ -37,8 +37,12 @@ impl Dimension {
 
     /// SI factor of a unit symbol of this dimension, `None` if the symbol is not one.
     pub(crate) fn factor(self, unit: &str) -> Option<f64> {
+        // The micro sign (U+00B5), the Greek small letter mu (U+03BC) that keyboards and
+        // Unicode normalisation (NFKC) give for it, or ASCII `u`.
         fn micro(u: &str) -> Option<&str> {
-            u.strip_prefix('u').or_else(|| u.strip_prefix('µ'))
+            u.strip_prefix('u')
+                .or_else(|| u.strip_prefix('\u{b5}'))
+                .or_else(|| u.strip_prefix('\u{3bc}'))
         }
         match self {
             Dimension::Length => match unit {
@@ -464,6 +468,12 @@ mod tests {
             [4e-3, 6e-3]
         );
         assert_relative_eq!(parse_quantity("290 µm", Dimension::Length).unwrap(), 290e-6);
+        // Greek mu (U+03BC) as the micro sign (U+00B5).
+        assert_relative_eq!(
+            parse_quantity("290 \u{3bc}m", Dimension::Length).unwrap(),
+            290e-6
+        );
+        assert_relative_eq!(parse_quantity("5\u{3bc}N", Dimension::Force).unwrap(), 5e-6);
         assert_relative_eq!(
             parse_quantity("3.7GPa", Dimension::Pressure).unwrap(),
             3.7e9

@@ -24,17 +24,19 @@ pub(crate) fn sniff_delimiter(text: &str) -> u8 {
         .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
     match first {
         Some(l) if l.contains(';') && !l.contains(',') => b';',
+        // Tab-separated (spreadsheets' "Text (Tab delimited)").
+        Some(l) if l.contains('\t') && !l.contains(',') && !l.contains(';') => b'\t',
         _ => b',',
     }
 }
 
-/// A number cell of a CSV with `delimiter`: in a semicolon-separated file a decimal comma
-/// (`4,5`) is the decimal point.
+/// A number cell of a CSV with `delimiter`: in a semicolon- or tab-separated file a decimal
+/// comma (`4,5`) is the decimal point.
 pub(crate) fn parse_number(cell: &str, delimiter: u8) -> Option<f64> {
     let cell = cell.trim();
     match cell.parse::<f64>() {
         Ok(v) => Some(v),
-        Err(_) if delimiter == b';' && cell.matches(',').count() == 1 && !cell.contains('.') => {
+        Err(_) if delimiter != b',' && cell.matches(',').count() == 1 && !cell.contains('.') => {
             cell.replace(',', ".").parse().ok()
         }
         Err(_) => None,
@@ -331,6 +333,18 @@ pub fn sci3(value: &serde_json::Value) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn delimiters_are_sniffed_from_the_header() {
+        assert_eq!(sniff_delimiter("file,force_mN\na.tif,4\n"), b',');
+        assert_eq!(sniff_delimiter("file;force_mN\na.tif;4,5\n"), b';');
+        assert_eq!(
+            sniff_delimiter("\u{feff}file\tforce_mN\na.tif\t4,5\n"),
+            b'\t'
+        );
+        assert_eq!(parse_number("4,5", b'\t'), Some(4.5));
+        assert_eq!(parse_number("4,5", b','), None);
+    }
 
     #[test]
     fn uncertainties_keep_two_significant_digits_and_values_their_decimal_place() {

@@ -162,6 +162,7 @@ def _stack(images: Any) -> np.ndarray:
         a = a[np.newaxis]
     if a.ndim != 3:
         raise InputError(f"images must be a 2-D image or a 3-D stack; got {a.ndim} dimensions")
+    _check_axes(a)
     if a.dtype.type not in _STACK_TYPES:
         if np.issubdtype(a.dtype, np.integer) and a.size and a.min() >= 0 and a.max() <= 65535:
             a = a.astype(np.uint16)
@@ -170,16 +171,46 @@ def _stack(images: Any) -> np.ndarray:
     return np.ascontiguousarray(a)
 
 
+def _check_axes(a: np.ndarray) -> None:
+    """A stack is (loads, rows, columns): an RGB(A) image (last axis 3 or 4, the others larger)
+    is refused, and a last axis far shorter than the others (the loads last?) is warned of."""
+    n, rows, cols = a.shape
+    if cols in (3, 4) and n > 4 and rows > 4:
+        kind = "RGB" if cols == 3 else "RGBA"
+        raise InputError(
+            f"images of shape {a.shape} look like one {kind} image (a last axis of {cols}), not "
+            f"a stack of {n} images of {rows}×{cols} pixels: pass one channel "
+            f"(images[..., 1] for green) or cs.rgb_to_gray(images); a stack is "
+            f"(load, rows, columns)")
+    if cols * 8 <= min(n, rows) and cols <= 64:
+        _warnings.warn(
+            f"the stack's last axis ({cols}) is far shorter than its others ({n}, {rows}): a "
+            f"stack is (load, rows, columns); if the loads are the last axis, pass "
+            f"np.moveaxis(images, -1, 0)", ContactscopeWarning, stacklevel=4)
+
+
+def rgb_to_gray(image: Any) -> np.ndarray:
+    """An RGB or RGBA image (rows, columns, 3 or 4) as one grey image (float64): the luma of
+    ITU-R BT.601, 0.299 R + 0.587 G + 0.114 B; the alpha channel is dropped. For a
+    fluorescence image stored as RGB, one channel (``image[..., 1]`` for green) is usually
+    the better choice: the others hold no signal."""
+    a = np.asarray(image)
+    if a.ndim < 3 or a.shape[-1] not in (3, 4):
+        raise InputError(f"rgb_to_gray needs (..., 3) or (..., 4) values; got shape {a.shape}")
+    rgb = a[..., :3].astype(np.float64)
+    return rgb @ np.array([0.299, 0.587, 0.114])
+
+
 def read_image(path: PathLike, channel: Union[int, str, None] = None,
                pixel_size: Optional[PixelSize] = None, *, series: Optional[int] = None,
                z: Optional[int] = None, t: Optional[int] = None,
                axes: Optional[Dict[str, int]] = None,
                load_axis: Optional[str] = None) -> Results:
-    """Images of a TIFF (every page of one channel) or of a Zeiss CZI, Nikon ND2 or Leica LIF
-    file (found by content), in the file's stored sample type (uint8, uint16, int16 or
-    float32, as tifffile returns them).
+    """Images of a TIFF, Zeiss CZI, Nikon ND2 or Leica LIF file (found by content), in the
+    file's stored sample type (uint8, uint16, int16 or float32, as tifffile returns them).
 
-    A vendor file gives the plane that ``series``, ``channel``, ``z``, ``t`` and ``axes`` (extra
+    A TIFF has the axes its OME-XML or ImageJ description states (plain pages are time
+    points); a file gives the plane that ``series``, ``channel``, ``z``, ``t`` and ``axes`` (extra
     axes by name, e.g. ``{"H": 3}`` for an Airyscan phase) select, or every plane along
     ``load_axis`` ("t", "z" or "series") — as the command line's selection flags: an axis
     longer than 1 must be chosen (the error lists every such axis at once), and ``channel`` is
@@ -770,11 +801,15 @@ def hertz(squeeze: PathLike, radius: float, loads: Optional[Sequence[float]] = N
     ``contact_offset_displacement_m``), ``radius_m``, ``predicted`` (per load: ``force_n``,
     ``contact_radius_m``, ``contact_area_m2``; also :attr:`Results.rows`), ``method``, and
     ``points``: the fitted points as ``hertz_fit.csv`` has them (``force_n``,
-    ``displacement_m``, ``delta_m``, ``fitted_force_n``, ``residual_n``).
+    ``displacement_m``, ``delta_m``, ``fitted_force_n``, ``residual_n``); ``warnings`` (a
+    modulus outside any solid's range, naming the likely unit; also issued as
+    :class:`ContactscopeWarning`).
     """
     loads = _opt_numbers(loads, "loads", "N")
     radius = _number(radius, "radius", "m")
-    return Results(_cs.hertz(os.fspath(squeeze), radius, loads), table="predicted")
+    result = Results(_cs.hertz(os.fspath(squeeze), radius, loads), table="predicted")
+    _warn(result)
+    return result
 
 
 def parse_forces(text: str) -> list:
@@ -842,7 +877,7 @@ def write_tiff(path: PathLike, stack: Any, pixel_size: Optional[PixelSize] = Non
     _cs.write_tiff(os.fspath(path), np.ascontiguousarray(a), pixel_size)
 
 
-__all__ += ["synth_series", "synth_beads", "synth_newton", "write_tiff"]
+__all__ += ["synth_series", "synth_beads", "synth_newton", "write_tiff", "rgb_to_gray"]
 
 from .archive import BatchResult, batch  # noqa: E402  (uses the names above)
 

@@ -89,7 +89,12 @@ pub fn finish(plan: Plan, fresh: Vec<Record>) -> Result<BatchOutcome> {
         }
     }
     let tables_seconds = tables_clock.elapsed().as_secs_f64();
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> = plan
+        .sheet
+        .skipped
+        .iter()
+        .map(|s| format!("not a series: {s}"))
+        .collect();
     let stale = stale_records(&out, &plan);
     if !stale.is_empty() {
         warnings.push(format!(

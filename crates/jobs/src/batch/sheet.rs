@@ -76,6 +76,9 @@ pub struct Sheet {
     pub rows: Vec<Row>,
     /// SHA-256 of the samplesheet's bytes.
     pub sha256: String,
+    /// What a folder walk found and did not take as a series, each "PATH: why" (empty for a
+    /// samplesheet read from a file).
+    pub skipped: Vec<String>,
 }
 
 /// Names the batch's tables use for their own columns: a metadata column may not take one.
@@ -196,6 +199,7 @@ impl Sheet {
                 .collect(),
             rows,
             sha256: crate::provenance::sha256_bytes(bytes),
+            skipped: Vec::new(),
         })
     }
 

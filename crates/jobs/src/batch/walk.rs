@@ -4,7 +4,9 @@
 //! series of its own; with `tiff_folders`, so is every other folder holding TIFF files. A series'
 //! id is its path below the archive with `/` as `-` (`sampleA/run1.czi` → `sampleA-run1`).
 //! Hidden entries (names starting with `.`) and the batch's own output folder are skipped;
-//! symbolic links are not followed. The walk is in natural order (`run2` before `run10`) and
+//! symbolic links are not followed. A folder holding TIFF files that no pattern takes, and no
+//! manifest, is not a series unless `tiff_folders`: it is listed in [`Sheet::skipped`] with the
+//! options that would take it (the batch prints it as a warning). The walk is in natural order (`run2` before `run10`) and
 //! writes the samplesheet it used, so that the next run can be edited by hand and repeated.
 
 use std::path::{Component, Path, PathBuf};
@@ -43,6 +45,8 @@ pub fn walk(spec: &WalkSpec, skip: Option<&Path>) -> Result<Sheet> {
     let patterns = globs(&spec.patterns)?;
     let skip = skip.and_then(|s| s.canonicalize().ok());
     let mut found: Vec<(PathBuf, bool)> = Vec::new();
+    // Folders of micrographs that are not series, with the reason.
+    let mut skipped: Vec<String> = Vec::new();
     let mut entries = walkdir::WalkDir::new(root)
         .follow_links(false)
         .sort_by(|a, b| {
@@ -77,6 +81,13 @@ pub fn walk(spec: &WalkSpec, skip: Option<&Path>) -> Result<Sheet> {
                 entries.skip_current_dir();
             } else if spec.tiff_folders && holds_tiffs(path) {
                 found.push((path.to_path_buf(), true));
+            } else if let Some(n) = unmatched_tiffs(path, &patterns) {
+                skipped.push(format!(
+                    "{}: {n} TIFF file(s) and no manifest.csv; not taken as series (give \
+                     --tiff-folders to take each such folder as one series, --pattern '*.tif' to \
+                     take each multi-page TIFF as one, or put a manifest.csv in the folder)",
+                    path.display()
+                ));
             }
         } else if entry.file_type().is_file() && patterns.is_match(entry.file_name()) {
             found.push((path.to_path_buf(), false));
@@ -86,12 +97,16 @@ pub fn walk(spec: &WalkSpec, skip: Option<&Path>) -> Result<Sheet> {
         return Err(Error::bad_input(
             Location::file(root),
             format!(
-                "no series found: no folder holds manifest.csv and no file matches {}{}",
+                "no series found: no folder holds manifest.csv and no file matches {} (--pattern){}{}",
                 pattern_list(&spec.patterns),
                 if spec.tiff_folders {
                     " and no folder holds TIFF files"
                 } else {
                     ""
+                },
+                match skipped.first() {
+                    Some(first) => format!("; {first}"),
+                    None => String::new(),
                 }
             ),
         ));
@@ -148,6 +163,7 @@ pub fn walk(spec: &WalkSpec, skip: Option<&Path>) -> Result<Sheet> {
         option_columns: Vec::new(),
         rows,
         sha256: String::new(),
+        skipped,
     })
 }
 
@@ -177,6 +193,21 @@ fn globs(patterns: &[String]) -> Result<GlobSet> {
     builder
         .build()
         .map_err(|e| Error::InvalidArgument(format!("patterns: {e}")))
+}
+
+/// The TIFF files of `dir` that no pattern takes as a series (`None` for none).
+fn unmatched_tiffs(dir: &Path, patterns: &GlobSet) -> Option<usize> {
+    let n = std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(|e| e.ok())
+        .filter(|e| {
+            let name = e.file_name().to_string_lossy().to_ascii_lowercase();
+            !name.starts_with('.')
+                && (name.ends_with(".tif") || name.ends_with(".tiff"))
+                && !patterns.is_match(e.file_name())
+        })
+        .count();
+    (n > 0).then_some(n)
 }
 
 fn holds_tiffs(dir: &Path) -> bool {

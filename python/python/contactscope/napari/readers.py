@@ -112,11 +112,7 @@ def _planes_of_channel(path: str, fmt: str, series: int, channel: int,
                        shape: Tuple[int, int]) -> np.ndarray:
     """One channel of one series as (T, Z, extra axes…, Y, X)."""
     nt, nz = sizes["T"], sizes["Z"]
-    if fmt == "tiff":
-        pages = cs.read_image(path, channel=channel).images
-        if pages.shape[0] == nt * nz:
-            return pages.reshape(nt, nz, *shape)
-        return pages.reshape(pages.shape[0], 1, *shape)
+    # Every format, TIFF too, by the axes `info` gives (a TIFF's OME-XML or ImageJ axes).
     stacks = []
     for combo in itertools.product(range(nz), *[range(n) for n in extras.values()]):
         z, rest = combo[0], dict(zip(extras, combo[1:]))

@@ -1,0 +1,87 @@
+"""A TIFF's planes read by the axes its metadata states, as tifffile reads them
+(``series[0].axes``), over a matrix of axis orders and sizes; arrays on the wrong axis refused
+or warned of."""
+
+import numpy as np
+import pytest
+
+import contactscope as cs
+
+tifffile = pytest.importorskip("tifffile")
+
+SIZES = {"T": 3, "Z": 2, "C": 2, "Y": 12, "X": 10}
+
+
+def _data(axes):
+    """Every plane distinct: its values encode its position."""
+    shape = tuple(SIZES[a] for a in axes)
+    planes = int(np.prod(shape[:-2]))
+    base = (np.arange(planes, dtype=np.uint16) * 100 + 200).reshape(shape[:-2] + (1, 1))
+    ramp = np.arange(SIZES["Y"] * SIZES["X"], dtype=np.uint16).reshape(SIZES["Y"], SIZES["X"])
+    return (base + ramp % 50).astype(np.uint16)
+
+
+def _plane(data, axes, t, z, c):
+    index = tuple({"T": t, "Z": z, "C": c}.get(a, slice(None)) for a in axes)
+    return data[index]
+
+
+OME_AXES = ["TCYX", "CTYX", "TZCYX", "ZTCYX", "CZTYX", "TZYX", "ZCYX"]
+IMAGEJ_AXES = ["TZCYX", "TCYX", "ZCYX", "TZYX", "CYX", "TYX"]
+
+
+@pytest.mark.parametrize("writer,axes", [("ome", a) for a in OME_AXES]
+                         + [("imagej", a) for a in IMAGEJ_AXES])
+def test_planes_match_tifffile(tmp_path, writer, axes):
+    path = tmp_path / f"{writer}_{axes}.tif"
+    data = _data(axes)
+    if writer == "ome":
+        tifffile.imwrite(path, data, ome=True, metadata={"axes": axes})
+    else:
+        tifffile.imwrite(path, data, imagej=True, metadata={"axes": axes})
+    series = tifffile.TiffFile(path).series[0]
+    assert series.axes == axes, series.axes
+    info = cs.info(path)["series"][0]["axes"]
+    for a in "TZC":
+        assert info[a] == SIZES[a] if a in axes else info[a] == 1, (a, info)
+    ts = range(SIZES["T"]) if "T" in axes else [0]
+    zs = range(SIZES["Z"]) if "Z" in axes else [0]
+    cs_ = range(SIZES["C"]) if "C" in axes else [0]
+    for t in ts:
+        for z in zs:
+            for c in cs_:
+                got = cs.read_series(path, channel=c if "C" in axes else None,
+                                     z=z if "Z" in axes else None,
+                                     t=t if "T" in axes else None)["images"]
+                assert got.shape == (1, SIZES["Y"], SIZES["X"])
+                np.testing.assert_array_equal(got[0], _plane(data, axes, t, z, c),
+                                              err_msg=f"t {t} z {z} c {c}")
+    # Along the time points, one focal plane and channel: the planes tifffile gives.
+    if "T" in axes:
+        got = cs.read_series(path, channel=1 if "C" in axes else None,
+                             z=1 if "Z" in axes else None, load_axis="t")["images"]
+        want = np.stack([_plane(data, axes, t, 1, 1) for t in ts])
+        np.testing.assert_array_equal(got, want)
+
+
+def test_a_channel_by_its_ome_name(tmp_path):
+    path = tmp_path / "named.ome.tif"
+    data = _data("TCYX")
+    tifffile.imwrite(path, data, ome=True,
+                     metadata={"axes": "TCYX", "Channel": {"Name": ["fluo", "refl"]}})
+    got = cs.read_series(path, channel="refl")["images"]
+    np.testing.assert_array_equal(got, data[:, 1])
+    with pytest.raises(cs.InputError, match="'fluo'"):
+        cs.read_series(path)
+
+
+def test_rgb_arrays_are_refused_and_loads_last_warned_of():
+    rgb = np.zeros((64, 48, 3), np.uint16)
+    with pytest.raises(cs.InputError, match="rgb_to_gray"):
+        cs.otsu_threshold(rgb)
+    gray = cs.rgb_to_gray(rgb)
+    assert gray.shape == (64, 48)
+    stack = np.zeros((5, 64, 64), np.uint16)
+    stack[:, 20:40, 20:40] = 3000
+    with pytest.warns(cs.ContactscopeWarning, match="np.moveaxis"):
+        cs.otsu_threshold(np.moveaxis(stack, 0, -1))
