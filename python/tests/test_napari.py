@@ -175,7 +175,7 @@ def test_real_nd2_lif_and_tiff_hyperstack():
     tif = real("real-tiff/neubias/xyzc_16bit__dna_conf_wf.tif")
     layers = readers.get_micrograph_reader(str(tif))(str(tif))
     assert [d.shape for d, _, _ in layers] == [(45, 130, 133)] * 2
-    np.testing.assert_array_equal(layers[1][0], cs.read_image(tif, channel=1).images)
+    np.testing.assert_array_equal(layers[1][0], cs.read_image(tif, channel=1, load_axis="z").images)
 
 
 @needs_napari

@@ -625,6 +625,7 @@ class HertzResult(TypedDict):
     offset_fit: Optional[HertzOffsetFit]
     predicted: List[HertzPrediction]
     points: List[HertzPoint]
+    warnings: List[str]
 
 def hertz(squeeze: Path, radius: float, loads: Optional[Sequence[float]] = None) -> HertzResult: ...
 
@@ -642,7 +643,8 @@ class InfoChannel(TypedDict):
     excitation_m: Optional[float]
 
 class InfoSeries(TypedDict, total=False):
-    """One series (``planes`` only with ``stats=True``)."""
+    """One series (``planes`` only with ``stats=True``; ``axes_from`` for a TIFF: where its
+    axes come from, ``ome``, ``imagej`` or ``pages``)."""
 
     index: int
     name: str
@@ -651,6 +653,7 @@ class InfoSeries(TypedDict, total=False):
     channels: List[InfoChannel]
     pixel_size_m: VoxelSize
     pixel_size_source: Optional[str]
+    axes_from: str
     planes: List[Dict[str, Any]]
 
 class InfoResult(TypedDict):
