@@ -6,7 +6,7 @@
 //! so that one 65 536-bin histogram indexes any 8-bit, 16-bit or signed 16-bit image directly and
 //! exactly. Float data is held as `f32`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
@@ -203,6 +203,24 @@ pub struct Image {
 }
 
 impl Image {
+    /// A decoded plane of `path` (`page`: its IFD, or its place along the load axis) with its
+    /// pixel size.
+    pub fn of_plane(
+        plane: &Plane,
+        pixel_size: Option<PixelSize>,
+        path: &Path,
+        page: usize,
+    ) -> Self {
+        Image {
+            values: plane.to_f64(),
+            width: plane.width,
+            height: plane.height,
+            pixel_size,
+            path: path.to_path_buf(),
+            page,
+        }
+    }
+
     /// Value at column `x`, row `y`.
     pub fn at(&self, x: usize, y: usize) -> f64 {
         self.values[y * self.width + x]

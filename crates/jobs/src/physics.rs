@@ -71,8 +71,8 @@ pub const PLAUSIBLE: &[Plausible] = &[
     Plausible {
         what: Checked::MeanPressure,
         name: "mean pressure",
-        lo: 1e3,
-        hi: 20e9,
+        lo: crate::fits::LOWEST_PLAUSIBLE_PRESSURE_PA,
+        hi: crate::fits::IMPLAUSIBLE_PRESSURE_PA,
         factor: 1e-6,
         unit: "MPa",
         low_cause: "below any contact that bears a load: the pixel size too large, or the forces too small (mN given as N?)",

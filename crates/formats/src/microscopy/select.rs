@@ -17,7 +17,7 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::str::FromStr;
 
 use serde::Serialize;
@@ -539,14 +539,7 @@ pub fn read_images(
             series_pixel_size(file.format, &file.series[p.series]),
             pixel_size_m,
         );
-        images.push(Image {
-            values: plane.to_f64(),
-            width: plane.width,
-            height: plane.height,
-            pixel_size,
-            path: PathBuf::from(path),
-            page: p.load_index,
-        });
+        images.push(Image::of_plane(&plane, pixel_size, path, p.load_index));
     }
     Ok(images)
 }
@@ -567,14 +560,7 @@ fn read_tiff_planes(
         .into_iter()
         .map(|(_, (page, sample))| {
             let plane = reader.read_page(page, sample)?;
-            Ok(Image {
-                values: plane.to_f64(),
-                width: plane.width,
-                height: plane.height,
-                pixel_size,
-                path: path.to_path_buf(),
-                page,
-            })
+            Ok(Image::of_plane(&plane, pixel_size, path, page))
         })
         .collect()
 }
@@ -593,7 +579,7 @@ pub fn read_one_image(
                 selection
                     .channel
                     .as_ref()
-                    .map(|c| c.resolve(path, &[]))
+                    .map(|c| c.resolve(path, &super::series_of_tiff(&info).channels))
                     .transpose()?,
                 pixel_size_m,
             );

@@ -23,6 +23,9 @@ use serde::Serialize;
 
 use super::metadata::{length_unit_factor, ImageJDescription};
 
+/// The most planes an OME-XML description may state (the table of their pages is allocated).
+const MAX_PLANES: usize = 1 << 22;
+
 /// Where a TIFF's axes come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -296,7 +299,9 @@ fn ome_axes(path: &Path, xml: &str, pages: &[usize], samples: usize) -> Result<T
         .checked_mul(z)
         .and_then(|n| n.checked_mul(t))
         .ok_or("counts overflow")?;
-    if planes > pages.len().max(1) * 4096 {
+    // Checked before the plane table is allocated: a multi-file set may state more planes
+    // than this file's pages, but not without bound.
+    if planes > (pages.len().max(1) * 4096).min(MAX_PLANES) {
         return Err(format!("{planes} planes stated"));
     }
     // Linear plane index in DimensionOrder → (t, z, c), and back.
@@ -513,6 +518,13 @@ mod tests {
         );
         let (_, notes) = axes(&ome("XYQZT", 1, 1, 1, ""), 1, 1);
         assert!(notes[0].contains("DimensionOrder"), "{notes:?}");
+        // Absurd counts are refused before anything is allocated.
+        let (a, notes) = axes(&ome("XYCZT", 4_000_000_000, 4_000_000_000, 9, ""), 1, 1);
+        assert_eq!(a.source, AxesSource::Pages);
+        assert!(
+            notes[0].contains("overflow") || notes[0].contains("planes stated"),
+            "{notes:?}"
+        );
     }
 
     #[test]

@@ -55,14 +55,7 @@ pub fn read_pages(
         .into_iter()
         .map(|page| {
             let plane = reader.read_page(page, channel)?;
-            Ok(Image {
-                values: plane.to_f64(),
-                width: plane.width,
-                height: plane.height,
-                pixel_size,
-                path: path.to_path_buf(),
-                page,
-            })
+            Ok(Image::of_plane(&plane, pixel_size, path, page))
         })
         .collect()
 }
