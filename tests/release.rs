@@ -186,3 +186,27 @@ fn library_crates_include_only_their_own_files() {
         "included from outside the crate: {outside:#?}"
     );
 }
+
+/// The wheel file names the docs give are the names `scripts/build-wheels` writes (maturin's
+/// `--compatibility manylinux2014` gives both tags), so that a copied `pip install` line works.
+#[test]
+fn documented_wheel_names_are_the_built_ones() {
+    let version = packages()[0]["version"].as_str().unwrap().to_string();
+    let lib =
+        format!("contactscope-{version}-cp39-abi3-manylinux2014_x86_64.manylinux_2_17_x86_64.whl");
+    let cli = format!(
+        "contactscope_cli-{version}-py3-none-manylinux2014_x86_64.manylinux_2_17_x86_64.whl"
+    );
+    for doc in ["README.md", "python/README.md", "docs/napari.md"] {
+        let text = read(doc);
+        for name in text
+            .split(|c: char| c.is_whitespace() || c == '"' || c == '[' || c == '/' || c == '`')
+            .filter(|w| w.ends_with(".whl") && w.starts_with("contactscope") && !w.contains('…'))
+        {
+            assert!(
+                name == lib || name == cli,
+                "{doc}: {name} is not a wheel build-wheels writes"
+            );
+        }
+    }
+}

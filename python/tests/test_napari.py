@@ -371,8 +371,9 @@ def test_series_widget_manifest_matches_cli(viewer, series_tif, tmp_path, cli):
 @needs_napari
 @needs_display
 def test_three_clicks_from_a_czi(viewer, tmp_path, cli):
-    # Open the file, pick its layer in the dock widget (channel, load axis t and the Z plane on
-    # screen come from the layer and the viewer), type the forces, Analyze.
+    # Open the file, pick its layer in the dock widget (channel and load axis t come from the
+    # layer; the Z plane from the widget's own z box, never the viewer's slider), type the
+    # forces, Analyze.
     from contactscope.napari.series_widget import LoadSeriesWidget
 
     czi = real("real-formats/czi/CellDivision_T3_Z5_CH2_X240_Y170.czi")
@@ -382,7 +383,12 @@ def test_three_clicks_from_a_czi(viewer, tmp_path, cli):
     viewer.window.add_dock_widget(w, name="Load series (contact area)")
     w.source.setCurrentText("CellDivision_T3_Z5_CH2_X240_Y170 C1")
     assert w.load_axis.currentText() == "t"
-    assert (w.selection["channel"].value(), w.selection["z"].value()) == (1, 2)
+    # The slider stands on plane 2; the widget says it analyses plane 0 until told otherwise.
+    assert (w.selection["channel"].value(), w.selection["z"].value()) == (1, 0)
+    assert "z plane 0 of 5" in w.status.text() and "slider" in w.status.text()
+    w.selection["z"].setValue(2)
+    viewer.dims.set_point(1, 4 * 0.32)  # moving the slider changes nothing
+    assert w.selection["z"].value() == 2
     assert w.selection["series"].value() == -1  # one series: no --series, as on the CLI
     w.forces.setText("4,40,400mN")
     w.run_now()

@@ -275,8 +275,10 @@ class LoadSeriesWidget(QWidget):
 
     def take_layer(self, name: str) -> None:
         """Fill the selection from a layer a reader made: its channel and series, the load
-        axis "t" where the file has a T axis, and the plane now shown on the other axes (the
-        Z slider's position for a z stack)."""
+        axis "t" where the file has a T axis, and for a file with Z planes too, z plane 0 in
+        the widget's own z box, said in the status line. The viewer's sliders never choose a
+        plane: where they stand is no part of an analysis, which must give the same numbers
+        each time it is run."""
         if not name or name == FILES or name not in self.viewer.layers:
             return
         layer = self.viewer.layers[name]
@@ -289,9 +291,12 @@ class LoadSeriesWidget(QWidget):
         if "T" in axes:
             self.load_axis.setCurrentText("t")
         if "Z" in axes and "T" in axes:
-            # The viewer's point in the layer's pixel indices.
-            here = layer.world_to_data(self.viewer.dims.point[-layer.ndim:])
-            self.selection["z"].setValue(int(round(here[axes.index("Z")])))
+            nz = int(layer.data.shape[axes.index("Z")])
+            if self.selection["z"].value() < 0 or self.selection["z"].value() >= nz:
+                self.selection["z"].setValue(0)
+            self.status.setText(
+                f"z plane {self.selection['z'].value()} of {nz} (0..{nz - 1}), chosen in the z "
+                "box: the viewer's slider does not choose the plane analysed")
 
     def _browse_files(self) -> None:
         if choose_micrographs(self, self.paths):
