@@ -2,6 +2,8 @@
 (``series[0].axes``), over a matrix of axis orders and sizes; arrays on the wrong axis refused
 or warned of."""
 
+import pathlib
+
 import numpy as np
 import pytest
 
@@ -85,3 +87,31 @@ def test_rgb_arrays_are_refused_and_loads_last_warned_of():
     stack[:, 20:40, 20:40] = 3000
     with pytest.warns(cs.ContactscopeWarning, match="np.moveaxis"):
         cs.otsu_threshold(np.moveaxis(stack, 0, -1))
+
+
+SHARED = pathlib.Path(__file__).resolve().parents[2].parent / "shared" / "data"
+
+
+def test_every_shared_tiff_has_tifffiles_axes():
+    """The real and synthetic TIFFs beside the checkout: T, Z and C as tifffile's
+    ``series[0]`` (its unlabelled page axes I and Q are our time points, its samples S our
+    channels)."""
+    files = sorted(SHARED.glob("real-tiff/**/*.tif*")) + \
+        sorted(SHARED.glob("synthetic-tiff-formats/*.tif"))
+    if not files:
+        pytest.skip(f"{SHARED} not found (the shared test data sits beside the checkout)")
+    compared = 0
+    for path in files:
+        if path.name == "m_packed12.tif":  # packed 12-bit: refused by design
+            continue
+        s = tifffile.TiffFile(path).series[0]
+        want = {k: (s.shape[s.axes.index(k)] if k in s.axes else 1) for k in "TZC"}
+        for unlabelled in "IQ":
+            if unlabelled in s.axes:
+                want["T"] = s.shape[s.axes.index(unlabelled)]
+        if "S" in s.axes:
+            want["C"] = s.shape[s.axes.index("S")]
+        got = {k: v for k, v in cs.info(path)["series"][0]["axes"].items() if k in "TZC"}
+        assert got == want, (path.name, s.axes, got)
+        compared += 1
+    assert compared > 20
