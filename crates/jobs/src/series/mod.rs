@@ -1,8 +1,10 @@
 //! A load series: which page of which file is which load step, and its normal force.
 //!
 //! Inputs are one multi-page TIFF, several files, a directory of TIFFs (natural sort order, so
-//! `img2` comes before `img10` and `load_1.25mN` before `load_1.5mN`: [`natural_cmp`]) or a manifest CSV with columns `file`, optional `page`,
-//! `force_mN` and optional `friction_mN`, paths relative to the manifest's folder.
+//! `img2` comes before `img10` and `load_1.25mN` before `load_1.5mN`: [`natural_cmp`]) or a
+//! manifest CSV with columns `file`, optional `page`, `force_mN` and optional `friction_mN`,
+//! paths relative to the manifest's folder. A TIFF gives the planes its axes and the selection
+//! name (`contactscope_formats::microscopy::LoadDefault`).
 //! Pages are zero-based TIFF page (IFD) indices, as tifffile numbers them.
 //!
 //! Zeiss CZI, Nikon ND2 and Leica LIF files ([`contactscope_formats::microscopy`]) are accepted as well,
