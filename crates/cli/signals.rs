@@ -29,6 +29,8 @@ pub fn discard_on_interrupt() {
             if let Some(signal) = signals.forever().next() {
                 INTERRUPTED.store(true, Ordering::SeqCst);
                 let removed = contactscope_jobs::staging::discard_unfinished();
+                // A batch's lock goes too (its folder and finished series stay).
+                let released = contactscope_jobs::batch::release_locks();
                 let name = if signal == SIGINT {
                     "SIGINT"
                 } else {
@@ -40,6 +42,10 @@ pub fn discard_on_interrupt() {
                     let names: Vec<String> =
                         removed.iter().map(|p| p.display().to_string()).collect();
                     format!("discarded the unfinished output {}", names.join(", "))
+                };
+                let what = match released.len() {
+                    0 => what,
+                    _ => format!("{what}; released the batch's lock (finished series are kept)"),
                 };
                 // Not eprintln!: with stderr gone (a closed pipe) it would panic this thread
                 // and the process would never exit.

@@ -143,6 +143,14 @@ fn a_killed_batch_keeps_what_it_finished_and_resumes() {
         assert!(fifo.success());
         let (status, err) = interrupted(dir, signal);
         assert_eq!(status, code, "{signal}: {err}");
+        // Interrupted, the batch releases its lock (killed, the next run takes it over).
+        if signal == "-INT" {
+            assert!(
+                !dir.join("results/.contactscope-batch.lock").exists(),
+                "{err}"
+            );
+            assert!(err.contains("released the batch's lock"), "{err}");
+        }
         std::fs::remove_file(&real).unwrap();
         std::fs::copy(&saved, &real).unwrap();
         let results = dir.join("results");

@@ -3,6 +3,7 @@
 //! failures isolated, killed batches resumed, re-runs that redo only what changed.
 
 mod failures;
+mod faults;
 mod fit;
 mod reruns;
 mod sheet;

@@ -12,20 +12,59 @@ use contactscope_formats::param::Param;
 use super::{walk, SeriesOptions, SeriesTask, Sheet, MARKER};
 use crate::error::{Error, Location, Result};
 use crate::provenance::{self, Machine};
+use crate::staging::CreatedFolders;
 
 const LOCK: &str = ".contactscope-batch.lock";
 
-/// A batch's folder taken for one run: its lock file, removed when dropped.
+/// A batch's folder taken for one run: its lock file, removed when dropped. A folder this run
+/// made is removed again (only what the run itself put there, only while empty) unless the run
+/// [keeps](Lock::keep) it: a refused or failed batch leaves nothing, and never removes what
+/// another batch made.
 #[derive(Debug)]
 pub(super) struct Lock {
     file: PathBuf,
+    out: PathBuf,
+    made: Option<CreatedFolders>,
     _held: Held,
+}
+
+impl Lock {
+    /// The run goes on: the folder stays, whatever happens later.
+    pub(super) fn keep(&mut self) {
+        if let Some(made) = self.made.take() {
+            made.keep();
+        }
+    }
 }
 
 impl Drop for Lock {
     fn drop(&mut self) {
+        if self.made.is_some() {
+            // Made by this run and not kept: only this run's own (empty) layout goes.
+            let _ = std::fs::remove_file(self.out.join(MARKER));
+            for dir in SUBFOLDERS {
+                let _ = std::fs::remove_dir(self.out.join(dir));
+            }
+        }
         let _ = std::fs::remove_file(&self.file);
+        // `made`, dropped after this, removes the folder and the parents it made when empty.
     }
+}
+
+/// The batch's own subfolders.
+const SUBFOLDERS: [&str; 4] = ["series", "fit", "qc", "records"];
+
+/// The lock files of the batches this process holds, for [`release_locks`].
+static LOCKS: std::sync::Mutex<BTreeSet<PathBuf>> = std::sync::Mutex::new(BTreeSet::new());
+
+/// Remove the lock files of every batch this process holds (the command line's SIGINT and
+/// SIGTERM handler calls it before the process exits; the locks' owners never run again).
+pub fn release_locks() -> Vec<PathBuf> {
+    let locks = std::mem::take(&mut *LOCKS.lock().unwrap_or_else(|e| e.into_inner()));
+    locks
+        .into_iter()
+        .filter(|f| std::fs::remove_file(f).is_ok())
+        .collect()
 }
 
 /// The folders this process's batches hold (a Python session may plan two).
@@ -33,7 +72,7 @@ static HELD: std::sync::Mutex<BTreeSet<PathBuf>> = std::sync::Mutex::new(BTreeSe
 
 /// A folder held by a batch of this process, released when dropped.
 #[derive(Debug)]
-struct Held(PathBuf);
+struct Held(PathBuf, Option<PathBuf>);
 
 impl Held {
     fn take(folder: PathBuf) -> Option<Held> {
@@ -42,12 +81,25 @@ impl Held {
             .unwrap_or_else(|e| e.into_inner())
             .insert(folder.clone());
         // Made only when taken (and after the set's lock is released: its drop takes it).
-        taken.then(|| Held(folder))
+        taken.then(|| Held(folder, None))
+    }
+
+    /// Its lock file is made: the signal handler removes it.
+    fn locked(&mut self, file: &Path) {
+        let file = self.0.join(file.file_name().unwrap_or_default());
+        LOCKS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(file.clone());
+        self.1 = Some(file);
     }
 }
 
 impl Drop for Held {
     fn drop(&mut self) {
+        if let Some(file) = &self.1 {
+            LOCKS.lock().unwrap_or_else(|e| e.into_inner()).remove(file);
+        }
         HELD.lock()
             .unwrap_or_else(|e| e.into_inner())
             .remove(&self.0);
@@ -56,7 +108,9 @@ impl Drop for Held {
 
 /// Make or take the batch's folder: new, empty, or an earlier batch's (its [`MARKER`]), and not
 /// in use by a running batch (its lock, made atomically, names a live process of this host,
-/// another host, or a batch of this process).
+/// another host, or a batch of this process). Refused, it removes only folders this call made,
+/// and only while they are empty: a batch that lost the race for a folder never touches the
+/// winner's files.
 pub(super) fn take_folder(out: &Path) -> Result<Lock> {
     let refuse = |reason: String| Error::Output {
         path: out.to_path_buf(),
@@ -72,7 +126,8 @@ pub(super) fn take_folder(out: &Path) -> Result<Lock> {
                 .map_err(|e| Error::io(out, e))?
                 .next()
                 .is_none();
-            if !empty && !out.join(MARKER).is_file() {
+            // A batch that has just made the folder has its lock there before its marker.
+            if !empty && !out.join(MARKER).is_file() && !out.join(LOCK).is_file() {
                 return Err(refuse(format!(
                     "is not empty and is not a batch's folder (no {MARKER})"
                 )));
@@ -80,15 +135,11 @@ pub(super) fn take_folder(out: &Path) -> Result<Lock> {
         }
         Err(_) => {}
     }
-    for dir in ["", "series", "fit", "qc", "records"] {
-        let d = out.join(dir);
-        std::fs::create_dir_all(&d).map_err(|e| Error::Output {
-            path: d.clone(),
-            reason: e.to_string(),
-        })?;
-    }
+    super::faults::pause("folder-checked");
+    let made = CreatedFolders::create(out)?;
+    super::faults::pause("folder-made");
     let folder = out.canonicalize().map_err(|e| Error::io(out, e))?;
-    let held = Held::take(folder)
+    let mut held = Held::take(folder)
         .ok_or_else(|| refuse("is in use by another batch of this process".into()))?;
     let file = out.join(LOCK);
     let host = Machine::this().hostname;
@@ -105,12 +156,23 @@ pub(super) fn take_folder(out: &Path) -> Result<Lock> {
         match created {
             Ok(mut f) => {
                 use std::io::Write as _;
+                held.locked(&file);
                 let lock = Lock {
                     file: file.clone(),
+                    out: out.to_path_buf(),
+                    made: Some(made),
                     _held: held,
                 };
                 f.write_all(me.to_string().as_bytes())
                     .map_err(output_error)?;
+                super::faults::pause("folder-locked");
+                for dir in SUBFOLDERS {
+                    let d = out.join(dir);
+                    std::fs::create_dir_all(&d).map_err(|e| Error::Output {
+                        path: d.clone(),
+                        reason: e.to_string(),
+                    })?;
+                }
                 let marker =
                     json!({ "written_by": format!("contactscope {}", provenance::version()) });
                 crate::staging::write_atomic(&out.join(MARKER), marker.to_string().as_bytes())?;
@@ -127,12 +189,23 @@ pub(super) fn take_folder(out: &Path) -> Result<Lock> {
                     holder["pid"].as_u64().unwrap_or(0),
                 );
                 let ours = their_host == host;
+                // A lock being written (no holder readable yet, and new) is another batch's.
+                let being_written = holder.is_null()
+                    && std::fs::metadata(&file)
+                        .and_then(|m| m.modified())
+                        .ok()
+                        .and_then(|t| t.elapsed().ok())
+                        .is_none_or(|age| age.as_secs() < 60);
                 if (ours && pid != u64::from(std::process::id()) && alive(pid))
                     || (!ours && !their_host.is_empty())
+                    || being_written
                 {
+                    let who = match being_written {
+                        true => "another batch (its lock is being written)".to_string(),
+                        false => format!("a batch on host {their_host} (process {pid})"),
+                    };
                     return Err(refuse(format!(
-                        "is in use by a batch on host {their_host} (process {pid}); wait for it, \
-                         or remove {} if that batch is gone",
+                        "is in use by {who}; wait for it, or remove {} if that batch is gone",
                         file.display()
                     )));
                 }
@@ -246,12 +319,24 @@ mod tests {
     #[test]
     fn a_folder_is_taken_by_one_batch_at_a_time() {
         let dir = tempfile::tempdir().unwrap();
-        let out = dir.path().join("results");
-        let first = take_folder(&out).unwrap();
+        let out = dir.path().join("new/results");
+        // Made and given up (a run that stops before it starts): nothing is left.
+        drop(take_folder(&out).unwrap());
+        assert!(
+            !dir.path().join("new").exists(),
+            "a folder made and not kept goes"
+        );
+        let mut first = take_folder(&out).unwrap();
         assert!(out.join(LOCK).is_file() && out.join(MARKER).is_file());
         let err = take_folder(&out).unwrap_err().to_string();
         assert!(err.contains("another batch of this process"), "{err}");
+        assert!(
+            out.join(LOCK).is_file(),
+            "the refused run leaves the folder alone"
+        );
+        first.keep();
         drop(first);
+        assert!(out.join(MARKER).is_file(), "kept");
         assert!(!out.join(LOCK).exists(), "released");
         let host = Machine::this().hostname;
         // A live process of this host (init) holds it: refused, its lock left alone.

@@ -24,6 +24,7 @@
 //! it finished (each series' folders are written all or nothing, its record after them).
 
 pub mod columns;
+mod faults;
 mod finish;
 pub mod flags;
 mod folder;
@@ -48,6 +49,8 @@ pub use sheet::Sheet;
 pub use walk::WalkSpec;
 
 use crate::error::{Error, Result};
+pub use faults::VARIABLE as TEST_PAUSE_VARIABLE;
+pub use folder::release_locks;
 use folder::{check_inputs_outside, take_folder, walk_sheet, Lock};
 
 /// Where the series come from.
@@ -235,29 +238,17 @@ pub fn plan(request: BatchRequest) -> Result<Plan> {
         SheetSource::Walk(_) => Some(walk_sheet(&out, &sheet, &tasks)?),
         _ => None,
     };
-    // Everything is checked: the folder is taken (made, when new) only now, and removed again
-    // if this run made it and cannot go on, so that a refused batch writes nothing.
-    let existed = out.exists();
-    let lock = take_folder(&out).inspect_err(|_| {
-        if !existed {
-            let _ = std::fs::remove_dir_all(&out);
-        }
-    })?;
+    // Everything is checked: the folder is taken (made, when new) only now; a refused or
+    // failed run removes only what it made itself ([`Lock`]), so that it writes nothing.
+    let mut lock = take_folder(&out)?;
     let written_sheet = match walk_sheet {
         Some((bytes, sha)) => {
-            match crate::staging::write_atomic(&out.join("samplesheet.csv"), &bytes) {
-                Ok(()) => Some(sha),
-                Err(e) => {
-                    drop(lock);
-                    if !existed {
-                        let _ = std::fs::remove_dir_all(&out);
-                    }
-                    return Err(e);
-                }
-            }
+            crate::staging::write_atomic(&out.join("samplesheet.csv"), &bytes)?;
+            Some(sha)
         }
         None => None,
     };
+    lock.keep();
     let mut decisions = Vec::with_capacity(tasks.len());
     let mut reused = Vec::with_capacity(tasks.len());
     let mut bytes_hashed = 0;
@@ -314,13 +305,16 @@ fn decide(task: &SeriesTask, rerun: Rerun, hashed: &mut u64) -> (Decision, Optio
             return run("--rerun failed".into());
         }
     } else if let Some(missing) = missing_output(task, &record) {
-        return run(format!("{missing} is missing"));
+        return run(match missing.contains(' ') {
+            true => missing,
+            false => format!("{missing} is missing"),
+        });
     }
     // Files only touched (same bytes, a new time): the record takes their new times, so that
     // the next run does not hash them again.
     let record = match touched {
         true => {
-            let record = record.retouched();
+            let record = record.retouched(&task.input);
             let _ = record.write(&task.out);
             record
         }
@@ -335,7 +329,7 @@ fn decide(task: &SeriesTask, rerun: Rerun, hashed: &mut u64) -> (Decision, Optio
     )
 }
 
-/// An output of a finished series that is no longer there.
+/// An output of a finished series that is no longer there, or not the one its record describes.
 fn missing_output(task: &SeriesTask, record: &Record) -> Option<String> {
     let marker = |dir: PathBuf| dir.join(crate::staging::MARKER);
     if record.result.is_some() && !marker(task.series_dir()).is_file() {
@@ -347,7 +341,11 @@ fn missing_output(task: &SeriesTask, record: &Record) -> Option<String> {
     if cfg!(feature = "plots") && record.result.is_some() && !task.thumbnail().is_file() {
         return Some(format!("qc/{}.png", task.id));
     }
-    None
+    // A folder another run made (or a record of a batch before records named their folders).
+    record
+        .outputs
+        .disagreement(&record::Outputs::of(task), &task.id)
+        .map(|folder| format!("{folder} does not match its record (written by another run)"))
 }
 
 /// Progress of a batch in this process: told after each series with its record, how many are

@@ -283,6 +283,46 @@ pub struct Record {
     pub result: Option<SeriesResult>,
     /// `fit-hardening`'s numbers.
     pub fit: Option<FitSummary>,
+    /// The folders it describes, by the SHA-256 of their summaries.
+    #[serde(default)]
+    pub outputs: Outputs,
+}
+
+/// The SHA-256 of the summary each of a series' folders holds (`series/ID/summary.json`,
+/// `fit/ID/fit.json`; each holds its run's times, so no two runs' summaries are alike): a
+/// folder that another run replaced no longer matches its record.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub struct Outputs {
+    /// Of `series/ID/summary.json`.
+    pub series_summary_sha256: Option<String>,
+    /// Of `fit/ID/fit.json`.
+    pub fit_summary_sha256: Option<String>,
+}
+
+impl Outputs {
+    /// The summaries of `task`'s folders as they are now.
+    pub fn of(task: &super::SeriesTask) -> Outputs {
+        let sha = |path: PathBuf| {
+            std::fs::read(path)
+                .ok()
+                .map(|b| crate::provenance::sha256_bytes(&b))
+        };
+        Outputs {
+            series_summary_sha256: sha(task.series_dir().join("summary.json")),
+            fit_summary_sha256: sha(task.fit_dir().join("fit.json")),
+        }
+    }
+
+    /// The first folder (`series/ID`, `fit/ID`) of `now` that differs from `self`.
+    pub fn disagreement(&self, now: &Outputs, id: &str) -> Option<String> {
+        if self.series_summary_sha256 != now.series_summary_sha256 {
+            return Some(format!("series/{id}"));
+        }
+        if self.fit_summary_sha256 != now.fit_summary_sha256 {
+            return Some(format!("fit/{id}"));
+        }
+        None
+    }
 }
 
 /// Why a series is analysed again (or `None`: its record still holds).
@@ -333,45 +373,94 @@ impl Record {
         if &self.settings != settings {
             return Some("the batch's output settings changed".into());
         }
-        if InputState::of(input) != self.input {
+        let now = InputState::of(input);
+        // The listing, not the path: the same archive read from another working directory,
+        // or moved as a whole, is the same archive.
+        if now.listing != self.input.listing
+            || now.canonical.is_none() != self.input.canonical.is_none()
+        {
             return Some(format!("{} changed (its listing or path)", input.display()));
         }
         for file in &self.files {
-            let path = Path::new(&file.path);
-            let Ok(stat) = Stat::of(path) else {
-                return Some(format!("{} is gone", file.path));
+            let path = self.where_now(file, &now);
+            // Named as the batch named it, or where it was looked for in a moved archive.
+            let shown = match path == file.canonical {
+                true => file.path.clone(),
+                false => path.display().to_string(),
             };
+            let Ok(stat) = Stat::of(&path) else {
+                return Some(format!("{shown} is gone"));
+            };
+            // Found elsewhere (a moved archive): the record takes the new place.
+            *touched |= path != file.canonical;
             if stat.size_bytes != file.size_bytes {
-                return Some(format!("{} changed (size)", file.path));
+                return Some(format!("{shown} changed (size)"));
             }
             if u64::try_from(stat.modified_ns).ok() != Some(file.modified_ns) {
                 if file.sha256.is_empty() {
                     // Seen, never hashed (its series failed before reading it): a new time is
                     // a change.
-                    return Some(format!("{} changed (time)", file.path));
+                    return Some(format!("{shown} changed (time)"));
                 }
-                match sha256_file(path) {
+                match sha256_file(&path) {
                     Ok((sha, n)) => {
                         *hashed += n;
                         if sha != file.sha256 {
-                            return Some(format!("{} changed (content)", file.path));
+                            return Some(format!("{shown} changed (content)"));
                         }
                         *touched = true;
                     }
-                    Err(_) => return Some(format!("{} cannot be read", file.path)),
+                    Err(_) => return Some(format!("{shown} cannot be read")),
                 }
             }
         }
         None
     }
 
-    /// The record with the files' current modification times (their bytes are unchanged).
-    pub fn retouched(mut self) -> Record {
-        for file in &mut self.files {
-            if let Ok(stat) = Stat::of(Path::new(&file.path)) {
-                file.modified_ns = u64::try_from(stat.modified_ns).unwrap_or(u64::MAX);
+    /// Where a recorded file is now: its canonical path; for an archive that moved, the same
+    /// place relative to the series' input (`now`) as it had to the input recorded.
+    fn where_now(&self, file: &FileRecord, now: &InputState) -> PathBuf {
+        let rebased = || {
+            let (old, new) = (self.input.canonical.as_ref()?, now.canonical.as_ref()?);
+            if old == new {
+                return None;
+            }
+            // A folder input holds its files; a file input's files lie beside it.
+            let root = |p: &Path| match self.input.listing {
+                Some(_) => Some(p.to_path_buf()),
+                None => p.parent().map(Path::to_path_buf),
+            };
+            let tail = file.canonical.strip_prefix(root(old)?).ok()?;
+            Some(root(new)?.join(tail))
+        };
+        rebased().unwrap_or_else(|| file.canonical.clone())
+    }
+
+    /// The record with the files' current modification times (their bytes are unchanged), as
+    /// found from `input` now.
+    pub fn retouched(mut self, input: &Path) -> Record {
+        let now = InputState::of(input);
+        let places: Vec<(PathBuf, Option<u64>)> = self
+            .files
+            .iter()
+            .map(|f| {
+                let path = self.where_now(f, &now);
+                let time = Stat::of(&path)
+                    .ok()
+                    .map(|s| u64::try_from(s.modified_ns).unwrap_or(u64::MAX));
+                (path, time)
+            })
+            .collect();
+        for (file, (path, time)) in self.files.iter_mut().zip(places) {
+            if let Some(t) = time {
+                if path != file.canonical {
+                    file.path = path.display().to_string();
+                    file.canonical = path;
+                }
+                file.modified_ns = t;
             }
         }
+        self.input = now;
         self
     }
 }
@@ -421,6 +510,7 @@ mod tests {
             seconds: 0.0,
             result: None,
             fit: None,
+            outputs: Outputs::default(),
         };
         (record, file)
     }
@@ -466,7 +556,7 @@ mod tests {
         let (mut hashed, mut touched) = (0, false);
         assert_eq!(check(&record, &options, &mut hashed, &mut touched), None);
         assert!(touched);
-        let retouched = record.clone().retouched();
+        let retouched = record.clone().retouched(&file);
         let (mut hashed, mut touched) = (0, false);
         assert_eq!(check(&retouched, &options, &mut hashed, &mut touched), None);
         assert_eq!((hashed, touched), (0, false));

@@ -17,8 +17,8 @@ use contactscope::model_fit::Family;
 
 use super::options::{OutputSettings, SeriesOptions};
 use super::record::{
-    CommandLines, FileRecord, FitSummary, ImageResult, InputState, PowerLaw, Record, SeriesResult,
-    Status,
+    CommandLines, FileRecord, FitSummary, ImageResult, InputState, Outputs, PowerLaw, Record,
+    SeriesResult, Status,
 };
 use crate::analyze::files::{run_open_to_folder, ImageOutputs};
 use crate::analyze::{AnalyzeOutcome, AreaUnit, Row};
@@ -110,6 +110,11 @@ struct Progress {
 /// are what `contactscope analyze` writes), whichever front-end runs the batch.
 pub fn run_series(task: &SeriesTask) -> Record {
     let _words = contactscope_formats::param::CommandLineWords::begin();
+    // The old record goes before any folder of the series changes: a run killed from here on
+    // leaves no record, so the next run does the series again rather than trusting a record
+    // that no longer describes its folders.
+    let _ = std::fs::remove_file(Record::path(&task.out, &task.id));
+    super::faults::pause("record-removed");
     let started = SystemTime::now();
     let clock = Instant::now();
     let mut progress = Progress {
@@ -153,6 +158,7 @@ pub fn run_series(task: &SeriesTask) -> Record {
         seconds: clock.elapsed().as_secs_f64(),
         result: progress.result,
         fit: progress.fit,
+        outputs: Outputs::of(task),
     };
     match record.write(&task.out) {
         Ok(()) => record,
@@ -211,6 +217,7 @@ fn stages(task: &SeriesTask, progress: &mut Progress) -> std::result::Result<(),
     progress.files = files;
     progress.bytes_hashed = bytes;
     let (outcome, _) = analysed.map_err(at("analyze"))?;
+    super::faults::pause("series-committed");
     progress.result = Some(series_result(task, &open, &outcome));
     if let Some(png) = thumbnail.into_inner().expect("lock") {
         crate::staging::write_atomic(&task.thumbnail(), &png.map_err(at("qc"))?)
@@ -228,6 +235,7 @@ fn stages(task: &SeriesTask, progress: &mut Progress) -> std::result::Result<(),
         // later run in this process may replace.
         contactscope_formats::inputs::forget_input(&areas);
         let (fit, _) = fitted.map_err(at("fit-hardening"))?;
+        super::faults::pause("fit-committed");
         progress.fit = Some(fit_summary(&fit));
     }
     Ok(())
