@@ -44,6 +44,10 @@ pub struct Args {
     threshold: String,
     #[command(flatten)]
     pixel_size: PixelSizeArg,
+    /// Pixel size for files whose metadata states none (a stated one is kept): 200nm, or
+    /// 200x210nm.
+    #[arg(long, conflicts_with = "pixel_size")]
+    pixel_size_default: Option<String>,
     /// Relative uncertainty of the pixel size (given or the files'), as bounds: 1% or 0.01;
     /// widens the area and fit intervals (also written --pixel-size 200nm±1%).
     #[arg(long)]
@@ -112,6 +116,10 @@ pub fn run(args: Args) -> Result<Finished> {
         method: Method::parse(&args.threshold)?,
         psf_fwhm_m,
         pixel_size_m,
+        pixel_size_default_m: crate::args::optional_pixel_size(
+            &args.pixel_size_default,
+            "--pixel-size-default",
+        )?,
         pixel_size_uncertainty,
         hertz,
         memory_budget: args.memory_mib << 20,

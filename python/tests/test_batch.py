@@ -180,9 +180,14 @@ def test_a_walk_from_python(archive, cli):
     walked = archive / "walked"
     shutil.copytree(archive / "s1", walked / "a")
     shutil.copytree(archive / "s2", walked / "b")
+    # b's TIFF states no pixel size: the batch's fills it; a keeps its own 200 nm.
+    images = cs.read_series(walked / "b")["images"]
+    cs.write_tiff(walked / "b" / "series.tif", images)
     result = cs.batch(walked, archive / "walk-out", pixel_size="250nm")
     assert list(result.series["series_id"]) == ["a", "b"]
-    assert set(result.series["pixel_size_source"]) == {"batch default (pixel_size)"}
+    assert list(result.series["pixel_size_source"]) == [
+        "ImageJ unit + X/YResolution", "batch default for files without one"]
+    assert list(result.series["pixel_size_x_um"]) == [0.2, 0.25]
     assert (archive / "walk-out" / "samplesheet.csv").read_text().startswith(
-        "id,input,pixel_size\na,../walked/a,250nm\n")
+        "id,input,pixel_size_default\na,../walked/a,250nm\n")
     assert os.path.exists(archive / "walk-out" / "index.html")

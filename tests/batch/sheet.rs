@@ -133,6 +133,9 @@ fn a_samplesheet_gives_analyze_folders_one_table_and_provenance() {
     assert_eq!(sources[0], "ImageJ unit + X/YResolution");
     assert_eq!(sources[2], "samplesheet (pixel_size)");
     assert_eq!(cells(&series, "pixel_size_x_um")[2], "0.25");
+    // Converted to µm without binary noise (metres × 1e6 would give 0.19999999999999998).
+    assert_eq!(cells(&series, "pixel_size_x_um")[0], "0.2");
+    assert_eq!(cells(&images, "pixel_size_uncertainty_pct")[0], "0");
     let flags = cells(&series, "flags");
     assert_eq!(flags[..2], ["", ""]);
     assert_eq!(flags[2], "pixel_size_vs_metadata");
@@ -228,7 +231,7 @@ fn a_bad_samplesheet_is_refused_whole_with_its_line_and_column() {
     let o = super::batch(dir, &["--samplesheet", "both.csv", "--out", "results"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(
-        stderr(&o).contains("line 2, column forces: the input archive/manifest-a is a manifest"),
+        stderr(&o).contains("line 2, column forces_mN: the input archive/manifest-a is a manifest"),
         "{}",
         stderr(&o)
     );

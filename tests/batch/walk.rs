@@ -14,7 +14,21 @@ fn a_walk_writes_the_samplesheet_it_used() {
     synth(&archive.join("glass"), "run10", 2, &[]);
     let loose = synth(&archive, "loose", 3, &[]);
     std::fs::remove_file(loose.join("manifest.csv")).unwrap();
-    std::fs::rename(loose.join("series.tif"), archive.join("steel-ramp.tif")).unwrap();
+    // The loose file states no pixel size (its planes written again without one).
+    let planes: Vec<_> = (0..4)
+        .map(|z| {
+            (
+                0,
+                contactscope_formats::microscopy::PlaneIndex::tzc(0, z, 0),
+            )
+        })
+        .collect();
+    crate::common::export_tiff(
+        &loose.join("series.tif"),
+        &planes,
+        None,
+        &archive.join("steel-ramp.tif"),
+    );
     std::fs::remove_dir_all(&loose).unwrap();
     // The output folder inside the archive is not walked into.
     let args = [
@@ -33,7 +47,7 @@ fn a_walk_writes_the_samplesheet_it_used() {
     let sheet = std::fs::read_to_string(archive.join("results/samplesheet.csv")).unwrap();
     assert_eq!(
         sheet,
-        "id,input,forces,pixel_size\n\
+        "id,input,forces,pixel_size_default\n\
          glass-run2,../glass/run2,,200nm\n\
          glass-run10,../glass/run10,,200nm\n\
          steel-ramp,../steel-ramp.tif,\"1,2,4,8mN\",200nm\n"
@@ -46,14 +60,14 @@ fn a_walk_writes_the_samplesheet_it_used() {
     // The manifests give their own forces; the default applies to the loose file only.
     let images = csv(&archive.join("results/images.csv"));
     assert_eq!(images.1.len(), 12);
-    // The pixel size came from the batch's default: flagged.
-    assert!(cells(&series, "flags")
-        .iter()
-        .all(|f| f.contains("pixel_size_default")));
-    assert_eq!(
-        cells(&series, "pixel_size_source")[0],
-        "batch default (pixel_size)"
-    );
+    // The batch's pixel size fills only the file that states none (flagged); the others keep
+    // their own.
+    let flags = cells(&series, "flags");
+    assert!(!flags[0].contains("pixel_size") && !flags[1].contains("pixel_size"));
+    assert!(flags[2].contains("pixel_size_default"), "{flags:?}");
+    let sources = cells(&series, "pixel_size_source");
+    assert_eq!(sources[0], "ImageJ unit + X/YResolution");
+    assert_eq!(sources[2], "batch default for files without one");
 
     // The samplesheet repeats the run: everything re-used, the same tables.
     let before = std::fs::read(archive.join("results/series.parquet")).unwrap();

@@ -283,7 +283,7 @@ fn a_pixel_size_far_from_the_files_own_is_warned_of() {
     // 1000× the metadata's 0.2 µm: both named, and the absurd pressures that follow.
     let err = stderr(&analyse("200um"));
     assert!(
-        err.contains("--pixel-size 200 µm is 1000× the 200 nm of"),
+        err.contains("--pixel-size 200 µm is 1000× larger than the 200 nm of"),
         "{err}"
     );
     assert!(err.contains("ImageJ"), "{err}");
@@ -294,7 +294,7 @@ fn a_pixel_size_far_from_the_files_own_is_warned_of() {
         err.contains("far below what a light microscope resolves"),
         "{err}"
     );
-    assert!(err.contains("is 400× the 200 nm"), "{err}");
+    assert!(err.contains("is 400× smaller than the 200 nm"), "{err}");
     // Within 1.5× of the metadata: no word.
     let err = stderr(&analyse("250nm"));
     assert!(!err.contains("metadata"), "{err}");

@@ -135,6 +135,9 @@ pub enum PixelSizeSource {
     Nd2Calibration,
     /// Leica LIF `DimensionDescription` (DimID 1, 2) `Length/(NumberOfElements − 1)`.
     LifDimensions,
+    /// Given for files that state none (`--pixel-size-default`; a batch's `--pixel-size`),
+    /// used because these files state none.
+    DefaultForUncalibrated,
 }
 
 impl PixelSizeSource {
@@ -154,6 +157,15 @@ impl PixelSizeSource {
             PixelSizeSource::LifDimensions => {
                 "LIF DimensionDescription DimID 1/2 Length/(NumberOfElements-1)"
             }
+            PixelSizeSource::DefaultForUncalibrated => match crate::param::front_end() {
+                crate::param::FrontEnd::Python => {
+                    "given for files without one (pixel_size_default=)"
+                }
+                crate::param::FrontEnd::CommandLine => {
+                    "default for files without one (--pixel-size-default)"
+                }
+                crate::param::FrontEnd::Library => "the default for files without one",
+            },
         }
     }
 }

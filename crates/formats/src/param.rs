@@ -97,6 +97,8 @@ macro_rules! params {
 params! {
     /// Pixel size overriding the files' metadata.
     PixelSize: "--pixel-size", "pixel_size", "the pixel size";
+    /// Pixel size for files whose metadata states none (never replacing a stated one).
+    PixelSizeDefault: "--pixel-size-default", "", "the pixel size for files without one";
     /// Relative uncertainty of the pixel size (as bounds).
     PixelSizeUncertainty: "--pixel-size-uncertainty", "pixel_size_uncertainty", "the pixel size's uncertainty";
     /// Metres per stored height unit.

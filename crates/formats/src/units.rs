@@ -405,6 +405,24 @@ pub fn parse_relative_uncertainty(text: &str, of: Option<f64>) -> Result<f64> {
     Ok(value)
 }
 
+/// `value × factor` in another unit without the binary noise of the product (2e-7 m × 1e6 is
+/// `0.19999999999999998`, this gives `0.2`): the product rounded to 15 significant digits,
+/// which every f64 holds exactly enough; a value whose digits are all meaningful keeps them
+/// (the rounding moves it by at most a few units in the last place).
+pub fn in_unit(value: f64, factor: f64) -> f64 {
+    let product = value * factor;
+    if !product.is_finite() || product == 0.0 {
+        return product;
+    }
+    let rounded: f64 = format!("{product:.14e}").parse().unwrap_or(product);
+    // Only noise is removed: a product that moves by more than a few ulps keeps its digits.
+    let ulp = f64::EPSILON * product.abs();
+    match (rounded - product).abs() <= 4.0 * ulp {
+        true => rounded,
+        false => product,
+    }
+}
+
 /// Format a length in metres in the most readable unit (`200 nm`, `2.49 µm`).
 pub fn format_length(metres: f64) -> String {
     let abs = metres.abs();
@@ -420,6 +438,21 @@ pub fn format_length(metres: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unit_changes_drop_binary_noise_only() {
+        assert_eq!(in_unit(2e-7, 1e6), 0.2);
+        assert_eq!((2e-7f64 * 1e6).to_string(), "0.19999999999999998");
+        // Seventeen meaningful digits stay.
+        let full = 1.234_567_890_123_456_7e-7;
+        assert_eq!(in_unit(full, 1e6), full * 1e6);
+        assert_eq!(in_unit(0.1 + 0.2, 1.0), 0.3);
+        assert_eq!(in_unit(0.0, 1e6), 0.0);
+        // A value whose 16th and 17th digits mean something (well away from a 15-digit one)
+        // is not rounded: only the last few ulps move.
+        let x = 1.0 / 3.0;
+        assert!((in_unit(x, 1.0) - x).abs() <= 4.0 * f64::EPSILON);
+    }
 
     #[test]
     fn value_lists_and_ranges_carry_the_last_unit() {

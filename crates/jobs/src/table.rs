@@ -11,6 +11,8 @@ pub(crate) struct Table {
     path: PathBuf,
     header: Vec<String>,
     rows: Vec<csv::StringRecord>,
+    /// The line each row starts on.
+    lines: Vec<u64>,
     delimiter: u8,
 }
 
@@ -64,14 +66,23 @@ impl Table {
             .iter()
             .map(String::from)
             .collect();
-        let rows = reader
-            .records()
-            .collect::<std::result::Result<Vec<_>, _>>()
-            .map_err(|e| Error::bad_input(at(), format!("not a readable CSV: {e}")))?;
+        let mut rows = Vec::new();
+        let mut lines = Vec::new();
+        for record in reader.records() {
+            let record =
+                record.map_err(|e| Error::bad_input(at(), format!("not a readable CSV: {e}")))?;
+            // A row with no value at all (a spreadsheet's trailing `,,,`) is no row.
+            if record.iter().all(str::is_empty) {
+                continue;
+            }
+            lines.push(line_of(text, &record));
+            rows.push(record);
+        }
         Ok(Table {
             path: path.to_path_buf(),
             header,
             rows,
+            lines,
             delimiter,
         })
     }
@@ -152,7 +163,7 @@ impl Table {
                         self.location(),
                         format!(
                             "line {}, column {name}: {cell:?} is not a finite number",
-                            line_of(row, k)
+                            self.line(k)
                         ),
                     )),
                 }
@@ -160,7 +171,6 @@ impl Table {
             .collect()
     }
 
-    /// File line of data row `k` (for messages).
     /// [`Self::numbers`], each also within ±`max_abs` (SI, after `factor`): a plausibility
     /// bound that keeps absurd values (1e308 mN) from overflowing what is computed from them.
     pub(crate) fn numbers_within(&self, name: &str, factor: f64, max_abs: f64) -> Result<Vec<f64>> {
@@ -179,13 +189,27 @@ impl Table {
         Ok(values)
     }
 
+    /// File line of data row `k` (for messages).
     pub(crate) fn line(&self, k: usize) -> u64 {
-        self.rows.get(k).map_or(k as u64 + 2, |r| line_of(r, k))
+        self.lines.get(k).copied().unwrap_or(k as u64 + 2)
     }
 }
 
-fn line_of(row: &csv::StringRecord, k: usize) -> u64 {
-    row.position().map_or(k as u64 + 2, |p| p.line())
+/// The line (from 1) a record of `text` starts on, counted from its byte offset: the CSV
+/// reader's own line count is one off after CRLF line ends (Excel's).
+pub(crate) fn line_of(text: &str, record: &csv::StringRecord) -> u64 {
+    let Some(position) = record.position() else {
+        return 0;
+    };
+    let bytes = text.as_bytes();
+    let mut start = usize::try_from(position.byte())
+        .unwrap_or(usize::MAX)
+        .min(bytes.len());
+    // (The offset may point at the line end before the record.)
+    while bytes.get(start).is_some_and(|b| b"\r\n".contains(b)) {
+        start += 1;
+    }
+    1 + bytes[..start].iter().filter(|&&b| b == b'\n').count() as u64
 }
 
 fn csv_error(path: &Path, e: csv::Error) -> Error {
@@ -344,6 +368,21 @@ mod tests {
         );
         assert_eq!(parse_number("4,5", b'\t'), Some(4.5));
         assert_eq!(parse_number("4,5", b','), None);
+    }
+
+    #[test]
+    fn excel_line_ends_and_empty_rows_keep_line_numbers_exact() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("manifest.csv");
+        std::fs::write(
+            &path,
+            "file,force_mN\r\na.tif,4\r\n\r\nb.tif,x\r\n,\r\n,\r\n",
+        )
+        .unwrap();
+        let table = Table::read(&path).unwrap();
+        assert_eq!(table.len(), 2, "empty rows are no rows");
+        let e = table.numbers("force_mN", 1e-3).unwrap_err().to_string();
+        assert!(e.contains("line 4, column force_mN"), "{e}");
     }
 
     #[test]

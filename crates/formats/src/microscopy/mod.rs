@@ -355,9 +355,9 @@ impl MicroscopyFile {
                 unsupported(
                     path,
                     format!(
-                        "a {} height map{channels}, not a CZI, ND2, LIF or TIFF micrograph: read \
+                        "{} height map{channels}, not a CZI, ND2, LIF or TIFF micrograph: read \
                          it with `contactscope topography` (or `simulate --topography`)",
-                        map.name()
+                        map.with_article()
                     ),
                 )
             }

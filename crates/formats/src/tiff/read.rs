@@ -182,9 +182,9 @@ fn other_format(path: &Path) -> Option<Error> {
         return Some(Error::Unsupported {
             at: Location::file(path),
             reason: format!(
-                "a {} height map, not a TIFF micrograph: read it with `contactscope topography` \
+                "{} height map, not a TIFF micrograph: read it with `contactscope topography` \
                  (or `simulate --topography`)",
-                map.name()
+                map.with_article()
             ),
         });
     }

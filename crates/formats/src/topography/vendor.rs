@@ -114,6 +114,27 @@ impl TopographyFormat {
         }
     }
 
+    /// The name with its article as spoken (`an ibw`, `a gwy`, `a nanoscope`): abbreviations are
+    /// spelt letter by letter.
+    pub fn with_article(self) -> String {
+        use TopographyFormat as F;
+        let name = self.name();
+        let word = matches!(
+            self,
+            F::ParkTiff | F::MetroPro | F::NetCdf | F::Tiff | F::Text | F::Nanoscope
+        );
+        let sounds = match word {
+            true => "aeiou",
+            // The letters whose spoken names start with a vowel (eff, aitch, el, em, …).
+            false => "aefhilmnorsx",
+        };
+        let article = match name.starts_with(|c: char| sounds.contains(c)) {
+            true => "an",
+            false => "a",
+        };
+        format!("{article} {name}")
+    }
+
     /// Whether files of this format state the unit of their heights (HDF5 files do not: their
     /// heights are in metres unless a height unit is given).
     pub fn states_height_unit(self) -> bool {
@@ -610,5 +631,20 @@ mod tests {
             (1e-6, 1e-6)
         )
         .is_err());
+    }
+}
+
+#[cfg(test)]
+mod article_tests {
+    use super::TopographyFormat as F;
+
+    #[test]
+    fn names_take_the_article_they_are_spoken_with() {
+        assert_eq!(F::Ibw.with_article(), "an ibw");
+        assert_eq!(F::Sdf.with_article(), "an sdf");
+        assert_eq!(F::Gwy.with_article(), "a gwy");
+        assert_eq!(F::Nanoscope.with_article(), "a nanoscope");
+        assert_eq!(F::MetroPro.with_article(), "a metropro");
+        assert_eq!(F::Opdx.with_article(), "an opdx");
     }
 }

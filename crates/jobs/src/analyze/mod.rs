@@ -35,6 +35,8 @@ pub struct AnalyzeRequest {
     /// Pixel size (x, y), m, overriding the files' metadata (needed for areas in µm² of
     /// planes in memory).
     pub pixel_size_m: Option<(f64, f64)>,
+    /// Pixel size (x, y), m, for files whose metadata states none (a stated one is kept).
+    pub pixel_size_default_m: Option<(f64, f64)>,
     /// Relative uncertainty of the pixel size (given or from the files), as bounds: 0.01 for
     /// ±1 %. 0 takes it as exact. Widens the area intervals and the fit intervals.
     pub pixel_size_uncertainty: f64,
@@ -54,6 +56,7 @@ impl AnalyzeRequest {
             micrographs,
             method: Method::GlobalOtsu,
             pixel_size_m: None,
+            pixel_size_default_m: None,
             pixel_size_uncertainty: 0.0,
             psf_fwhm_m: None,
             hertz: None,
@@ -67,6 +70,10 @@ impl AnalyzeRequest {
         if let Some((x, y)) = self.pixel_size_m {
             Quantity::PixelSize.check(x, Param::PixelSize)?;
             Quantity::PixelSize.check(y, Param::PixelSize)?;
+        }
+        if let Some((x, y)) = self.pixel_size_default_m {
+            Quantity::PixelSize.check(x, Param::PixelSizeDefault)?;
+            Quantity::PixelSize.check(y, Param::PixelSizeDefault)?;
         }
         check_pixel_size_uncertainty(self.pixel_size_uncertainty)?;
         if let Some(f) = self.psf_fwhm_m {
@@ -354,7 +361,12 @@ pub fn run_open(
     let series = &open.series;
     series::refuse_maps(series)?;
     let mut warnings = Vec::new();
-    let pixel_size = series::pixel_size(series, request.pixel_size_m, &mut warnings)?;
+    let pixel_size = series::pixel_size(
+        series,
+        request.pixel_size_m,
+        request.pixel_size_default_m,
+        &mut warnings,
+    )?;
     let options = AnalysisOptions {
         method: request.method,
         pixel_size,

@@ -9,7 +9,10 @@
 //! series without one; the `_px` columns exist only when some series is in pixels, and the
 //! `friction_mN` and Hertz columns only when some series has them.
 
+use contactscope_formats::units;
+
 use super::flags::Flag;
+use super::options::{in_batch_terms, Command};
 use super::record::{ImageResult, Record, SeriesResult};
 use super::sheet::{MetaColumn, MetaKind, Row};
 use super::tables::{Table, Values};
@@ -138,6 +141,13 @@ pub fn images_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
         t.float("hertz_radius_um", rows.iter().map(|r| r.3.hertz_radius_um));
         t.float("hertz_area_um2", rows.iter().map(|r| r.3.hertz_area_um2));
     }
+    // As areas.csv has it (there only when not 0): the relative uncertainty of the pixel size
+    // that the area intervals carry.
+    t.float(
+        "pixel_size_uncertainty_pct",
+        rows.iter()
+            .map(|r| Some(units::in_unit(r.1.pixel_size_uncertainty, 100.0))),
+    );
     t.bool("edge_contact", rows.iter().map(|r| Some(r.3.edge_contact)));
     t
 }
@@ -161,7 +171,16 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
         "failed_stage",
         entries.iter().map(|e| e.record.failed_stage.clone()),
     );
-    t.text("error", entries.iter().map(|e| e.record.error.clone()));
+    t.text(
+        "error",
+        entries.iter().map(|e| {
+            let stage = match e.record.failed_stage.as_deref() {
+                Some("fit-hardening") => Command::Fit,
+                _ => Command::Analyze,
+            };
+            e.record.error.as_deref().map(|m| in_batch_terms(m, stage))
+        }),
+    );
     t.text(
         "input",
         entries.iter().map(|e| Some(e.row.input_text.clone())),
@@ -187,7 +206,7 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
         "pixel_size_source",
         r().map(|x| {
             x.and_then(|x| match (x.pixel_size_from_default, x.pixel_size_given) {
-                (true, _) => Some("batch default (pixel_size)".to_string()),
+                (true, _) => Some("batch default for files without one".to_string()),
                 (false, true) => Some("samplesheet (pixel_size)".to_string()),
                 (false, false) => x.pixel_size_source.clone(),
             })
@@ -195,7 +214,7 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
     );
     t.float(
         "pixel_size_uncertainty_pct",
-        r().map(|x| x.map(|x| x.pixel_size_uncertainty * 100.0)),
+        r().map(|x| x.map(|x| units::in_unit(x.pixel_size_uncertainty, 100.0))),
     );
     t.text("area_unit", r().map(|x| x.map(|x| x.area_unit.clone())));
     fn max_force(x: &SeriesResult) -> Option<(f64, &ImageResult)> {
@@ -342,14 +361,17 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
                 .record
                 .result
                 .iter()
-                .flat_map(|r| r.warnings.iter().cloned())
+                .flat_map(|r| {
+                    r.warnings
+                        .iter()
+                        .map(|w| in_batch_terms(w, Command::Analyze))
+                })
                 .collect();
-            all.extend(
-                e.record
-                    .fit
+            all.extend(e.record.fit.iter().flat_map(|f| {
+                f.warnings
                     .iter()
-                    .flat_map(|f| f.warnings.iter().map(|w| format!("fit-hardening: {w}"))),
-            );
+                    .map(|w| format!("fit-hardening: {}", in_batch_terms(w, Command::Fit)))
+            }));
             (!all.is_empty()).then(|| all.join(" | "))
         }),
     );

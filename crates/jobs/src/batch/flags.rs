@@ -125,8 +125,7 @@ fn series_flags(record: &Record, thresholds: &ThresholdStats) -> Vec<Flag> {
     if result.pixel_size_from_default {
         flag(
             "pixel_size_default",
-            "the pixel size is the batch's default (--pixel-size), not the row's or the file's"
-                .into(),
+            "the files state no pixel size: the batch's default (--pixel-size) is used".into(),
         );
     }
     if let (true, Some((x, y)), Some((mx, my))) = (

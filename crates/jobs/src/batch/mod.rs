@@ -200,24 +200,46 @@ pub fn plan(request: BatchRequest) -> Result<Plan> {
             0 => format!("series {}", row.id),
             n => format!("{}: line {n}", sheet.label.display()),
         };
+        // An option as the sheet's header names it (`forces_mN`), or the batch's flag.
+        let column = |opt: Opt| match row.options.get(opt) {
+            Some(_) => sheet
+                .option_columns
+                .iter()
+                .find(|(o, _)| *o == opt)
+                .map_or(opt.column().to_string(), |(_, h)| h.clone()),
+            None => default_flag(opt),
+        };
         let mut options = request.defaults.clone();
         // A manifest gives its images' forces: a default does not apply to it, and a row that
         // gives both is refused (one of the two would be ignored).
         if crate::series::is_manifest(&row.input) {
             if row.options.get(Opt::Forces).is_some() {
                 return Err(Error::InvalidArgument(format!(
-                    "{}, column forces: the input {} is a manifest, which gives the forces; \
+                    "{}, column {}: the input {} is a manifest, which gives the forces; \
                      leave the cell empty",
                     at(),
+                    column(Opt::Forces),
                     row.input_text
                 )));
             }
             options.0.remove(&Opt::Forces);
         }
         options.0.extend(row.options.0.clone());
-        options.check().map_err(|(opt, m)| {
-            Error::InvalidArgument(format!("{}, column {}: {m}", at(), opt.column()))
-        })?;
+        // The batch's pixel size fills only files that state none; a row's own replaces the
+        // files' (and is flagged where they differ).
+        if row.options.get(Opt::PixelSize).is_none() {
+            if let Some(default) = options.0.remove(&Opt::PixelSize) {
+                options.0.entry(Opt::PixelSizeDefault).or_insert(default);
+            }
+        } else {
+            options.0.remove(&Opt::PixelSizeDefault);
+        }
+        options
+            .check()
+            .map_err(|(opt, m)| match row.options.get(opt) {
+                Some(_) => Error::InvalidArgument(format!("{}, column {}: {m}", at(), column(opt))),
+                None => Error::InvalidArgument(format!("{} ({}): {m}", at(), column(opt))),
+            })?;
         let topography = options
             .get(Opt::Topography)
             .map(|t| options::resolve(&sheet.base, t));
@@ -225,8 +247,6 @@ pub fn plan(request: BatchRequest) -> Result<Plan> {
             id: row.id.clone(),
             input: row.input.clone(),
             topography,
-            pixel_size_from_default: row.options.get(Opt::PixelSize).is_none()
-                && request.defaults.get(Opt::PixelSize).is_some(),
             options,
             settings: request.settings,
             out: out.clone(),

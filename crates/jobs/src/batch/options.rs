@@ -103,6 +103,9 @@ options! {
     PixelSize: "pixel_size", Analyze, "--pixel-size", "", Some(Dimension::Length);
     /// Relative uncertainty of the pixel size (`1%`), given or the files'.
     PixelSizeUncertainty: "pixel_size_uncertainty", Analyze, "--pixel-size-uncertainty", "", None;
+    /// Pixel size for files that state none (the batch's `--pixel-size` becomes this for rows
+    /// without their own `pixel_size`).
+    PixelSizeDefault: "pixel_size_default", Analyze, "--pixel-size-default", "", Some(Dimension::Length);
     /// Sphere radius (Hertz columns; the sphere of the fit).
     Radius: "radius", Both, "--radius", "--radius", Some(Dimension::Length);
     /// Contact modulus E* (Hertz columns; the fit's material).
@@ -160,6 +163,20 @@ impl Opt {
         })
     }
 
+    /// Takes one number (with its unit), not a list or a range: a decimal comma in it can be
+    /// read as a point.
+    pub fn single_number(self) -> bool {
+        matches!(
+            self,
+            Opt::PixelSize
+                | Opt::PixelSizeDefault
+                | Opt::PixelSizeUncertainty
+                | Opt::Radius
+                | Opt::Modulus
+                | Opt::TopographyPixelSize
+        )
+    }
+
     /// The cell's text as the flag takes it: a bare number (or list) in a column whose name
     /// carries a unit gets that unit (`200` in `pixel_size_nm` is `200nm`).
     pub fn with_unit(text: &str, unit: Option<&str>) -> String {
@@ -205,7 +222,7 @@ impl Opt {
                 crate::analyze::check_pixel_size_uncertainty(u).map_err(|e| e.to_string())?;
                 json!(u)
             }
-            Opt::PixelSize | Opt::TopographyPixelSize => {
+            Opt::PixelSize | Opt::PixelSizeDefault | Opt::TopographyPixelSize => {
                 if let Ok((_, Some(_))) = units::parse_pixel_size_uncertain(text) {
                     return Err(format!(
                         "'{text}': give the pixel size's uncertainty on its own, as \
@@ -273,6 +290,48 @@ fn parse_axes(text: &str) -> Result<BTreeMap<String, usize>, String> {
         };
     }
     Ok(axes)
+}
+
+/// A message of a series' `analyze` (`stage` [`Command::Analyze`]) or `fit-hardening`
+/// ([`Command::Fit`]), which names the command's flags, in the batch's terms: the first mention
+/// of each flag is followed by where a batch sets it (`--pixel-size (in a batch: the
+/// topography_pixel_size column, or --topography-pixel-size)` for a height map's pixel size).
+pub fn in_batch_terms(message: &str, stage: Command) -> String {
+    let mut out = message.to_string();
+    for &opt in Opt::ALL {
+        let flag = match (stage, opt.command()) {
+            (Command::Fit, Command::Fit | Command::Both) => opt.fit_flag(),
+            (Command::Analyze | Command::Both, Command::Analyze | Command::Both) => {
+                opt.analyze_flag()
+            }
+            _ => continue,
+        };
+        if flag.is_empty() {
+            continue;
+        }
+        // The flag as a whole word (`--pixel-size`, not the start of `--pixel-size-uncertainty`).
+        let whole = |at: usize| {
+            !out[at + flag.len()..]
+                .starts_with(|c: char| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        };
+        let Some(at) = out.match_indices(flag).map(|(i, _)| i).find(|&i| whole(i)) else {
+            continue;
+        };
+        let batch_flag = super::default_flag(opt);
+        let place = match opt {
+            Opt::PixelSize => format!(
+                "the {} column; the batch's {batch_flag} fills only files without one",
+                opt.column()
+            ),
+            _ => format!("the {} column, or the batch's {batch_flag}", opt.column()),
+        };
+        let note = format!(" (in a batch: {place})");
+        if out[at + flag.len()..].starts_with(&note) {
+            continue;
+        }
+        out.insert_str(at + flag.len(), &note);
+    }
+    out
 }
 
 /// A series' options as text, the way the flags take them (units applied, defaults merged).
@@ -440,6 +499,9 @@ impl SeriesOptions {
             pixel_size_m: self
                 .get(Opt::PixelSize)
                 .and_then(|t| units::parse_pixel_size(t).ok()),
+            pixel_size_default_m: self
+                .get(Opt::PixelSizeDefault)
+                .and_then(|t| units::parse_pixel_size(t).ok()),
             pixel_size_uncertainty: self
                 .get(Opt::PixelSizeUncertainty)
                 .and_then(|t| units::parse_relative_uncertainty(t, None).ok())
@@ -593,6 +655,32 @@ pub fn resolve(base: &Path, text: &str) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn messages_name_where_a_batch_sets_a_flag() {
+        let fit = in_batch_terms(
+            "map.npy: no pixel size; give it with --pixel-size (e.g. 1um)",
+            Command::Fit,
+        );
+        assert_eq!(
+            fit,
+            "map.npy: no pixel size; give it with --pixel-size (in a batch: the \
+             topography_pixel_size column, or the batch's --topography-pixel-size) (e.g. 1um)"
+        );
+        let analyze = in_batch_terms(
+            "--pixel-size-uncertainty 1% and --pixel-size 20 nm",
+            Command::Analyze,
+        );
+        assert!(
+            analyze.starts_with("--pixel-size-uncertainty (in a batch: the pixel_size_uncertainty")
+                && analyze.contains(
+                    "--pixel-size (in a batch: the pixel_size column; the batch's \
+                 --pixel-size fills only files without one) 20 nm"
+                ),
+            "{analyze}"
+        );
+        assert_eq!(in_batch_terms("nothing", Command::Analyze), "nothing");
+    }
 
     #[test]
     fn columns_name_options_in_any_spelling_with_units() {

@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use contactscope::image::Plane;
 use contactscope::measure::Mask;
 use contactscope::model_fit::Family;
+use contactscope_formats::units::in_unit;
 
 use super::options::{OutputSettings, SeriesOptions};
 use super::record::{
@@ -41,8 +42,6 @@ pub struct SeriesTask {
     pub topography: Option<PathBuf>,
     /// The options: the row's cells over the batch's defaults.
     pub options: SeriesOptions,
-    /// The pixel size came from the batch's default rather than the row.
-    pub pixel_size_from_default: bool,
     /// Output settings of the whole batch.
     pub settings: OutputSettings,
     /// The batch's folder.
@@ -359,14 +358,16 @@ fn series_result(task: &SeriesTask, open: &OpenSeries, outcome: &AnalyzeOutcome)
         height_px: first.map_or(0, |f| f.height),
         threshold_method: outcome.threshold.method.to_string(),
         threshold: outcome.threshold.value,
-        pixel_size_um: pixel.map(|p| (p.x_m * 1e6, p.y_m * 1e6)),
+        pixel_size_um: pixel.map(|p| (in_unit(p.x_m, 1e6), in_unit(p.y_m, 1e6))),
         pixel_size_source: pixel.map(|p| p.source.describe().to_string()),
         pixel_size_given: task.options.get(super::options::Opt::PixelSize).is_some(),
-        pixel_size_from_default: task.pixel_size_from_default && pixel.is_some(),
+        pixel_size_from_default: pixel.is_some_and(|p| {
+            p.source == contactscope::image::PixelSizeSource::DefaultForUncalibrated
+        }),
         pixel_size_uncertainty: outcome.area_interval.pixel_size_uncertainty,
         metadata_pixel_size_um: first
             .and_then(|f| f.pixel_size)
-            .map(|p| (p.x_m * 1e6, p.y_m * 1e6)),
+            .map(|p| (in_unit(p.x_m, 1e6), in_unit(p.y_m, 1e6))),
         power_law: outcome.fits.power_law.map(|f| PowerLaw {
             prefactor: f.prefactor,
             exponent: f.exponent,

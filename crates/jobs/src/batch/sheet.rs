@@ -107,6 +107,14 @@ impl Sheet {
     /// Check a samplesheet's text; `label` names it in messages, `base` resolves its inputs.
     pub fn parse(bytes: &[u8], label: &Path, base: &Path) -> Result<Sheet> {
         let at = || Location::file(label);
+        if let Some(kind) = spreadsheet_kind(bytes) {
+            return Err(Error::bad_input(
+                at(),
+                format!(
+                    "{kind}, not CSV text: save the sheet as CSV (Excel: File → Save As →                      \"CSV UTF-8\"; LibreOffice: File → Save As → \"Text CSV\") and give that file"
+                ),
+            ));
+        }
         let text = std::str::from_utf8(bytes).map_err(|_| {
             Error::bad_input(at(), "not UTF-8 text (save the samplesheet as CSV UTF-8)")
         })?;
@@ -129,7 +137,11 @@ impl Sheet {
         for record in reader.records() {
             let record =
                 record.map_err(|e| Error::bad_input(at(), format!("not a readable CSV: {e}")))?;
-            let line = record.position().map_or(0, |p| p.line() as usize);
+            let line = crate::table::line_of(text, &record) as usize;
+            // A row with no value at all (a spreadsheet's trailing `,,,,`) is no row.
+            if record.iter().all(str::is_empty) {
+                continue;
+            }
             let cell = |i: usize| record.get(i).unwrap_or("").to_string();
             let bad = |column: &str, m: String| {
                 Error::bad_input(at(), format!("line {line}, column {column}: {m}"))
@@ -152,6 +164,11 @@ impl Sheet {
                 if value.is_empty() {
                     continue;
                 }
+                // In a `;`- or tab-separated sheet a single number may have a decimal comma.
+                let value = match delimiter != b',' && opt.single_number() {
+                    true => decimal_point(&value),
+                    false => value,
+                };
                 let value = Opt::with_unit(&value, unit.as_deref());
                 opt.parse(&value).map_err(|m| bad(&header[*i], m))?;
                 options.0.insert(*opt, value);
@@ -224,6 +241,39 @@ impl Sheet {
         }
         w.into_inner()
             .map_err(|e| Error::InvalidArgument(format!("samplesheet: {e}")))
+    }
+}
+
+/// What kind of spreadsheet file `bytes` is, when it is one rather than text: a ZIP (`.xlsx`,
+/// `.ods`) or an OLE compound file (`.xls`).
+fn spreadsheet_kind(bytes: &[u8]) -> Option<&'static str> {
+    if bytes.starts_with(b"PK\x03\x04") {
+        let head = &bytes[..bytes.len().min(4096)];
+        let has = |needle: &[u8]| head.windows(needle.len()).any(|w| w == needle);
+        return Some(if has(b"opendocument") {
+            "an OpenDocument spreadsheet (.ods)"
+        } else {
+            "an Excel workbook (.xlsx, a ZIP file)"
+        });
+    }
+    bytes
+        .starts_with(&[0xD0, 0xCF, 0x11, 0xE0, 0xA1, 0xB1, 0x1A, 0xE1])
+        .then_some("an old Excel workbook (.xls)")
+}
+
+/// `0,2um` → `0.2um`: one comma between digits and no point is a decimal comma.
+fn decimal_point(cell: &str) -> String {
+    let b = cell.as_bytes();
+    let commas: Vec<usize> = (0..b.len()).filter(|&i| b[i] == b',').collect();
+    match commas[..] {
+        [i] if !cell.contains('.')
+            && i > 0
+            && b[i - 1].is_ascii_digit()
+            && b.get(i + 1).is_some_and(u8::is_ascii_digit) =>
+        {
+            cell.replacen(',', ".", 1)
+        }
+        _ => cell.to_string(),
     }
 }
 
@@ -461,6 +511,41 @@ mod tests {
         let e = err("id,input\ns1,a,extra\n");
         assert!(e.contains("not a readable CSV"), "{e}");
         assert!(err("id,input\ns1,\n").contains("column input: empty"));
+    }
+
+    #[test]
+    fn sheets_as_excel_and_libreoffice_write_them() {
+        // CRLF line ends: line numbers stay exact.
+        let e = parse("id,input,pixel_size\r\ns1,a,200nm\r\ns2,b,200\r\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 3, column pixel_size"), "{e}");
+        let e = parse("\u{feff}# notes\r\nid,input\r\n\r\ns1,a\r\n,\r\ns 2,b\r\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 6, column id"), "{e}");
+        // Empty trailing rows (and empty rows between) are no rows.
+        let sheet = parse("id,input,sample,pixel_size_nm\r\ns1,a,x,200\r\n,,,\r\n,,,\r\n").unwrap();
+        assert_eq!(sheet.rows.len(), 1);
+        // Semicolons with decimal commas; a list keeps its commas.
+        let sheet =
+            parse("id;input;pixel_size_um;radius;forces\ns1;a;0,2;290,5um;4,10,40mN\n").unwrap();
+        let o = &sheet.rows[0].options;
+        assert_eq!(o.get(Opt::PixelSize), Some("0.2um"));
+        assert_eq!(o.get(Opt::Radius), Some("290.5um"));
+        assert_eq!(o.get(Opt::Forces), Some("4,10,40mN"));
+        // A workbook is refused naming CSV export.
+        let e = Sheet::parse(
+            b"PK\x03\x04\x14\x00[Content_Types].xml xl/workbook.xml",
+            Path::new("sheet.xlsx"),
+            Path::new("."),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("sheet.xlsx: an Excel workbook") && e.contains("CSV UTF-8"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -317,7 +317,7 @@ pub fn load(spec: &SeriesSpec, pixel_size_m: Option<(f64, f64)>) -> Result<Loade
     let mut warnings = Vec::new();
     // Reading does not need a pixel size: metadata that cannot be used (implausible, or files
     // that disagree) leave it unknown, with the reason, as `analyze` would refuse them.
-    let pixel_size = match super::pixel_size(&open.series, pixel_size_m, &mut warnings) {
+    let pixel_size = match super::pixel_size(&open.series, pixel_size_m, None, &mut warnings) {
         Ok(p) => p,
         Err(e) => {
             warnings.push(format!(

@@ -9,14 +9,21 @@ use contactscope_formats::ranges::{short, Quantity};
 use super::Series;
 use crate::error::{Error, Location, Result};
 
-/// The pixel size for the whole series: the override, or the files' metadata if they agree.
+/// The pixel size for the whole series: the override, or the files' metadata if they agree,
+/// or else `default_m` (for files that state none; never replacing one they state).
 ///
 /// Notes from the files' metadata, and the lack of any pixel size, are added to `warnings`.
 pub fn pixel_size(
     series: &Series,
     override_m: Option<(f64, f64)>,
+    default_m: Option<(f64, f64)>,
     warnings: &mut Vec<String>,
 ) -> Result<Option<PixelSize>> {
+    let default = default_m.map(|(x_m, y_m)| PixelSize {
+        x_m,
+        y_m,
+        source: PixelSizeSource::DefaultForUncalibrated,
+    });
     if let Some((x_m, y_m)) = override_m {
         warnings.extend(pixel_size_warnings(series, (x_m, y_m), true));
         return Ok(Some(PixelSize {
@@ -27,11 +34,13 @@ pub fn pixel_size(
     }
     let Some(first) = series.files.first() else {
         // Planes in memory: no metadata.
-        warnings.push(format!(
-            "no pixel size given ({}): areas are in pixels",
-            Param::PixelSize
-        ));
-        return Ok(None);
+        if default.is_none() {
+            warnings.push(format!(
+                "no pixel size given ({}): areas are in pixels",
+                Param::PixelSize
+            ));
+        }
+        return Ok(default);
     };
     for other in &series.files[1..] {
         let agree = match (&first.pixel_size, &other.pixel_size) {
@@ -64,14 +73,15 @@ pub fn pixel_size(
         Quantity::PixelSize.check_at(p.x_m, &at)?;
         Quantity::PixelSize.check_at(p.y_m, &at)?;
     }
-    match first.pixel_size {
-        Some(p) => warnings.extend(pixel_size_warnings(series, (p.x_m, p.y_m), false)),
-        None => warnings.push(format!(
+    match (first.pixel_size, default) {
+        (Some(p), _) => warnings.extend(pixel_size_warnings(series, (p.x_m, p.y_m), false)),
+        (None, Some(d)) => warnings.extend(pixel_size_warnings(series, (d.x_m, d.y_m), true)),
+        (None, None) => warnings.push(format!(
             "no pixel size in the files' metadata and no {}: areas are in pixels",
             Param::PixelSize
         )),
     }
-    Ok(first.pixel_size)
+    Ok(first.pixel_size.or(default))
 }
 
 /// Given pixel sizes that differ from the file's metadata by more than this factor are warned of.
@@ -104,9 +114,13 @@ pub fn pixel_size_warnings(series: &Series, used: (f64, f64), given: bool) -> Ve
             let ratio = |a: f64, b: f64| (a / b).max(b / a);
             let worst = ratio(used.0, meta.x_m).max(ratio(used.1, meta.y_m));
             if worst > PIXEL_SIZE_CONTRADICTION {
+                let way = match used.0 * used.1 < meta.x_m * meta.y_m {
+                    true => "smaller",
+                    false => "larger",
+                };
                 out.push(format!(
-                    "{} {} is {}× the {} of {}'s metadata ({}): areas scale with its square; \
-                     the given size is used",
+                    "{} {} is {}× {way} than the {} of {}'s metadata ({}): areas scale with its \
+                     square; the given size is used",
                     Param::PixelSize,
                     show(used),
                     short((worst * 10.0).round() / 10.0),
