@@ -70,7 +70,8 @@ def test_the_page_loads_clean_with_every_image(page):
     out, result = page
     flags = {i: "" if pd.isna(f) else f
              for i, f in zip(result.series["series_id"], result.series["flags"])}
-    assert flags["r1"] == "pixel_size_vs_metadata"
+    # A given 250 nm against the file's 200 nm: flagged, and its areas (×1.56) stand out.
+    assert flags["r1"] == "archive_outlier,pixel_size_vs_metadata"
     assert "threshold_outlier" in flags["r4"]
     assert "edge_contact" in flags["r5"]
     assert flags["missing"] == "failed"
@@ -140,5 +141,74 @@ def test_the_page_loads_clean_with_every_image(page):
                     Image.open(path).convert("RGB").quantize(256).save(path, optimize=True)
                 except ImportError:
                     pass
+        finally:
+            browser.close()
+
+
+@pytest.fixture(scope="module", params=[60, 200])
+def many(request, tmp_path_factory):
+    """A batch of 60 or 200 series (six inputs repeated, four lubricants, a date column with
+    gaps, a failure with a long path), as an archive of a busy lab looks."""
+    n = request.param
+    d = tmp_path_factory.mktemp(f"qc{n}")
+    for k in range(6):
+        _series(d / f"r{k}", seed=30 + k, scale=1.0 + 0.05 * k)
+    deep = "/".join(["a-rather-long-folder-name-of-an-instrument-archive"] * 6)
+    rows = []
+    for i in range(n):
+        date = "" if i % 7 == 3 else f"2024-{1 + i % 12:02d}-{1 + (i * 5) % 28:02d}"
+        lub = ["dry", "glycerol", "water", "hexadecane"][i % 4]
+        inp = f"{deep}/missing.tif" if i == 5 else f"r{i % 6}"
+        rows.append(f"s{i:03d},{inp},{lub},{date}\n")
+    (d / "sheet.csv").write_text("id,input,lubricant,date\n" + "".join(rows))
+    result = cs.batch(d / "sheet.csv", d / "out", color_by="lubricant")
+    return d / "out", result, n
+
+
+def test_many_series_fit_the_window_and_sort_by_kind(many):
+    _browser_or_skip()
+    from playwright.sync_api import sync_playwright
+
+    out, result, n = many
+    order = "Array.from(document.querySelectorAll('#series tbody tr')).map(r => r.id.slice(2))"
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM,
+                                    args=["--no-sandbox", "--disable-gpu", "--no-first-run"])
+        try:
+            for width in (1400, 1920):
+                tab = browser.new_page(viewport={"width": width, "height": 1000})
+                tab.goto((out / "index.html").as_uri())
+                tab.wait_for_load_state("load")
+                # The whole table, its numbers, flags and warnings, within the window.
+                right = tab.evaluate("document.getElementById('series')"
+                                     ".getBoundingClientRect().right")
+                assert right <= width, f"{n} series at {width} px: the table ends at {right}"
+                for head in ("β", "R²", "flags", "warnings"):
+                    box = tab.locator("#series thead th", has_text=head).first.bounding_box()
+                    assert box["x"] + box["width"] <= width, (n, width, head, box)
+                shots = os.environ.get("CONTACTSCOPE_QC_SHOTS")
+                if shots:
+                    tab.screenshot(path=os.path.join(shots, f"qc-{n}-{width}.png"))
+                tab.close()
+            tab = browser.new_page(viewport={"width": 1400, "height": 1000})
+            tab.goto((out / "index.html").as_uri())
+            dates = dict(zip(result.series["series_id"],
+                             result.series["date"].fillna("")))
+            betas = result.series.set_index("series_id")["power_law_exponent"]
+            header = tab.locator("#series thead th", has_text="date")
+            for direction in (1, -1):
+                header.click()
+                ids = tab.evaluate(order)
+                filled = [dates[i] for i in ids if dates[i]]
+                assert filled == sorted(filled, reverse=direction < 0), direction
+                # Series without a date last, whichever way.
+                assert all(not dates[i] for i in ids[len(filled):]), direction
+            header = tab.locator("#series thead th", has_text="β")
+            for direction in (1, -1):
+                header.click()
+                ids = tab.evaluate(order)
+                known = [betas[i] for i in ids if not np.isnan(betas[i])]
+                assert known == sorted(known, reverse=direction < 0), direction
+                assert all(np.isnan(betas[i]) for i in ids[len(known):]), direction
         finally:
             browser.close()

@@ -5,6 +5,7 @@
 mod failures;
 mod faults;
 mod fit;
+mod outliers;
 mod reruns;
 mod sheet;
 mod walk;

@@ -355,6 +355,17 @@ pub fn series_table(metadata: &[MetaColumn], entries: &[Entry]) -> Table {
         }),
     );
     t.text(
+        "flag_notes",
+        entries.iter().map(|e| {
+            let notes: Vec<String> = e
+                .flags
+                .iter()
+                .map(|f| format!("{}: {}", f.code, f.text))
+                .collect();
+            (!notes.is_empty()).then(|| notes.join(" | "))
+        }),
+    );
+    t.text(
         "warnings",
         entries.iter().map(|e| {
             let mut all: Vec<String> = e

@@ -64,7 +64,7 @@ pub fn finish(plan: Plan, fresh: Vec<Record>) -> Result<BatchOutcome> {
         records.push(record);
     }
     let refs: Vec<&Record> = records.iter().collect();
-    let flags = flags::flags(&refs);
+    let flags = flags::flags(&refs, &sample_groups(&plan.sheet));
     let entries: Vec<columns::Entry> = plan
         .sheet
         .rows
@@ -261,4 +261,20 @@ fn provenance_json(plan: &Plan, records: &[Record], outcome: &BatchOutcome, qc_s
         "warnings": outcome.warnings,
         "series": series,
     })
+}
+
+/// Each row's group for the archive-wide comparison: its value in the samplesheet's `sample`
+/// column (or else `sphere`), or one group for the whole archive.
+fn sample_groups(sheet: &super::Sheet) -> Vec<String> {
+    let column = ["sample", "sphere"].iter().find_map(|name| {
+        sheet
+            .metadata
+            .iter()
+            .position(|m| m.name.eq_ignore_ascii_case(name))
+    });
+    sheet
+        .rows
+        .iter()
+        .map(|r| column.map_or(String::new(), |k| r.metadata[k].clone()))
+        .collect()
 }

@@ -4,25 +4,21 @@
 
 use serde::Serialize;
 
+use super::outliers;
 use super::record::{Record, Status};
 
 /// R² of the log–log power law below which a fit is weak.
 pub const WEAK_FIT_R2: f64 = 0.95;
 /// Fewest points of a power law that is not weak.
 pub const WEAK_FIT_POINTS: usize = 3;
-/// Robust z-score (|t − median| / (1.4826 · MAD)) beyond which a series' threshold is far from
-/// the archive's others.
-pub const THRESHOLD_Z: f64 = 3.5;
-/// Fewest comparable series (same sample type, one global Otsu threshold each) before
-/// thresholds are compared.
-pub const THRESHOLD_MIN_SERIES: usize = 5;
 /// Relative difference between a given pixel size and the file's own beyond which it is flagged.
 pub const PIXEL_SIZE_TOLERANCE: f64 = 0.01;
 
 /// One flag: a short code (for filtering) and what it means for this series.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Flag {
-    /// `failed`, `edge_contact`, `weak_fit`, `threshold_outlier`, `pixel_size_default`,
+    /// `failed`, `edge_contact`, `weak_fit`, `threshold_outlier`, `archive_outlier`,
+    /// `pixel_size_default`,
     /// `pixel_size_vs_metadata`, `no_pixel_size`, `no_forces`, `physics`, `warnings`,
     /// `fit_warnings`.
     pub code: &'static str,
@@ -36,6 +32,7 @@ pub const CODES: &[&str] = &[
     "edge_contact",
     "weak_fit",
     "threshold_outlier",
+    "archive_outlier",
     "pixel_size_default",
     "pixel_size_vs_metadata",
     "no_pixel_size",
@@ -45,16 +42,18 @@ pub const CODES: &[&str] = &[
     "fit_warnings",
 ];
 
-/// The flags of each series (in the order of `records`).
-pub fn flags(records: &[&Record]) -> Vec<Vec<Flag>> {
-    let thresholds = ThresholdStats::of(records);
+/// The flags of each series (in the order of `records`); `groups` names each series' sample
+/// for the archive-wide comparison ([`outliers`]; empty: the whole archive).
+pub fn flags(records: &[&Record], groups: &[String]) -> Vec<Vec<Flag>> {
+    let far = outliers::find(records, groups);
     records
         .iter()
-        .map(|r| series_flags(r, &thresholds))
+        .zip(far)
+        .map(|(r, far)| series_flags(r, &far))
         .collect()
 }
 
-fn series_flags(record: &Record, thresholds: &ThresholdStats) -> Vec<Flag> {
+fn series_flags(record: &Record, far: &[outliers::Finding]) -> Vec<Flag> {
     let mut out = Vec::new();
     let mut flag = |code: &'static str, text: String| out.push(Flag { code, text });
     if record.status == Status::Failed {
@@ -111,16 +110,15 @@ fn series_flags(record: &Record, thresholds: &ThresholdStats) -> Vec<Flag> {
         ),
         _ => {}
     }
-    if let (Some(t), Some(z)) = (result.threshold, thresholds.z(record)) {
-        if z.abs() > THRESHOLD_Z {
-            flag(
-                "threshold_outlier",
-                format!(
-                    "threshold {t} is far from the archive's median {} (robust z = {z:.1})",
-                    thresholds.median_of(record).unwrap_or(f64::NAN)
-                ),
-            );
-        }
+    let (thresholds, others): (Vec<_>, Vec<_>) = far
+        .iter()
+        .partition(|(q, _)| *q == outliers::Quantity::Threshold);
+    if !thresholds.is_empty() {
+        flag("threshold_outlier", thresholds[0].1.clone());
+    }
+    if !others.is_empty() {
+        let words: Vec<&str> = others.iter().map(|(_, w)| w.as_str()).collect();
+        flag("archive_outlier", words.join("; "));
     }
     if result.pixel_size_from_default {
         flag(
@@ -182,80 +180,4 @@ fn series_flags(record: &Record, thresholds: &ThresholdStats) -> Vec<Flag> {
         );
     }
     out
-}
-
-/// The archive's thresholds per kind of series (sample type; one global Otsu threshold each).
-struct ThresholdStats {
-    groups: Vec<(String, f64, f64)>,
-}
-
-impl ThresholdStats {
-    fn key(record: &Record) -> Option<(String, f64)> {
-        let r = record.result.as_ref()?;
-        (r.threshold_method == "otsu-global")
-            .then_some(())
-            .and(r.threshold)
-            .map(|t| (r.sample_type.clone(), t))
-    }
-
-    fn of(records: &[&Record]) -> Self {
-        let mut by_type: std::collections::BTreeMap<String, Vec<f64>> = Default::default();
-        for (kind, t) in records.iter().filter_map(|r| ThresholdStats::key(r)) {
-            by_type.entry(kind).or_default().push(t);
-        }
-        let groups = by_type
-            .into_iter()
-            .filter(|(_, v)| v.len() >= THRESHOLD_MIN_SERIES)
-            .map(|(kind, v)| {
-                let median = median(v.clone());
-                let mad = median_abs_dev(&v, median);
-                // A floor on the spread: 1 % of the median, and one grey level.
-                let scale = (1.4826 * mad).max(0.01 * median.abs()).max(1.0);
-                (kind, median, scale)
-            })
-            .collect();
-        ThresholdStats { groups }
-    }
-
-    fn group(&self, record: &Record) -> Option<(f64, f64, f64)> {
-        let (kind, t) = ThresholdStats::key(record)?;
-        self.groups
-            .iter()
-            .find(|(k, _, _)| *k == kind)
-            .map(|(_, m, s)| (t, *m, *s))
-    }
-
-    fn z(&self, record: &Record) -> Option<f64> {
-        self.group(record).map(|(t, m, s)| (t - m) / s)
-    }
-
-    fn median_of(&self, record: &Record) -> Option<f64> {
-        self.group(record).map(|(_, m, _)| m)
-    }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
-fn median_abs_dev(v: &[f64], m: f64) -> f64 {
-    median(v.iter().map(|x| (x - m).abs()).collect())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn medians_and_spreads() {
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
-        assert_eq!(median_abs_dev(&[1.0, 2.0, 3.0, 4.0, 100.0], 3.0), 1.0);
-    }
 }

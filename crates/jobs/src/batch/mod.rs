@@ -29,6 +29,7 @@ mod finish;
 pub mod flags;
 mod folder;
 pub mod options;
+pub mod outliers;
 pub mod qc;
 pub mod record;
 mod run;

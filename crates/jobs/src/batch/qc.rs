@@ -182,6 +182,7 @@ fn combined_plot(
         points,
         curves,
         curves_follow_points: true,
+        translucent: true,
     })
 }
 
@@ -312,8 +313,14 @@ border-radius:8px;background:#f0ad4e;color:#fff;font-size:.8em}.flag.failed{back
 .none{color:#888}.mini .frame{fill:#fff;stroke:#bbb}.mini .pt{fill:#0072b2}\
 .mini .edge{fill:#d55e00}.mini .fit{stroke:#009e73;stroke-width:1.5}.mini .lab{font-size:9px;\
 fill:#555}.controls{margin:.6em 0}.combined{max-width:720px;width:100%;border:1px solid #ddd}\
-details{max-width:28em}.num{text-align:right;white-space:nowrap}";
+details{max-width:28em}.num{text-align:right;white-space:nowrap}\
+td{max-width:18em;overflow-wrap:break-word}td.status,td.notes{max-width:14em;\
+overflow-wrap:anywhere}td.short{white-space:nowrap}";
 
+/// Filtering, "flagged only", and sorting by a click on a column's head: each column sorts by
+/// its kind, found from all its values (ISO dates as dates, numbers as numbers, anything else
+/// as text in natural order); empty cells and "—" sort last in either direction. A cell's
+/// `data-v` is its sort value when its text is not (`0.87 ± 0.01`).
 const SCRIPT: &str = "(function(){\
 var table=document.getElementById('series');var body=table.tBodies[0];\
 var filter=document.getElementById('filter');var flagged=document.getElementById('flagged');\
@@ -322,15 +329,25 @@ for(var i=0;i<body.rows.length;i++){var r=body.rows[i];\
 var show=r.textContent.toLowerCase().indexOf(q)>=0&&(!only||r.dataset.flags!=='');\
 r.style.display=show?'':'none';}}\
 filter.addEventListener('input',apply);flagged.addEventListener('change',apply);\
+var DATE=/^\\d{4}-\\d{2}-\\d{2}([T ]\\d{2}:\\d{2}(:\\d{2}(\\.\\d+)?)?)?(Z|[+-]\\d{2}:?\\d{2})?$/;\
+function key(cell){var v=cell.dataset.v;if(v===undefined)v=cell.textContent;v=v.trim();\
+return(v===''||v==='\u{2014}'||v==='-')?null:v;}\
+function kind(keys){var date=true,num=true,any=false;keys.forEach(function(k){if(k===null)return;\
+any=true;if(!DATE.test(k))date=false;if(k===''||!isFinite(Number(k)))num=false;});\
+return !any?'text':date?'date':num?'num':'text';}\
 var heads=table.tHead.rows[0].cells;\
 for(var c=0;c<heads.length;c++){(function(col){heads[col].addEventListener('click',function(){\
 var rows=Array.prototype.slice.call(body.rows);var dir=heads[col].dataset.dir==='asc'?-1:1;\
-heads[col].dataset.dir=dir===1?'asc':'desc';rows.sort(function(a,b){\
-var x=(a.cells[col].dataset.v||a.cells[col].textContent).trim(),\
-y=(b.cells[col].dataset.v||b.cells[col].textContent).trim();\
-if(x===''||y==='')return (x==='')-(y==='');\
-var nx=parseFloat(x),ny=parseFloat(y);if(!isNaN(nx)&&!isNaN(ny))return dir*(nx-ny);\
-return dir*x.localeCompare(y);});rows.forEach(function(r){body.appendChild(r);});});})(c);}\
+heads[col].dataset.dir=dir===1?'asc':'desc';\
+var keys=new Map();rows.forEach(function(r){keys.set(r,key(r.cells[col]));});\
+var k=kind(Array.from(keys.values()));\
+function val(x){return k==='num'?Number(x):k==='date'?Date.parse(x.replace(' ','T')):x;}\
+rows.sort(function(a,b){var x=keys.get(a),y=keys.get(b);\
+if(x===null||y===null)return (x===null)-(y===null);\
+if(k==='text')return dir*x.localeCompare(y,undefined,{numeric:true});\
+var d=val(x)-val(y);return dir*(d>0?1:d<0?-1:0);});\
+rows.forEach(function(r){body.appendChild(r);});\
+for(var h=0;h<heads.length;h++){if(h!==col)delete heads[h].dataset.dir;}});})(c);}\
 })();";
 
 fn page(
@@ -459,14 +476,22 @@ fn row(html: &mut String, e: &Entry, metadata: usize, fits: bool) {
     }
     html.push_str("</td>");
     for k in 0..metadata {
-        let _ = write!(html, "<td>{}</td>", esc(&e.row.metadata[k]));
+        // A short value (a date, a code) on one line; a long one wraps.
+        let value = &e.row.metadata[k];
+        let class = match value.chars().count() <= 16 {
+            true => " class=\"short\"",
+            false => "",
+        };
+        let _ = write!(html, "<td{class}>{}</td>", esc(value));
     }
     let status = e.record.status.name();
     match &e.record.error {
         Some(err) => {
+            // Folded: a long error (a path deep in an archive) does not widen the table.
             let _ = write!(
                 html,
-                "<td><b>{status}</b> ({})<br>{}</td>",
+                "<td class=\"status\" data-v=\"{status}\"><details><summary><b>{status}</b> \
+                 ({})</summary>{}</details></td>",
                 esc(e.record.failed_stage.as_deref().unwrap_or("")),
                 esc(err)
             );
@@ -495,26 +520,33 @@ fn row(html: &mut String, e: &Entry, metadata: usize, fits: bool) {
             let law = r.power_law;
             let _ = write!(
                 html,
-                "<td class=\"num\" data-v=\"{}\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>",
+                "<td class=\"num\" data-v=\"{}\">{}</td><td class=\"num\">{}</td>\
+                 <td class=\"num\" data-v=\"{}\">{}</td>",
                 law.map_or(String::new(), |l| l.exponent.to_string()),
                 pm(law.map(|l| l.exponent), law.and_then(|l| l.exponent_se), 3),
                 law.and_then(|l| l.r_squared)
                     .map_or("—".into(), |r| format!("{r:.4}")),
-                r.proportional_mpa.map_or("—".into(), |p| format!("{:.1}", p.0)),
+                r.proportional_mpa
+                    .map_or(String::new(), |p| p.0.to_string()),
+                r.proportional_mpa
+                    .map_or("—".into(), |p| format!("{:.1}", p.0)),
             );
         }
         None => html.push_str("<td></td><td></td><td></td><td></td><td></td>"),
     }
     if fits {
         let f = e.record.fit.as_ref();
+        let v = |x: Option<f64>| x.map_or(String::new(), |x| x.to_string());
         let _ = write!(
             html,
-            "<td class=\"num\">{}</td><td class=\"num\">{}</td>",
+            "<td class=\"num\" data-v=\"{}\">{}</td><td class=\"num\" data-v=\"{}\">{}</td>",
+            v(f.and_then(|f| f.k_pa_per_m)),
             pm(
                 f.and_then(|f| f.k_pa_per_m).map(|k| k * 1e-15),
                 f.and_then(|f| f.k_se_pa_per_m).map(|k| k * 1e-15),
                 3
             ),
+            v(f.and_then(|f| f.hardness_pa)),
             pm(
                 f.and_then(|f| f.hardness_pa).map(|p| p * 1e-6),
                 f.and_then(|f| f.hardness_se_pa).map(|p| p * 1e-6),
@@ -536,7 +568,7 @@ fn row(html: &mut String, e: &Entry, metadata: usize, fits: bool) {
                         format!("{} × {}", short(x), short(y))
                     };
                     let from = if r.pixel_size_from_default {
-                        "batch default"
+                        "batch default (file had none)"
                     } else if r.pixel_size_given {
                         "samplesheet"
                     } else {
@@ -548,8 +580,9 @@ fn row(html: &mut String, e: &Entry, metadata: usize, fits: bool) {
             };
             let _ = write!(
                 html,
-                "<td class=\"num\">{}</td><td>{pixel}</td>",
-                esc(&threshold)
+                "<td class=\"num\">{}</td><td data-v=\"{}\">{pixel}</td>",
+                esc(&threshold),
+                r.pixel_size_um.map_or(String::new(), |p| p.0.to_string())
             );
         }
         None => html.push_str("<td></td><td></td>"),
@@ -564,7 +597,7 @@ fn row(html: &mut String, e: &Entry, metadata: usize, fits: bool) {
             esc(f.code)
         );
     }
-    html.push_str("</td><td>");
+    html.push_str("</td><td class=\"notes\">");
     let warnings: Vec<&String> = result
         .iter()
         .flat_map(|r| r.warnings.iter())

@@ -93,6 +93,9 @@ pub struct Chart {
     /// Curve `j` takes the colour of point set `j` (a fit drawn in its data's colour) instead
     /// of colours after the point sets'.
     pub curves_follow_points: bool,
+    /// Points and lines half transparent, so that where many sets overlap none hides another
+    /// (the batch's plot of every series); the legend stays opaque.
+    pub translucent: bool,
 }
 
 /// What is left of a [`Chart`] after dropping points that log axes cannot show.
@@ -252,8 +255,12 @@ impl Chart {
                 }
                 continue;
             }
+            let fill = match self.translucent {
+                true => colour.mix(0.4).filled(),
+                false => colour.filled(),
+            };
             let series = chart
-                .draw_series(xy.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                .draw_series(xy.iter().map(|&p| Circle::new(p, 4, fill)))
                 .map_err(plot_err)?;
             if !set.label.is_empty() {
                 labelled = true;
@@ -268,8 +275,12 @@ impl Chart {
                 false => series_colour(self.points.len() + j),
             };
             let style = colour.stroke_width(2);
+            let line = match self.translucent {
+                true => colour.mix(0.55).stroke_width(2),
+                false => style,
+            };
             let series = chart
-                .draw_series(runs.iter().map(|run| PathElement::new(run.clone(), style)))
+                .draw_series(runs.iter().map(|run| PathElement::new(run.clone(), line)))
                 .map_err(plot_err)?;
             if !curve.label.is_empty() {
                 labelled = true;
