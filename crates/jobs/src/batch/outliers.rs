@@ -180,7 +180,8 @@ pub fn far(logs: &[f64]) -> Vec<(usize, f64, f64)> {
         .filter_map(|(i, &l)| {
             let z = (l - median) / scale;
             let ratio = (l - median).exp();
-            (z.abs() > Z_LIMIT && (ratio > FACTOR || ratio < 1.0 / FACTOR)).then_some((i, z, ratio))
+            (z.abs() > Z_LIMIT && !(1.0 / FACTOR..=FACTOR).contains(&ratio))
+                .then_some((i, z, ratio))
         })
         .collect()
 }
