@@ -178,6 +178,10 @@ fn print_outcome(outcome: &AnalyzeOutcome, written: &[PathBuf], out: &Path) {
         ),
         None => println!("pixel size: unknown, areas in pixels"),
     }
+    println!(
+        "images: {} in load order by {}",
+        outcome.inputs.images, outcome.inputs.order
+    );
     let unit = match r.unit {
         AreaUnit::SquareMicrometre => "µm²",
         AreaUnit::Pixel => "px",

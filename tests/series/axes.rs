@@ -196,3 +196,71 @@ fn a_z_stack_is_a_load_series_only_when_told() {
     );
     analyze(&slices, &tmp.path().join("s"), &["--forces", forces]);
 }
+
+/// Decimal forces in file names: read as numbers (1.25 before 1.5 before 10), and the order
+/// used is printed above the table and kept in `summary.json`.
+#[test]
+fn decimal_names_load_in_numeric_order_and_the_order_is_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let synth = dir.path().join("synth");
+    let o = crate::common::run(&[
+        "synth-series",
+        "--out",
+        synth.to_str().unwrap(),
+        "--size",
+        "192",
+        "--forces",
+        "1,2,4,8mN",
+        "--seed",
+        "3",
+        "--layout",
+        "files",
+    ]);
+    assert!(o.status.success(), "{}", crate::common::stderr(&o));
+    let folder = dir.path().join("decimal");
+    std::fs::create_dir(&folder).unwrap();
+    // Written out of order on purpose; each file a larger load than the one before.
+    for (k, name) in ["load_10mN", "load_1.0mN", "load_1.5mN", "load_1.25mN"]
+        .iter()
+        .enumerate()
+    {
+        let source = ["load_04.tif", "load_01.tif", "load_03.tif", "load_02.tif"][k];
+        std::fs::copy(synth.join(source), folder.join(format!("{name}.tif"))).unwrap();
+    }
+    let out = dir.path().join("out");
+    let o = crate::common::run_ok(&[
+        "analyze",
+        folder.to_str().unwrap(),
+        "--forces",
+        "1,1.25,1.5,10mN",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("images: 4 in load order by file names in natural order"),
+        "{text}"
+    );
+    let names: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.split_whitespace().rev().nth(1))
+        .filter(|w| w.starts_with("load_"))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "load_1.0mN.tif",
+            "load_1.25mN.tif",
+            "load_1.5mN.tif",
+            "load_10mN.tif"
+        ]
+    );
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["inputs"]["order"]
+        .as_str()
+        .unwrap()
+        .starts_with("file names in natural order"));
+    // The areas grow with the load: no physics warning.
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("wrong order"));
+}

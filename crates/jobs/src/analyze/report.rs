@@ -678,6 +678,8 @@ pub struct PixelSizeUsed {
 pub struct InputFacts {
     /// Images in the series.
     pub images: usize,
+    /// How they were put in load order (the manifest's rows, natural file-name order, …).
+    pub order: String,
     /// The manifest, if the series came from one.
     pub manifest: Option<String>,
     /// The channel read.
@@ -697,6 +699,7 @@ impl InputFacts {
     pub fn of(series: &Series, analysis: &Analysis) -> Self {
         InputFacts {
             images: series.images.len(),
+            order: series.order.clone(),
             manifest: series.manifest.as_ref().map(|m| m.display().to_string()),
             channel: series.channel,
             selection: series.selection.clone(),

@@ -206,6 +206,7 @@ impl MemorySeries {
             manifest: None,
             selection: Selection::default(),
             load_axis: None,
+            order: "the stack's first axis, as given".into(),
         };
         if let Some(forces) = &self.forces_n {
             assign_forces(&mut series, forces)?;

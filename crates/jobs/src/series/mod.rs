@@ -78,6 +78,10 @@ pub struct Series {
     pub selection: Selection,
     /// The axis of CZI, ND2 or LIF files holding the loads, if any.
     pub load_axis: Option<LoadAxis>,
+    /// How the images were put in load order, in words (`summary.json`'s `inputs.order`, and
+    /// printed with the files): the manifest's rows, file names in natural order, the files
+    /// as given, a file's planes.
+    pub order: String,
 }
 
 impl Series {
@@ -241,8 +245,14 @@ impl FileTable {
         }
     }
 
-    fn into_series(self, images: Vec<ImageRef>, manifest: Option<PathBuf>) -> Series {
+    fn into_series(
+        self,
+        images: Vec<ImageRef>,
+        manifest: Option<PathBuf>,
+        order: String,
+    ) -> Series {
         Series {
+            order,
             images,
             channel: self.channel(),
             files: self.files,
@@ -267,7 +277,20 @@ pub fn from_files_selected(
 ) -> Result<Series> {
     let mut table = FileTable::new(selection.clone(), load_axis, false);
     let mut images = Vec::new();
-    for path in collect_files(inputs)? {
+    let files = collect_files(inputs)?;
+    let planes = match load_axis {
+        Some(axis) => format!("planes along {}", axis.name()),
+        None => "planes in order".to_string(),
+    };
+    let order = match (inputs.iter().any(|p| p.is_dir()), files.len()) {
+        (true, _) => format!(
+            "file names in natural order (numbers compared as numbers: load_1.25mN, \
+             load_1.5mN, load_10mN), each file's {planes}"
+        ),
+        (false, 1) => format!("the file's {planes}"),
+        (false, _) => format!("the files in the order given, each file's {planes}"),
+    };
+    for path in files {
         let planes = table.get(&path)?.images();
         images.extend(planes.into_iter().map(|(page, plane)| ImageRef {
             path: path.clone(),
@@ -277,7 +300,7 @@ pub fn from_files_selected(
             friction_n: None,
         }));
     }
-    Ok(table.into_series(images, None))
+    Ok(table.into_series(images, None, order))
 }
 
 /// Give each image its force (newtons); the counts must agree.
@@ -445,7 +468,11 @@ pub fn from_manifest_selected(
             "manifest lists no images",
         ));
     }
-    Ok(table.into_series(images, Some(manifest.to_path_buf())))
+    Ok(table.into_series(
+        images,
+        Some(manifest.to_path_buf()),
+        "the manifest's rows".into(),
+    ))
 }
 
 fn resolve_page(
