@@ -191,3 +191,25 @@ def test_a_walk_from_python(archive, cli):
     assert (archive / "walk-out" / "samplesheet.csv").read_text().startswith(
         "id,input,pixel_size_default\na,../walked/a,250nm\n")
     assert os.path.exists(archive / "walk-out" / "index.html")
+
+
+def test_python_batches_share_the_archive_fixes(tmp_path, monkeypatch):
+    """cs.batch and distributed.batch run the same plan and series code as the command line:
+    an Excel-made sheet (CRLF, a trailing empty row), a re-run from another working directory
+    and of the archive moved as a whole reuse every series; the lock is gone afterwards."""
+    lab = tmp_path / "lab"
+    write_series(lab / "s1", 1)
+    write_series(lab / "s2", 2)
+    (lab / "sheet.csv").write_bytes(b"id,input,sample\r\ns1,s1,glass\r\ns2,s2,glass\r\n,,\r\n")
+    monkeypatch.chdir(lab)
+    first = cs.batch("sheet.csv", "results")
+    assert first.outcome["analysed"] == 2
+    assert not (lab / "results" / ".contactscope-batch.lock").exists()
+    monkeypatch.chdir(tmp_path)
+    again = cs.batch(lab / "sheet.csv", lab / "results")
+    assert again.outcome["analysed"] == 0 and again.outcome["reused"] == 2
+    moved = tmp_path / "moved"
+    lab.rename(moved)
+    result = dd.batch(moved / "sheet.csv", moved / "results", client="serial")
+    assert result.outcome["analysed"] == 0
+    pd.testing.assert_frame_equal(result.series, first.series)
