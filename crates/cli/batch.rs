@@ -49,14 +49,18 @@ struct Defaults {
     /// otsu, per-image or a grey value (column threshold; default otsu).
     #[arg(long)]
     threshold: Option<String>,
-    /// Pixel size overriding the files' metadata, e.g. 200nm (column pixel_size); flagged on the
-    /// QC page as a default.
+    /// Pixel size for the files that state none, e.g. 200nm (a file's own is kept; a row's
+    /// pixel_size column replaces it); flagged pixel_size_default where used.
     #[arg(long)]
     pixel_size: Option<String>,
     /// Relative uncertainty of the pixel size (given or the files'), e.g. 1% (column
     /// pixel_size_uncertainty): widens the area and fit intervals.
     #[arg(long)]
     pixel_size_uncertainty: Option<String>,
+    /// The PSF's full width at half maximum for the area intervals, e.g. 450nm (column
+    /// psf_fwhm; without it a 1 µm PSF, wider than a confocal microscope's, is taken).
+    #[arg(long)]
+    psf_fwhm: Option<String>,
     /// Sphere radius, e.g. 290um (column radius): Hertz columns with --modulus; the fit's sphere.
     #[arg(long)]
     radius: Option<String>,
@@ -106,6 +110,7 @@ impl Defaults {
             (Opt::Threshold, &self.threshold),
             (Opt::PixelSize, &self.pixel_size),
             (Opt::PixelSizeUncertainty, &self.pixel_size_uncertainty),
+            (Opt::PsfFwhm, &self.psf_fwhm),
             (Opt::Radius, &self.radius),
             (Opt::Modulus, &self.modulus),
             (Opt::Topography, &self.topography),

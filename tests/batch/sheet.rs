@@ -24,10 +24,10 @@ pub fn archive(dir: &Path) {
     }
     std::fs::write(
         dir.join("sheet.csv"),
-        "id,input,forces_mN,pixel_size_nm,sample,load_cell_N,date\n\
-         a,archive/manifest-a,,,glass,1.5,2026-11-02\n\
-         b,archive/tiffs-b,\"1,2,4,8\",,glass,2,2026-11-03\n\
-         c,archive/c/series.tif,\"1,2,4,8\",250,steel,2.5,2026-11-04\n",
+        "id,input,forces_mN,pixel_size_nm,psf_fwhm_nm,sample,load_cell_N,date\n\
+         a,archive/manifest-a,,,,glass,1.5,2026-11-02\n\
+         b,archive/tiffs-b,\"1,2,4,8\",,,glass,2,2026-11-03\n\
+         c,archive/c/series.tif,\"1,2,4,8\",250,450,steel,2.5,2026-11-04\n",
     )
     .unwrap();
 }
@@ -68,15 +68,19 @@ fn a_samplesheet_gives_analyze_folders_one_table_and_provenance() {
         serde_json::from_slice(&std::fs::read(results.join("series/c/summary.json")).unwrap())
             .unwrap();
     assert_eq!(
-        summary_c["command_line"].as_array().unwrap()[2..7],
+        summary_c["command_line"].as_array().unwrap()[2..9],
         [
             "archive/c/series.tif",
             "--forces",
             "1,2,4,8mN",
             "--pixel-size",
-            "250nm"
+            "250nm",
+            "--psf-fwhm",
+            "450nm"
         ]
     );
+    // The row's PSF reached the area intervals.
+    assert_eq!(summary_c["area_interval"]["psf_fwhm_um"], 0.45);
 
     // The image table: the folders' numbers, with the metadata on every row.
     let images = csv(&results.join("images.csv"));

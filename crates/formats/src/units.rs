@@ -406,18 +406,17 @@ pub fn parse_relative_uncertainty(text: &str, of: Option<f64>) -> Result<f64> {
 }
 
 /// `value × factor` in another unit without the binary noise of the product (2e-7 m × 1e6 is
-/// `0.19999999999999998`, this gives `0.2`): the product rounded to 15 significant digits,
-/// which every f64 holds exactly enough; a value whose digits are all meaningful keeps them
-/// (the rounding moves it by at most a few units in the last place).
+/// `0.19999999999999998`, this gives `0.2`): a product within two units in the last place of a
+/// decimal of at most 12 significant digits is that decimal; any other product (a computed
+/// value whose 16 or 17 digits all come from its computation) is kept exactly.
 pub fn in_unit(value: f64, factor: f64) -> f64 {
     let product = value * factor;
     if !product.is_finite() || product == 0.0 {
         return product;
     }
-    let rounded: f64 = format!("{product:.14e}").parse().unwrap_or(product);
-    // Only noise is removed: a product that moves by more than a few ulps keeps its digits.
+    let rounded: f64 = format!("{product:.11e}").parse().unwrap_or(product);
     let ulp = f64::EPSILON * product.abs();
-    match (rounded - product).abs() <= 4.0 * ulp {
+    match (rounded - product).abs() <= 2.0 * ulp {
         true => rounded,
         false => product,
     }
@@ -448,10 +447,14 @@ mod tests {
         assert_eq!(in_unit(full, 1e6), full * 1e6);
         assert_eq!(in_unit(0.1 + 0.2, 1.0), 0.3);
         assert_eq!(in_unit(0.0, 1e6), 0.0);
-        // A value whose 16th and 17th digits mean something (well away from a 15-digit one)
-        // is not rounded: only the last few ulps move.
+        assert_eq!(in_unit(4.5e-7, 1e6), 0.45);
+        // A computed value keeps every digit (15-digit rounding would move it by 3 ulps).
+        assert_eq!(
+            in_unit(0.371_919_904_654_471_17, 1.0),
+            0.371_919_904_654_471_17
+        );
         let x = 1.0 / 3.0;
-        assert!((in_unit(x, 1.0) - x).abs() <= 4.0 * f64::EPSILON);
+        assert_eq!(in_unit(x, 1.0), x);
     }
 
     #[test]

@@ -44,10 +44,11 @@ pub fn in_si<T>(f: impl FnOnce() -> T) -> T {
 }
 
 fn scaled(v: f64, lab: f64, si_factor: f64) -> f64 {
-    if si() {
-        v * si_factor
-    } else {
-        v * lab
+    let factor = if si() { si_factor } else { lab };
+    // Without the conversion's binary noise (4.5e-7 m is 0.45 µm, not 0.44999999999999996).
+    match factor == 1.0 {
+        true => v,
+        false => contactscope_formats::units::in_unit(v, factor),
     }
 }
 

@@ -106,6 +106,8 @@ options! {
     /// Pixel size for files that state none (the batch's `--pixel-size` becomes this for rows
     /// without their own `pixel_size`).
     PixelSizeDefault: "pixel_size_default", Analyze, "--pixel-size-default", "", Some(Dimension::Length);
+    /// The PSF's FWHM for the area intervals.
+    PsfFwhm: "psf_fwhm", Analyze, "--psf-fwhm", "", Some(Dimension::Length);
     /// Sphere radius (Hertz columns; the sphere of the fit).
     Radius: "radius", Both, "--radius", "--radius", Some(Dimension::Length);
     /// Contact modulus E* (Hertz columns; the fit's material).
@@ -170,6 +172,7 @@ impl Opt {
             self,
             Opt::PixelSize
                 | Opt::PixelSizeDefault
+                | Opt::PsfFwhm
                 | Opt::PixelSizeUncertainty
                 | Opt::Radius
                 | Opt::Modulus
@@ -233,6 +236,7 @@ impl Opt {
                 json!([x, y])
             }
             Opt::Radius => json!(checked(text, Dimension::Length, Quantity::Radius)?),
+            Opt::PsfFwhm => json!(checked(text, Dimension::Length, Quantity::Fwhm)?),
             Opt::Modulus => json!(checked(text, Dimension::Pressure, Quantity::Modulus)?),
             Opt::HeightUnit => json!(checked(text, Dimension::Length, Quantity::Height)?),
             Opt::Topography | Opt::TopographyChannel => json!(text.trim()),
@@ -507,6 +511,7 @@ impl SeriesOptions {
                 .and_then(|t| units::parse_relative_uncertainty(t, None).ok())
                 .unwrap_or(0.0),
             hertz,
+            psf_fwhm_m: self.value(Opt::PsfFwhm),
             memory_budget: settings.memory_mib << 20,
             ..AnalyzeRequest::new(Micrographs::Files(SeriesSpec {
                 inputs: vec![input.to_path_buf()],
