@@ -331,6 +331,11 @@ impl CreatedFolders {
         Ok(created)
     }
 
+    /// Whether any folder was created (`dir` did not exist).
+    pub fn created_any(&self) -> bool {
+        !self.dirs.is_empty()
+    }
+
     /// The output was committed into them: they stay.
     pub fn keep(mut self) {
         unregister_parents(&self.dirs);

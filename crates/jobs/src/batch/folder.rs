@@ -160,7 +160,9 @@ pub(super) fn take_folder(out: &Path) -> Result<Lock> {
                 let lock = Lock {
                     file: file.clone(),
                     out: out.to_path_buf(),
-                    made: Some(made),
+                    // Only a folder this call made is undone: an earlier batch's keeps its
+                    // marker and layout whatever happens.
+                    made: made.created_any().then_some(made),
                     _held: held,
                 };
                 f.write_all(me.to_string().as_bytes())
@@ -328,6 +330,12 @@ mod tests {
         );
         let mut first = take_folder(&out).unwrap();
         assert!(out.join(LOCK).is_file() && out.join(MARKER).is_file());
+        first.keep();
+        drop(first);
+        // An earlier batch's folder taken and given up: its marker and layout stay.
+        drop(take_folder(&out).unwrap());
+        assert!(out.join(MARKER).is_file() && out.join("records").is_dir());
+        let mut first = take_folder(&out).unwrap();
         let err = take_folder(&out).unwrap_err().to_string();
         assert!(err.contains("another batch of this process"), "{err}");
         assert!(

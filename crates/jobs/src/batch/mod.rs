@@ -50,7 +50,6 @@ pub use sheet::Sheet;
 pub use walk::WalkSpec;
 
 use crate::error::{Error, Result};
-pub use faults::VARIABLE as TEST_PAUSE_VARIABLE;
 pub use folder::release_locks;
 use folder::{check_inputs_outside, take_folder, walk_sheet, Lock};
 
