@@ -57,8 +57,12 @@ struct Defaults {
     /// pixel_size_uncertainty): widens the area and fit intervals.
     #[arg(long)]
     pixel_size_uncertainty: Option<String>,
+    /// psf.json written by `contactscope psf` (column psf; relative to the samplesheet's
+    /// folder): the PSF the area intervals take.
+    #[arg(long, conflicts_with = "psf_fwhm")]
+    psf: Option<String>,
     /// The PSF's full width at half maximum for the area intervals, e.g. 450nm (column
-    /// psf_fwhm; without it a 1 µm PSF, wider than a confocal microscope's, is taken).
+    /// psf_fwhm; without it or --psf a 1 µm PSF, wider than a confocal microscope's, is taken).
     #[arg(long)]
     psf_fwhm: Option<String>,
     /// Sphere radius, e.g. 290um (column radius): Hertz columns with --modulus; the fit's sphere.
@@ -111,6 +115,7 @@ impl Defaults {
             (Opt::PixelSize, &self.pixel_size),
             (Opt::PixelSizeUncertainty, &self.pixel_size_uncertainty),
             (Opt::PsfFwhm, &self.psf_fwhm),
+            (Opt::Psf, &self.psf),
             (Opt::Radius, &self.radius),
             (Opt::Modulus, &self.modulus),
             (Opt::Topography, &self.topography),

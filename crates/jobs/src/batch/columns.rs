@@ -12,10 +12,11 @@
 use contactscope_formats::units;
 
 use super::flags::Flag;
-use super::options::{in_batch_terms, Command};
+use super::options::Command;
 use super::record::{ImageResult, Record, SeriesResult};
 use super::sheet::{MetaColumn, MetaKind, Row};
 use super::tables::{Table, Values};
+use super::terms::in_batch_terms;
 
 /// One series as the tables see it.
 pub struct Entry<'a> {

@@ -35,6 +35,7 @@ pub mod record;
 mod run;
 pub mod sheet;
 pub mod tables;
+pub mod terms;
 pub mod walk;
 
 use std::path::{Path, PathBuf};
@@ -243,6 +244,13 @@ pub fn plan(request: BatchRequest) -> Result<Plan> {
         let topography = options
             .get(Opt::Topography)
             .map(|t| options::resolve(&sheet.base, t));
+        // A psf.json is named by its canonical path: the recorded command line finds it from
+        // anywhere, and the same file is the same option whatever the working directory.
+        if let Some(psf) = options.get(Opt::Psf) {
+            let path = options::resolve(&sheet.base, psf);
+            let path = path.canonicalize().unwrap_or(path);
+            options.0.insert(Opt::Psf, path.display().to_string());
+        }
         tasks.push(SeriesTask {
             id: row.id.clone(),
             input: row.input.clone(),

@@ -173,8 +173,12 @@ pub fn run_series(task: &SeriesTask) -> Record {
 type StageError = (&'static str, Error);
 
 fn stages(task: &SeriesTask, progress: &mut Progress) -> std::result::Result<(), StageError> {
-    let request = task.options.analyze_request(&task.input, &task.settings);
+    let mut request = task.options.analyze_request(&task.input, &task.settings);
     let at = |stage: &'static str| move |e: Error| (stage, e);
+    if let Some(psf) = task.options.get(super::options::Opt::Psf) {
+        let fwhm = crate::results::fwhm_from_psf_json(Path::new(psf)).map_err(at("inputs"))?;
+        request.psf_fwhm_m = Some(fwhm);
+    }
     request.check().map_err(at("inputs"))?;
     let open = request.micrographs.open().map_err(at("inputs"))?;
     let mut to_hash: Vec<(PathBuf, &str)> = open
