@@ -128,3 +128,29 @@ fn reruns_redo_only_what_changed() {
     );
     assert_eq!(super::csv(&dir.join("results/series.csv")).1.len(), 1);
 }
+
+#[test]
+fn a_changed_psf_file_redoes_its_series() {
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    synth(dir, "s1", 1, &[]);
+    synth(dir, "s2", 2, &[]);
+    std::fs::write(dir.join("psf.json"), r#"{"fwhm_nm_mean": 450}"#).unwrap();
+    std::fs::write(
+        dir.join("sheet.csv"),
+        "id,input,psf\ns1,s1,psf.json\ns2,s2,\n",
+    )
+    .unwrap();
+    let args = ["--samplesheet", "sheet.csv", "--out", "results"];
+    assert_eq!(counts(&batch_ok(dir, &args)), (2, 0));
+    let fwhm = |dir: &std::path::Path| -> Value {
+        let s = std::fs::read(dir.join("results/series/s1/summary.json")).unwrap();
+        serde_json::from_slice::<Value>(&s).unwrap()["area_interval"]["psf_fwhm_um"].clone()
+    };
+    assert_eq!(fwhm(dir), 0.45);
+    assert_eq!(counts(&batch_ok(dir, &args)), (0, 2));
+    // The same file with another PSF: the series that uses it is analysed again.
+    std::fs::write(dir.join("psf.json"), r#"{"fwhm_nm_mean": 600}"#).unwrap();
+    assert_eq!(counts(&batch_ok(dir, &args)), (1, 1));
+    assert_eq!(fwhm(dir), 0.6);
+}

@@ -20,6 +20,8 @@
 
 use std::collections::BTreeMap;
 
+use contactscope::numerics::stats::median;
+
 use super::record::Record;
 
 /// Robust z beyond which a value is far from its group's.
@@ -172,7 +174,7 @@ pub fn far(logs: &[f64]) -> Vec<(usize, f64, f64)> {
     if logs.len() < MIN_SERIES {
         return Vec::new();
     }
-    let median = median(logs.to_vec());
+    let median = median(logs);
     let mad = median_abs_dev(logs, median);
     let scale = (1.4826 * mad).max(SPREAD_FLOOR);
     logs.iter()
@@ -191,18 +193,8 @@ fn short(v: f64) -> String {
     contactscope_formats::ranges::short(format!("{v:.2e}").parse::<f64>().unwrap_or(v))
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 fn median_abs_dev(v: &[f64], m: f64) -> f64 {
-    median(v.iter().map(|x| (x - m).abs()).collect())
+    median(&v.iter().map(|x| (x - m).abs()).collect::<Vec<_>>())
 }
 
 #[cfg(test)]
@@ -213,8 +205,6 @@ mod tests {
 
     #[test]
     fn medians_and_spreads() {
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
         assert_eq!(median_abs_dev(&[1.0, 2.0, 3.0, 4.0, 100.0], 3.0), 1.0);
     }
 

@@ -44,7 +44,7 @@ impl Status {
 pub struct FileRecord {
     /// As the batch named it.
     pub path: String,
-    /// `image`, `manifest` or `topography`; `seen` for a file of a series that failed before
+    /// `image`, `manifest`, `topography` or `psf`; `seen` for a file of a series that failed before
     /// reading it (size and time only, no hash).
     pub role: String,
     /// Canonical path.

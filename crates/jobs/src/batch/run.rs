@@ -189,6 +189,12 @@ fn stages(task: &SeriesTask, progress: &mut Progress) -> std::result::Result<(),
         .collect();
     to_hash.extend(open.series.manifest.clone().map(|m| (m, "manifest")));
     to_hash.extend(task.topography.clone().map(|t| (t, "topography")));
+    // The PSF's file too: new contents of the same psf.json make the series stale.
+    to_hash.extend(
+        task.options
+            .get(super::options::Opt::Psf)
+            .map(|p| (PathBuf::from(p), "psf")),
+    );
     let lines = task.command_lines();
     let highest = highest_load(&open);
     let thumbnail: Mutex<Option<Result<Vec<u8>>>> = Mutex::new(None);
