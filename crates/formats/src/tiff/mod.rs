@@ -5,6 +5,7 @@
 pub mod axes;
 pub mod metadata;
 pub mod read;
+pub mod spare;
 pub mod write;
 
 use std::path::Path;
@@ -108,6 +109,42 @@ mod tests {
             PixelSizeSource::CommandLine
         );
         assert!(read_pages(&path, Some(1), None).is_err());
+    }
+
+    #[test]
+    fn pages_decoded_into_handed_back_buffers_are_the_pages() {
+        // Uncompressed and LZW pages of one size; each read after the previous page's codes
+        // were handed back (so it decodes over them) gives the page, not what was there.
+        let (width, height) = (37, 23);
+        let page = |k: u16| -> Vec<u16> {
+            (0..width * height)
+                .map(|i| (i as u16).wrapping_mul(31).wrapping_add(977 * k))
+                .collect()
+        };
+        let pages: Vec<Vec<u16>> = (0..4).map(page).collect();
+        let refs: Vec<&[u16]> = pages.iter().map(Vec::as_slice).collect();
+        let dir = tempfile::tempdir().unwrap();
+        for compression in [Compression::None, Compression::Lzw] {
+            let bytes =
+                encode_u16_stack_compressed(&refs, width, height, None, "", compression).unwrap();
+            let path = dir.path().join("pages.tif");
+            std::fs::write(&path, bytes).unwrap();
+            let mut reader = TiffReader::open(&path).unwrap();
+            for k in [0, 1, 2, 3, 1, 0] {
+                let Samples::Int { codes, offset: 0 } = reader.read_page(k, 0).unwrap().samples
+                else {
+                    panic!("uint16 pages");
+                };
+                assert_eq!(codes, pages[k], "page {k}");
+                spare::give_back(codes);
+            }
+            // A buffer of another size is not used for these pages.
+            spare::give_back(vec![7; 5]);
+            let Samples::Int { codes, .. } = reader.read_page(2, 0).unwrap().samples else {
+                panic!("uint16 pages");
+            };
+            assert_eq!(codes, pages[2]);
+        }
     }
 
     #[test]

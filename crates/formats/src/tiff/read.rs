@@ -11,7 +11,7 @@ use std::io::{BufReader, Read, Seek};
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
-use tiff::decoder::{Decoder, DecodingResult, Limits};
+use tiff::decoder::{Decoder, DecodingResult, DecodingSampleType, Limits};
 use tiff::tags::Tag;
 use tiff::{ColorType, TiffError};
 
@@ -233,18 +233,38 @@ impl TiffReader {
             .ok()
             .flatten()
             == Some(2);
-        let mut buffer = DecodingResult::U8(Vec::new());
+        let (width, height) = (width as usize, height as usize);
         let layout = self
             .decoder
-            .read_image_to_buffer(&mut buffer)
+            .image_buffer_layout()
             .map_err(|e| tiff_error(at.clone(), e))?;
+        // One-sample 16-bit pages decode into a buffer an earlier page of the same size handed
+        // back (`spare`): no allocation and no zeroing of 2 MB per 1024² page.
+        let spare = (samples_per_pixel == 1
+            && layout.sample_type == Some(DecodingSampleType::U16)
+            && layout.complete_len == width * height * 2)
+            .then(|| super::spare::take(width * height))
+            .flatten();
+        let mut buffer = DecodingResult::U8(Vec::new());
+        match spare {
+            Some(codes) => {
+                buffer = DecodingResult::U16(codes);
+                self.decoder
+                    .read_image_bytes(buffer.as_buffer(0).as_bytes_mut())
+                    .map_err(|e| tiff_error(at.clone(), e))?;
+            }
+            None => {
+                self.decoder
+                    .read_image_to_buffer(&mut buffer)
+                    .map_err(|e| tiff_error(at.clone(), e))?;
+            }
+        }
         if buffer.as_buffer(0).as_bytes().len() < layout.complete_len {
             return Err(Error::Unsupported {
                 at,
                 reason: "not all sample planes could be decoded within the size limit".into(),
             });
         }
-        let (width, height) = (width as usize, height as usize);
         let spp = samples_per_pixel as usize;
         // Channels of several page-channels of several samples each count samples fastest.
         let channel = if spp > 1 { channel % spp } else { 0 };

@@ -40,7 +40,7 @@ pub use pixel::{
 
 use crate::error::{Error, Location, Result};
 use contactscope::analysis::PlaneSource;
-use contactscope::image::{Plane, SampleType};
+use contactscope::image::{Plane, SampleType, Samples};
 use contactscope_formats::microscopy::select::{ChannelChoice, LoadAxis, SelectedPlane, Selection};
 use contactscope_formats::microscopy::{LoadDefault, MicroscopyFile};
 use contactscope_formats::param::Param;
@@ -657,7 +657,11 @@ impl PlaneSource for SeriesPlanes<'_> {
                     let r = self
                         .plane(&mut reader, i)
                         .map_err(contactscope::Error::from)
-                        .and_then(|p| f(i, &p));
+                        .and_then(|p| {
+                            let r = f(i, &p);
+                            give_back(p);
+                            r
+                        });
                     let failed = r.is_err();
                     out.push((i, r));
                     if failed {
@@ -674,6 +678,19 @@ impl PlaneSource for SeriesPlanes<'_> {
             return Err(flat.swap_remove(pos).1.err().expect("is an error"));
         }
         Ok(flat.into_iter().map(|(_, r)| r.expect("checked")).collect())
+    }
+}
+
+/// The codes of a plane no one else holds (not kept between the passes) go back to the TIFF
+/// reader for the next page of this thread ([`contactscope_formats::tiff::spare`]).
+fn give_back(plane: Arc<Plane>) {
+    if let Ok(Plane {
+        sample_type: SampleType::U16,
+        samples: Samples::Int { codes, .. },
+        ..
+    }) = Arc::try_unwrap(plane)
+    {
+        contactscope_formats::tiff::spare::give_back(codes);
     }
 }
 
