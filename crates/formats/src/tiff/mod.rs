@@ -144,6 +144,22 @@ mod tests {
                 panic!("uint16 pages");
             };
             assert_eq!(codes, pages[2]);
+            // A reader opened with the headers read before decodes the same pages; once the
+            // file has fewer pages, asking for a gone one is an error naming the file.
+            let info = reader.info().clone();
+            let mut again = TiffReader::reopen(info.clone()).unwrap();
+            let Samples::Int { codes, .. } = again.read_page(3, 0).unwrap().samples else {
+                panic!("uint16 pages");
+            };
+            assert_eq!(codes, pages[3]);
+            let fewer = encode_u16_stack(&refs[..2], width, height, None, "").unwrap();
+            std::fs::write(&path, fewer).unwrap();
+            let err = TiffReader::reopen(info)
+                .unwrap()
+                .read_page(3, 0)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("pages.tif"), "{err}");
         }
     }
 

@@ -206,6 +206,23 @@ impl TiffReader {
         Ok(TiffReader { decoder, info })
     }
 
+    /// Open a TIFF file whose headers were read before (`info`, from [`TiffReader::open`] of the
+    /// same file): only the first IFD is read again. For the many short-lived readers of a series
+    /// analysis, which would otherwise parse every IFD of a multi-page file for each page they
+    /// decode. A file that changed since gives errors (or planes of another size, which the
+    /// series checks) when its pages are read, never a panic. The file was noted as an input
+    /// ([`crate::inputs::note_input`]) when it was first opened.
+    pub fn reopen(info: TiffInfo) -> Result<Self> {
+        let path = info.path.clone();
+        let file = File::open(&path).map_err(|e| Error::io(&path, e))?;
+        let mut decoder =
+            Decoder::new(BufReader::new(file)).map_err(|e| tiff_error(Location::file(&path), e))?;
+        let mut limits = Limits::default();
+        limits.decoding_buffer_size = MAX_PAGE_BYTES;
+        decoder = decoder.with_limits(limits);
+        Ok(TiffReader { decoder, info })
+    }
+
     /// Header facts of the file.
     pub fn info(&self) -> &TiffInfo {
         &self.info

@@ -587,7 +587,16 @@ impl<'a> SeriesPlanes<'a> {
     fn read(&self, reader: &mut Option<Reader>, image: &ImageRef) -> Result<Plane> {
         if reader.as_ref().is_none_or(|r| r.path() != image.path) {
             *reader = Some(match image.plane {
-                None => Reader::Tiff(Box::new(TiffReader::open(&image.path)?)),
+                None => Reader::Tiff(Box::new(
+                    match self
+                        .series
+                        .info_of(&image.path)
+                        .and_then(|f| f.tiff.clone())
+                    {
+                        Some(info) => TiffReader::reopen(info)?,
+                        None => TiffReader::open(&image.path)?,
+                    },
+                )),
                 Some(_) => Reader::Vendor(Box::new(MicroscopyFile::open(&image.path)?)),
             });
         }
