@@ -224,7 +224,7 @@ pub enum FillInvalidArg {
 #[derive(clap::Args, Clone, Debug)]
 pub struct TopographyInput {
     /// Height map: .npy, float TIFF, .gsf, text matrix (.txt/.csv/.dat), WSxM .top, Nanoscope
-    /// .di, or a vendor AFM/profilometer file recognised by content (docs/formats.md).
+    /// .di, Nanonis .sxm, or a vendor AFM/profilometer file recognised by content (docs/formats.md).
     #[arg(long = "topography")]
     pub path: PathBuf,
     #[command(flatten)]

@@ -105,3 +105,46 @@ def test_autocorrelation_of_a_czi_plane_matches_cli(cli, tmp_path):
     plane = cs.read_image(czi, channel=1, z=2, t=1)
     again = cs.autocorrelation(plane.images[0], plane.pixel_size_m).rows[0]
     np.testing.assert_allclose(again["acf"], m["acf"], rtol=0, atol=1e-12)
+
+
+def write_sxm(path, forward, backward, scan_range_m, scan_dir):
+    """A Nanonis .sxm scan written from the format's description (header tags, DATA_INFO, the
+    0x1A 0x04 marker, big-endian float32 images forward then backward), independently of the
+    Rust encoder: a current saved forward only, then Z in both directions."""
+    ny, nx = forward.shape
+    header = (
+        ":NANONIS_VERSION:\n2\n:SCANIT_TYPE:\n              FLOAT            MSBFIRST\n"
+        f":SCAN_PIXELS:\n       {nx}       {ny}\n"
+        f":SCAN_RANGE:\n           {scan_range_m[0]:E}           {scan_range_m[1]:E}\n"
+        f":SCAN_DIR:\n{scan_dir}\n:DATA_INFO:\n"
+        "\tChannel\tName\tUnit\tDirection\tCalibration\tOffset\n"
+        "\t0\tCurrent\tA\tforward\t1.000E-10\t0.000E+0\n"
+        "\t14\tZ\tm\tboth\t-3.484E-9\t0.000E+0\n\n:SCANIT_END:\n\n\n"
+    )
+    current = np.full(forward.shape, 1e-12)
+    images = [current, forward, backward]
+    body = b"".join(np.asarray(a, dtype=">f4").tobytes() for a in images)
+    path.write_bytes(header.encode("latin-1") + b"\x1a\x04" + body)
+
+
+def test_nanonis_sxm_reads_with_its_calibration_and_orientation(cli, tmp_path):
+    ny, nx = 6, 8
+    stored = (np.arange(ny * nx, dtype=np.float64).reshape(ny, nx) * 0.25e-9).astype(np.float32)
+    stored[0, 0] = np.nan  # a point not scanned
+    mirrored = stored[:, ::-1] + np.float32(1e-9)  # backward lines are scanned right to left
+    path = tmp_path / "scan.sxm"
+    write_sxm(path, stored, mirrored, (4e-9, 3e-9), "up")
+    t = cs.read_topography(path, detrend="none", fill_invalid="nearest")
+    assert t.pixel_size_m == pytest.approx((0.5e-9, 0.5e-9), rel=1e-12)
+    assert t.heights.shape == (ny, nx)
+    # A scan "up" stores its bottom line first: row 0 of the map is the last stored line.
+    np.testing.assert_allclose(t.heights[0], stored[-1].astype(np.float64), rtol=1e-7)
+    back = cs.read_topography(path, channel="Z (backward)", detrend="none",
+                              fill_invalid="nearest")
+    np.testing.assert_allclose(back.heights[0], stored[-1].astype(np.float64) + 1e-9, rtol=1e-6)
+    summary = json.loads(cli("topography", path, "--json"))
+    assert summary["channel"] == "Z (forward)"
+    assert summary["channels"] == ["Current", "Z (forward)", "Z (backward)"]
+    assert summary["valid_points"] == nx * ny - 1
+    with pytest.raises(cs.InputError, match="'A', not a length"):
+        cs.read_topography(path, channel="Current")

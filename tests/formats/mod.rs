@@ -5,6 +5,7 @@ mod commands;
 mod files;
 mod peer;
 mod real;
+mod sxm;
 mod synthetic;
 mod topography;
 mod vendor_optics;

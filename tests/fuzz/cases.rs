@@ -127,6 +127,12 @@ pub const TEMPLATES: &[Template] = &[
         ["topography", "t.di", "--json"]
     ),
     t!(
+        "topography-sxm",
+        ["t.sxm"],
+        ["t.sxm"],
+        ["topography", "t.sxm", "--json"]
+    ),
+    t!(
         "simulate-npy",
         ["t.npy"],
         ["t.npy"],

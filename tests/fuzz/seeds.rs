@@ -46,6 +46,35 @@ fn text_matrix(dir: &Path) {
     fs::write(dir.join("t.txt"), text).unwrap();
 }
 
+/// A small Nanonis `.sxm` scan (`crates/formats/src/topography/sxm.rs`): a current channel saved
+/// forward only and a height saved in both directions, 6 × 4 pixels, one point not scanned.
+fn sxm(dir: &Path) {
+    let (nx, ny) = (6, 4);
+    let z: Vec<f32> = (0..nx * ny)
+        .map(|i| (i as f32 * 0.7).sin() * 2e-9)
+        .collect();
+    let mut back = z.clone();
+    back[5] = f32::NAN;
+    let current = vec![1e-12f32; nx * ny];
+    use contactscope_formats::topography::sxm::{encode_sxm, SxmSignal};
+    let signals = [
+        SxmSignal {
+            name: "Current",
+            unit: "A",
+            forward: &current,
+            backward: None,
+        },
+        SxmSignal {
+            name: "Z",
+            unit: "m",
+            forward: &z,
+            backward: Some(&back),
+        },
+    ];
+    let bytes = encode_sxm((nx, ny), (6e-9, 4e-9), "up", &signals);
+    fs::write(dir.join("t.sxm"), bytes).unwrap();
+}
+
 /// A small WSxM `.top` file as `crates/formats/src/topography/wsxm.rs` documents the format: three text lines,
 /// an INI-like header, `[Header end]`, then int16 little-endian heights.
 fn wsxm(dir: &Path) {
@@ -166,6 +195,7 @@ pub fn build(dir: &Path) {
     text_matrix(dir);
     wsxm(dir);
     nanoscope(dir);
+    sxm(dir);
     // A simulation folder and an analysis of the series (areas.csv for fits and friction).
     cli(
         dir,

@@ -1,7 +1,7 @@
 //! Which reader a height-map file goes to, decided from its content: magic bytes and headers
 //! first ([`super::detect_file`], NumPy, TIFF, Gwyddion Simple Field, gzip), then text; the
 //! extension only names what the file was expected to be in an error. A file in a format
-//! contactscope knows but does not read (Nanonis, JPK, Keyence, old Gwyddion, Nanoscope force
+//! contactscope knows but does not read (JPK, Keyence, old Gwyddion, Nanoscope force
 //! curves, images, …) is refused
 //! saying what it is.
 
@@ -26,8 +26,6 @@ fn known_unread(head: &[u8]) -> Option<&'static str> {
     } else if starts(b"GWYO") {
         "an old-format Gwyddion file (GWYO, before Gwyddion 2): open it in Gwyddion and save it \
          again (.gwy) to read it"
-    } else if starts(b":NANONIS_VERSION:") {
-        "a Nanonis .sxm file: not read by contactscope; export the map from Gwyddion as .gsf"
     } else if starts(b"VK4_") || starts(b"VK3_") {
         "a Keyence VK3/VK4 file: not read by contactscope (no sample file to test a reader on); \
          export the map as .gsf or a text matrix"
@@ -153,7 +151,7 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
 /// The formats read, for messages.
 pub const READ_FORMATS: &str = "Igor .ibw, Nanosurf .nid, Agilent .mi, Park TIFF, Gwyddion .gwy \
      and .gsf, ISO 25178 .x3p and .sdf, Wyko .opd, Sensofar .plu, Digital Surf .sur, FRT .frt, \
-     Nanoscope .di/.spm, WSxM .top/.stp, Alicona .al3d, TrueMap .tmd, NanoFocus .nms, Image \
+     Nanoscope .di/.spm, WSxM .top/.stp, Nanonis .sxm, Alicona .al3d, TrueMap .tmd, NanoFocus .nms, Image \
      Metrology .bcr/.bcrf, Zygo MetroPro .dat, NetCDF .nc, HDF5 .h5, NumPy .npy, float TIFF, text matrices and x y z grids \
      (also gzip-compressed)";
 
@@ -212,7 +210,6 @@ mod tests {
         for (head, needle) in [
             (&b"GWYOxxxx"[..], "old-format Gwyddion"),
             (b"\\*Force file list\r\n", "force-curve"),
-            (b":NANONIS_VERSION:\n2", "Nanonis"),
             (b"VK4_\0\0\0\0", "Keyence"),
             (b"\x89PNG\r\n\x1a\n", "picture"),
         ] {

@@ -54,6 +54,7 @@
 //! | Bruker/Veeco Vision64 `.opdx` | [`opdx`] | `VCA DATA\x01\x00\x00\x55` | float32 · `DataScale` (a 1-D profile is refused) | `Dimension2Extent`/(columns − 1), `Dimension1Extent`/(rows − 1) | NaN |
 //! | Bruker/Veeco Nanoscope `.di`, `.spm`, `.001`… | `nanoscope` | `\*File list` | `raw·(V_z/65536)·S` | scan size / samples | none |
 //! | WSxM images `.top`, `.stp`, … | `wsxm` | `WSxM file copyright` | integers: `raw·Z amplitude/(max − min)`; floats as stored | X/Y amplitude / points | none |
+//! | Nanonis `.sxm` | [`sxm`] | `:NANONIS_VERSION:` | float32 as stored, in the `DATA_INFO` unit; backward lines mirrored, scans `up` flipped | `SCAN_RANGE` / `SCAN_PIXELS` | NaN (not scanned) |
 //!
 //! A file that states no pixel size (HDF5; a MetroPro file with a camera resolution of 0; a
 //! NetCDF file without `length` attributes) is read with a pixel size of NaN, and
@@ -90,6 +91,7 @@ pub mod park;
 pub mod plu;
 pub mod sdf;
 pub mod sur;
+pub mod sxm;
 pub mod tmd;
 mod vendor;
 pub mod x3p;

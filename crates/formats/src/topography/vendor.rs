@@ -6,7 +6,7 @@ use std::path::Path;
 
 use super::{
     al3d, bcr, frt, gwy, hdf5, ibw, metropro, mi, mnt, nanoscope, netcdf, nid, nms, opd, opdx,
-    park, plu, sdf, sur, tmd, wsxm, x3p,
+    park, plu, sdf, sur, sxm, tmd, wsxm, x3p,
 };
 
 use ndarray::Array2;
@@ -78,6 +78,8 @@ pub enum TopographyFormat {
     Wsxm,
     /// Bruker/Veeco Nanoscope (`.di`, `.spm`, `.001`, …).
     Nanoscope,
+    /// Nanonis scan (`.sxm`).
+    Sxm,
 }
 
 impl TopographyFormat {
@@ -111,6 +113,7 @@ impl TopographyFormat {
             TopographyFormat::Xyz => "xyz",
             TopographyFormat::Wsxm => "wsxm",
             TopographyFormat::Nanoscope => "nanoscope",
+            TopographyFormat::Sxm => "sxm",
         }
     }
 
@@ -215,6 +218,8 @@ pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
         Some(TopographyFormat::Nanoscope)
     } else if starts(b"WSxM file copyright") {
         Some(TopographyFormat::Wsxm)
+    } else if sxm::is_sxm(head) {
+        Some(TopographyFormat::Sxm)
     } else if starts(al3d::MAGIC) {
         Some(TopographyFormat::Al3d)
     } else if starts(tmd::MAGIC) {
@@ -269,7 +274,8 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
         unsupported(
             path,
             "not a height-map format contactscope recognises from its content (ibw, nid, mi, \
-             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf, metropro, netcdf, hdf5, mnt, opdx)",
+             Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf, metropro, netcdf, hdf5, mnt, opdx, \
+             nanoscope, wsxm, sxm)",
         )
     })?;
     match format {
@@ -290,6 +296,7 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 TopographyFormat::Frt => frt::read(path, &bytes, channel),
                 TopographyFormat::Nanoscope => nanoscope::read(path, &bytes, channel),
                 TopographyFormat::Wsxm => wsxm::read(path, &bytes, channel),
+                TopographyFormat::Sxm => sxm::read(path, &bytes, channel),
                 TopographyFormat::Al3d => al3d::read(path, &bytes, channel),
                 TopographyFormat::Tmd => tmd::read(path, &bytes, channel),
                 TopographyFormat::Nms => nms::read(path, &bytes, channel),
