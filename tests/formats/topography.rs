@@ -231,3 +231,44 @@ fn implausible_pixel_size_is_summarised_and_refused_for_contact() {
     let t: Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(t["note"].is_null(), "{t}");
 }
+
+/// A map too small for the slope and curvature (2 × 2, 2 × 5) is summarised with what can be
+/// computed (grid, pixel size, heights as stored), the slope and curvature null and a note why;
+/// 3 × 3 gets them all.
+#[test]
+fn tiny_maps_print_what_they_can() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (nx, ny) in [(2usize, 2usize), (5, 2), (3, 3)] {
+        let heights: Vec<f32> = (0..nx * ny).map(|i| (i * i) as f32 * 1e-9).collect();
+        let mut bytes = format!(
+            "Gwyddion Simple Field 1.0\nXRes = {nx}\nYRes = {ny}\nXReal = {}e-6\nYReal = {}e-6\n\
+             XYUnits = m\nZUnits = m\n",
+            nx, ny
+        )
+        .into_bytes();
+        let pad = 4 - bytes.len() % 4;
+        bytes.extend(std::iter::repeat_n(0u8, pad));
+        for h in &heights {
+            bytes.extend_from_slice(&h.to_le_bytes());
+        }
+        let path = tmp.path().join(format!("t{nx}x{ny}.gsf"));
+        std::fs::write(&path, bytes).unwrap();
+        let o = run_ok(&["topography", s(&path), "--json"]);
+        let t: Value = serde_json::from_slice(&o.stdout).unwrap();
+        let max_um = heights.iter().fold(0f32, |a, &b| a.max(b)) as f64 * 1e6;
+        assert!(
+            (t["height_max_um"].as_f64().unwrap() - max_um).abs() < 1e-12,
+            "{t}"
+        );
+        assert!(t["h_rms_as_stored_um"].as_f64().unwrap() > 0.0, "{t}");
+        let small = nx < 3 || ny < 3;
+        assert_eq!(t["h_prime_rms_as_stored"].is_null(), small, "{t}");
+        assert_eq!(t["detrended"].is_null(), small, "{t}");
+        let note = t["note"].as_str().unwrap_or_default();
+        assert_eq!(note.contains("need at least 3 × 3 points"), small, "{t}");
+        // The text summary too, with exit status 0.
+        let o = run_ok(&["topography", s(&path)]);
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(text.contains("heights:"), "{text}");
+    }
+}
