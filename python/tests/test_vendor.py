@@ -148,3 +148,16 @@ def test_nanonis_sxm_reads_with_its_calibration_and_orientation(cli, tmp_path):
     assert summary["valid_points"] == nx * ny - 1
     with pytest.raises(cs.InputError, match="'A', not a length"):
         cs.read_topography(path, channel="Current")
+
+
+def test_topostats_file_reads_with_its_nm_calibration(cli):
+    """The committed TopoStats-layout fixture (tests/data/topostats_fixture.py): heights in nm
+    and pixel_to_nm_scaling become metres, as AFMReader's load_topostats gives them in nm."""
+    path = ROOT / "fixtures" / "topostats" / "tiny.topostats"
+    t = cs.read_topography(path, detrend="none")
+    i, j = np.mgrid[0:6, 0:8]
+    np.testing.assert_allclose(t.heights, (0.5 * i - 0.25 * j + 0.125 * i * j) * 1e-9,
+                               rtol=0, atol=1e-22)
+    assert t.pixel_size_m == pytest.approx((2.5e-9, 2.5e-9), rel=1e-12)
+    summary = json.loads(cli("topography", path, "--json"))
+    assert (summary["format"], summary["channels"]) == ("topostats", ["image", "image_original"])

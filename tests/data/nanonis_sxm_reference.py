@@ -1,4 +1,4 @@
-"""Reference numbers for the Nanonis .sxm samples (tests/formats/sxm.rs), from nanonispy's own
+"""Reference numbers for the Nanonis .sxm samples (tests/formats/reference_readers.rs), from nanonispy's own
 reader (`nanonispy.read.Scan`, nanonispy 1.1.0 with numpy 1.23, which that release needs).
 
     python tests/data/nanonis_sxm_reference.py DIR/*.sxm > tests/data/nanonis_sxm_reference.csv

@@ -5,7 +5,7 @@ mod commands;
 mod files;
 mod peer;
 mod real;
-mod sxm;
+mod reference_readers;
 mod synthetic;
 mod topography;
 mod vendor_optics;

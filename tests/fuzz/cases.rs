@@ -133,6 +133,12 @@ pub const TEMPLATES: &[Template] = &[
         ["topography", "t.sxm", "--json"]
     ),
     t!(
+        "topography-topostats",
+        ["t.topostats"],
+        ["t.topostats"],
+        ["topography", "t.topostats", "--json"]
+    ),
+    t!(
         "simulate-npy",
         ["t.npy"],
         ["t.npy"],

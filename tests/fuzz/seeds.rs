@@ -196,6 +196,12 @@ pub fn build(dir: &Path) {
     wsxm(dir);
     nanoscope(dir);
     sxm(dir);
+    // TopoStats: the committed fixture (fixtures/topostats, h5py).
+    fs::copy(
+        crate::common::root().join("fixtures/topostats/tiny.topostats"),
+        dir.join("t.topostats"),
+    )
+    .unwrap();
     // A simulation folder and an analysis of the series (areas.csv for fits and friction).
     cli(
         dir,

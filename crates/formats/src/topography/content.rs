@@ -151,7 +151,7 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
 /// The formats read, for messages.
 pub const READ_FORMATS: &str = "Igor .ibw, Nanosurf .nid, Agilent .mi, Park TIFF, Gwyddion .gwy \
      and .gsf, ISO 25178 .x3p and .sdf, Wyko .opd, Sensofar .plu, Digital Surf .sur, FRT .frt, \
-     Nanoscope .di/.spm, WSxM .top/.stp, Nanonis .sxm, Alicona .al3d, TrueMap .tmd, NanoFocus .nms, Image \
+     Nanoscope .di/.spm, WSxM .top/.stp, Nanonis .sxm, TopoStats .topostats, Alicona .al3d, TrueMap .tmd, NanoFocus .nms, Image \
      Metrology .bcr/.bcrf, Zygo MetroPro .dat, NetCDF .nc, HDF5 .h5, NumPy .npy, float TIFF, text matrices and x y z grids \
      (also gzip-compressed)";
 

@@ -10,6 +10,12 @@
 //! [`read_height_map`](super::read_height_map) requires as an argument, and heights as stored,
 //! which it takes as metres unless a height unit is given.
 //!
+//! A TopoStats file (`.topostats`, written by TopoStats and read by AFMReader's
+//! `load_topostats`) is an HDF5 file whose root holds the image as `image` (the levelled heights
+//! TopoStats analyses, in nm), often `image_original` (before levelling, nm) and the scalar
+//! `pixel_to_nm_scaling` (nm per pixel, both axes): it is read with that calibration, its
+//! channels being those two images.
+//!
 //! A NetCDF-4 file is an HDF5 file too: one that holds a `heights` dataset beside the `x` and
 //! `y` coordinate datasets SurfaceTopography writes is read as NetCDF ([`super::netcdf`]), with
 //! the sizes and units its attributes state.
@@ -66,6 +72,9 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
         &mut datasets,
     )?;
     if let Some(map) = netcdf4(path, &datasets, channel)? {
+        return Ok(map);
+    }
+    if let Some(map) = topostats(path, &datasets, channel)? {
         return Ok(map);
     }
     let maps: Vec<&(String, hdf5_reader::Dataset)> = datasets
@@ -195,6 +204,70 @@ fn values(d: &hdf5_reader::Dataset) -> std::result::Result<Vec<f64>, hdf5_reader
     })
 }
 
+/// The TopoStats images (`image`, `image_original`, nm) on pixels of `pixel_to_nm_scaling` nm, or
+/// `None` for another HDF5 file.
+fn topostats(
+    path: &Path,
+    datasets: &[(String, hdf5_reader::Dataset)],
+    channel: Option<&str>,
+) -> Result<Option<HeightMap>> {
+    let find = |name: &str| datasets.iter().find(|(n, _)| n == name).map(|(_, d)| d);
+    let (Some(_), Some(scaling)) = (find("image"), find("pixel_to_nm_scaling")) else {
+        return Ok(None);
+    };
+    if !scaling.shape().iter().all(|&n| n == 1) || !numeric(scaling.dtype()) {
+        return Ok(None);
+    }
+    let nm_per_pixel = values(scaling)
+        .map_err(h5(path))?
+        .first()
+        .copied()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| {
+            bad(
+                path,
+                "TopoStats pixel_to_nm_scaling is not a positive number",
+            )
+        })?;
+    let images: Vec<(&str, &hdf5_reader::Dataset)> = ["image", "image_original"]
+        .into_iter()
+        .filter_map(|name| find(name).map(|d| (name, d)))
+        .filter(|(_, d)| d.shape().len() == 2 && numeric(d.dtype()))
+        .collect();
+    if images.is_empty() {
+        return Err(bad(
+            path,
+            "TopoStats file whose image is not a numeric 2-D dataset",
+        ));
+    }
+    let channels: Vec<ChannelEntry> = images
+        .iter()
+        .map(|(name, _)| ChannelEntry {
+            name: name.to_string(),
+            height: true,
+        })
+        .collect();
+    let index = choose(path, &channels, channel)?;
+    let dataset = images[index].1;
+    let (ny, nx) = shape2(path, dataset.shape())?;
+    grid_bytes(path, nx, ny, 8)?;
+    let heights = values(dataset)
+        .map_err(h5(path))?
+        .into_iter()
+        .map(|h| h * 1e-9)
+        .collect();
+    let pixel = nm_per_pixel * 1e-9;
+    height_map(
+        path,
+        TopographyFormat::TopoStats,
+        (&channels, index),
+        (ny, nx),
+        heights,
+        (pixel, pixel),
+    )
+    .map(Some)
+}
+
 /// The height map of a NetCDF-4 file laid out as SurfaceTopography writes it (a `heights`
 /// dataset and `x`/`y` coordinate datasets), or `None` for another HDF5 file.
 fn netcdf4(
@@ -269,6 +342,37 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("x.h5"), "{err}");
+    }
+
+    #[test]
+    fn topostats_files_carry_their_calibration() {
+        // fixtures/topostats/tiny.topostats (tests/data/topostats_fixture.py, h5py): heights in
+        // nm from a formula, 2.5 nm pixels, a grain mask beside the images.
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/topostats/tiny.topostats");
+        let data = std::fs::read(&path).unwrap();
+        let m = read(&path, &data, None).unwrap();
+        assert_eq!(m.format, TopographyFormat::TopoStats);
+        assert_eq!(m.channels, ["image", "image_original"]);
+        assert_eq!((m.channel.as_str(), m.ny(), m.nx()), ("image", 6, 8));
+        assert_eq!((m.dx_m, m.dy_m), (2.5e-9, 2.5e-9));
+        let formula =
+            |i: usize, j: usize| 0.5 * i as f64 - 0.25 * j as f64 + 0.125 * (i * j) as f64;
+        for ((i, j), h) in m.heights.indexed_iter() {
+            assert!(
+                (h - formula(i, j) * 1e-9).abs() < 1e-24,
+                "({i}, {j}): {h:e}"
+            );
+        }
+        let original = read(&path, &data, Some("image_original")).unwrap();
+        for ((i, j), h) in original.heights.indexed_iter() {
+            let want = (formula(i, j) + 3.0 + 0.5 * j as f64) * 1e-9;
+            assert!((h - want).abs() < 1e-24, "({i}, {j}): {h:e}");
+        }
+        // The grain mask is not a height: asking for it names the two images.
+        let err = read(&path, &data, Some("grain")).unwrap_err().to_string();
+        assert!(err.contains("'image', 'image_original'"), "{err}");
+        truncations_and_corruptions(&path, &data, |d| read(&path, d, None).map(|_| ()));
     }
 
     #[test]

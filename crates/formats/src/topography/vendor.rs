@@ -80,6 +80,9 @@ pub enum TopographyFormat {
     Nanoscope,
     /// Nanonis scan (`.sxm`).
     Sxm,
+    /// TopoStats HDF5 (`.topostats`).
+    #[serde(rename = "topostats")]
+    TopoStats,
 }
 
 impl TopographyFormat {
@@ -114,6 +117,7 @@ impl TopographyFormat {
             TopographyFormat::Wsxm => "wsxm",
             TopographyFormat::Nanoscope => "nanoscope",
             TopographyFormat::Sxm => "sxm",
+            TopographyFormat::TopoStats => "topostats",
         }
     }
 
@@ -124,7 +128,7 @@ impl TopographyFormat {
         let name = self.name();
         let word = matches!(
             self,
-            F::ParkTiff | F::MetroPro | F::NetCdf | F::Tiff | F::Text | F::Nanoscope
+            F::ParkTiff | F::MetroPro | F::NetCdf | F::Tiff | F::Text | F::Nanoscope | F::TopoStats
         );
         let sounds = match word {
             true => "aeiou",
@@ -311,7 +315,8 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 | TopographyFormat::Tiff
                 | TopographyFormat::Gsf
                 | TopographyFormat::Text
-                | TopographyFormat::Xyz => unreachable!("not detected by content"),
+                | TopographyFormat::Xyz
+                | TopographyFormat::TopoStats => unreachable!("not detected by content"),
             }
         }
     }
