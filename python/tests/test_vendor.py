@@ -161,3 +161,19 @@ def test_topostats_file_reads_with_its_nm_calibration(cli):
     assert t.pixel_size_m == pytest.approx((2.5e-9, 2.5e-9), rel=1e-12)
     summary = json.loads(cli("topography", path, "--json"))
     assert (summary["format"], summary["channels"]) == ("topostats", ["image", "image_original"])
+
+
+def test_jpk_tiff_reads_its_default_calibration_slot(cli):
+    """The committed JPK-layout fixture (tests/data/jpk_fixture.py): raw·(−1.5e−15) + 2.5e−6 m of
+    its `calibrated` slot, lines flipped (stored bottom first), 4 nm pixels; the deflection page
+    in newtons is refused."""
+    path = ROOT / "fixtures" / "jpk" / "tiny.jpk"
+    t = cs.read_topography(path, detrend="none")
+    i, j = np.mgrid[0:4, 0:5]
+    raw = 1000 * i + 10 * j
+    np.testing.assert_allclose(t.heights, (raw * -1.5e-15 + 2.5e-6)[::-1], rtol=1e-12)
+    assert t.pixel_size_m == pytest.approx((4e-9, 4e-9), rel=1e-12)
+    summary = json.loads(cli("topography", path, "--json"))
+    assert summary["channel"] == "height (retrace)"
+    with pytest.raises(cs.InputError, match="'N', not a length"):
+        cs.read_topography(path, channel="vDeflection")

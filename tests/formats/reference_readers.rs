@@ -11,6 +11,9 @@
 //!   1.1.0).
 //! * TopoStats `.topostats`: the two files of `AFM-SPM/AFMReader` (`CONTACTSCOPE_AFMREADER_DIR`);
 //!   reference `tests/data/topostats_reference.csv` (`topostats_reference.py`, AFMReader 0.0.7).
+//! * JPK TIFF `.jpk`, `.jpk-qi-image`: the two files of `AFM-SPM/AFMReader`
+//!   (`CONTACTSCOPE_AFMREADER_DIR`); reference `tests/data/jpk_reference.csv`
+//!   (`jpk_reference.py`, AFMReader 0.0.7).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -123,4 +126,28 @@ fn topostats_files_read_as_afmreader_reads_them() {
     // Without a channel: TopoStats' levelled image.
     let map = read_height_map(&dir.join("sample_0_2.topostats"), &ReadOptions::default()).unwrap();
     assert_eq!(map.channel, "image");
+}
+
+#[test]
+fn jpk_tiffs_read_as_afmreader_reads_them() {
+    let Some(dir) = folder(
+        "CONTACTSCOPE_AFMREADER_DIR",
+        "AFMReader's tests/resources/sample_0.jpk and sample_0.jpk-qi-image",
+    ) else {
+        return;
+    };
+    assert_eq!(compare(&dir, "jpk_reference.csv"), 6);
+    // Without a channel: the first height page (a retrace in this file), never the deflection
+    // or adhesion of a QI map (in newtons).
+    let map = read_height_map(&dir.join("sample_0.jpk"), &ReadOptions::default()).unwrap();
+    assert_eq!(map.channel, "height (retrace)");
+    let qi = dir.join("sample_0.jpk-qi-image");
+    let map = read_height_map(&qi, &ReadOptions::default()).unwrap();
+    assert_eq!(map.channel, "measuredHeight (trace)");
+    let options = ReadOptions {
+        channel: Some("adhesion".into()),
+        ..ReadOptions::default()
+    };
+    let err = read_height_map(&qi, &options).unwrap_err().to_string();
+    assert!(err.contains("'N', not a length"), "{err}");
 }

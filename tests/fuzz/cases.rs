@@ -133,6 +133,12 @@ pub const TEMPLATES: &[Template] = &[
         ["topography", "t.sxm", "--json"]
     ),
     t!(
+        "topography-jpk",
+        ["t.jpk"],
+        ["t.jpk"],
+        ["topography", "t.jpk", "--json"]
+    ),
+    t!(
         "topography-topostats",
         ["t.topostats"],
         ["t.topostats"],

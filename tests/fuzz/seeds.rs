@@ -202,6 +202,12 @@ pub fn build(dir: &Path) {
         dir.join("t.topostats"),
     )
     .unwrap();
+    // JPK: the committed fixture (fixtures/jpk, tifffile).
+    fs::copy(
+        crate::common::root().join("fixtures/jpk/tiny.jpk"),
+        dir.join("t.jpk"),
+    )
+    .unwrap();
     // A simulation folder and an analysis of the series (areas.csv for fits and friction).
     cli(
         dir,

@@ -1,7 +1,7 @@
 //! Which reader a height-map file goes to, decided from its content: magic bytes and headers
 //! first ([`super::detect_file`], NumPy, TIFF, Gwyddion Simple Field, gzip), then text; the
 //! extension only names what the file was expected to be in an error. A file in a format
-//! contactscope knows but does not read (JPK, Keyence, old Gwyddion, Nanoscope force
+//! contactscope knows but does not read (Keyence, old Gwyddion, Nanoscope force
 //! curves, images, …) is refused
 //! saying what it is.
 
@@ -100,8 +100,8 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
         return match read_tiff(path, options.pixel_size_m, options.height_unit_m) {
             Err(_) if jpk => Err(unsupported(
                 path,
-                "a JPK Instruments TIFF: not read by contactscope (no sample file to test a \
-                 reader on); export the map as .gsf",
+                "a JPK Instruments TIFF without JPK's scan tags (32768, 32834, 32838): not read by \
+                 contactscope; export the map as .gsf",
             )),
             read => single(read),
         };
@@ -151,7 +151,7 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
 /// The formats read, for messages.
 pub const READ_FORMATS: &str = "Igor .ibw, Nanosurf .nid, Agilent .mi, Park TIFF, Gwyddion .gwy \
      and .gsf, ISO 25178 .x3p and .sdf, Wyko .opd, Sensofar .plu, Digital Surf .sur, FRT .frt, \
-     Nanoscope .di/.spm, WSxM .top/.stp, Nanonis .sxm, TopoStats .topostats, Alicona .al3d, TrueMap .tmd, NanoFocus .nms, Image \
+     Nanoscope .di/.spm, WSxM .top/.stp, Nanonis .sxm, TopoStats .topostats, JPK .jpk, Alicona .al3d, TrueMap .tmd, NanoFocus .nms, Image \
      Metrology .bcr/.bcrf, Zygo MetroPro .dat, NetCDF .nc, HDF5 .h5, NumPy .npy, float TIFF, text matrices and x y z grids \
      (also gzip-compressed)";
 

@@ -50,6 +50,7 @@
 //! | Zygo MetroPro `.dat` | [`metropro`] | `0x881B036F`, `…70`, `…71` | `phase·S·O·λ/R` (m) | camera resolution | phase ≥ 2147483640 |
 //! | NetCDF `.nc` (classic, 64-bit offset) | [`netcdf`] | `CDF\x01`, `CDF\x02`, `CDF\x05` | variable `heights` in its `unit` | `length` of the `x`/`y` variables / points | `mask`, `_FillValue` |
 //! | HDF5 `.h5` | [`hdf5`] | `\x89HDF\r\n\x1a\n` | 2-D datasets as stored, m (or the height unit given) | none: the argument is required | NaN |
+//! | JPK Instruments TIFF `.jpk`, `.jpk-qi-image` | [`jpk`] | TIFF + tags 32768, 32834, 32838 | `raw·multiplier + offset` of the default slot, in its unit; lines flipped | grid lengths / points | none |
 //! | TopoStats `.topostats` | [`hdf5`] | HDF5 with `image` and `pixel_to_nm_scaling` | `image` or `image_original`, nm | `pixel_to_nm_scaling` (nm) | NaN |
 //! | Digital Surf MountainsMap `.mnt` | [`mnt`] | OLE2 (`D0 CF 11 E0`) with a `ScopedContents` stream | `count·step + origin` of the z axis | x and y axis steps | mask value ≠ 9 |
 //! | Bruker/Veeco Vision64 `.opdx` | [`opdx`] | `VCA DATA\x01\x00\x00\x55` | float32 · `DataScale` (a 1-D profile is refused) | `Dimension2Extent`/(columns − 1), `Dimension1Extent`/(rows − 1) | NaN |
@@ -80,6 +81,7 @@ pub mod frt;
 pub mod gwy;
 pub mod hdf5;
 pub mod ibw;
+pub mod jpk;
 pub mod metropro;
 pub mod mi;
 pub mod mnt;

@@ -32,7 +32,7 @@ fn first_ifd(path: &Path, head: &[u8], ifd: &[u8]) -> Result<Vec<(u16, u16, u32,
 }
 
 /// The first IFD's entries read from a file (at most 4096 of them).
-fn entries_of(source: &mut FileSource) -> Result<Vec<(u16, u16, u32, u32)>> {
+pub(crate) fn entries_of(source: &mut FileSource) -> Result<Vec<(u16, u16, u32, u32)>> {
     let path = source.path.clone();
     let head = source.read_up_to(0, 8)?;
     if head.len() < 8 {

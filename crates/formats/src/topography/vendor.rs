@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::{
-    al3d, bcr, frt, gwy, hdf5, ibw, metropro, mi, mnt, nanoscope, netcdf, nid, nms, opd, opdx,
+    al3d, bcr, frt, gwy, hdf5, ibw, jpk, metropro, mi, mnt, nanoscope, netcdf, nid, nms, opd, opdx,
     park, plu, sdf, sur, sxm, tmd, wsxm, x3p,
 };
 
@@ -80,6 +80,8 @@ pub enum TopographyFormat {
     Nanoscope,
     /// Nanonis scan (`.sxm`).
     Sxm,
+    /// JPK Instruments TIFF (`.jpk`, `.jpk-qi-image`).
+    Jpk,
     /// TopoStats HDF5 (`.topostats`).
     #[serde(rename = "topostats")]
     TopoStats,
@@ -118,6 +120,7 @@ impl TopographyFormat {
             TopographyFormat::Nanoscope => "nanoscope",
             TopographyFormat::Sxm => "sxm",
             TopographyFormat::TopoStats => "topostats",
+            TopographyFormat::Jpk => "jpk",
         }
     }
 
@@ -262,8 +265,12 @@ pub fn detect_file(path: &Path) -> Result<Option<TopographyFormat>> {
     if let Some(f) = detect(&head) {
         return Ok(Some(f));
     }
-    if (head.starts_with(b"II*\0") || head.starts_with(b"MM\0*")) && park::is_park(&mut source)? {
+    let tiff = head.starts_with(b"II*\0") || head.starts_with(b"MM\0*");
+    if tiff && park::is_park(&mut source)? {
         return Ok(Some(TopographyFormat::ParkTiff));
+    }
+    if tiff && jpk::is_jpk(&mut source)? {
+        return Ok(Some(TopographyFormat::Jpk));
     }
     if plu::is_plu(&mut source)? {
         return Ok(Some(TopographyFormat::Plu));
@@ -279,7 +286,7 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
             path,
             "not a height-map format contactscope recognises from its content (ibw, nid, mi, \
              Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf, metropro, netcdf, hdf5, mnt, opdx, \
-             nanoscope, wsxm, sxm)",
+             nanoscope, wsxm, sxm, jpk)",
         )
     })?;
     match format {
@@ -301,6 +308,7 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 TopographyFormat::Nanoscope => nanoscope::read(path, &bytes, channel),
                 TopographyFormat::Wsxm => wsxm::read(path, &bytes, channel),
                 TopographyFormat::Sxm => sxm::read(path, &bytes, channel),
+                TopographyFormat::Jpk => jpk::read(path, &bytes, channel),
                 TopographyFormat::Al3d => al3d::read(path, &bytes, channel),
                 TopographyFormat::Tmd => tmd::read(path, &bytes, channel),
                 TopographyFormat::Nms => nms::read(path, &bytes, channel),

@@ -10,7 +10,7 @@ file's pixel size (1 where the file does not state it) and the file's name and s
 
 Height maps: AFM and profilometer files (Igor ibw, Nanosurf nid, PicoView mi, Gwyddion gwy,
 X3P, SDF, Wyko opd, Sensofar plu, Digital Surf sur and mnt, FRT, GSF, WSxM top/stp, Nanoscope
-di/spm/001, Nanonis sxm, TopoStats, Alicona al3d, TrueMap tmd, NanoFocus nms, Image Metrology bcr/bcrf, Vision64 opdx,
+di/spm/001, Nanonis sxm, TopoStats, JPK TIFF, Alicona al3d, TrueMap tmd, NanoFocus nms, Image Metrology bcr/bcrf, Vision64 opdx,
 NetCDF nc, HDF5 h5, Park TIFF) through :func:`contactscope.read_topography`, as the command line's ``topography``
 reads them (plane-levelled, its default): one image layer of heights in µm, scale in µm.
 
@@ -39,7 +39,8 @@ MICROGRAPH_EXTENSIONS = (".tif", ".tiff", ".czi", ".nd2", ".lif")
 TIFF_EXTENSIONS = (".tif", ".tiff")
 TOPOGRAPHY_EXTENSIONS = (".ibw", ".nid", ".mi", ".gwy", ".x3p", ".sdf", ".opd", ".plu", ".sur",
                          ".frt", ".gsf", ".top", ".stp", ".di", ".spm", ".001", ".al3d", ".tmd",
-                         ".nms", ".bcr", ".bcrf", ".mnt", ".opdx", ".nc", ".h5", ".sxm", ".topostats")
+                         ".nms", ".bcr", ".bcrf", ".mnt", ".opdx", ".nc", ".h5", ".sxm", ".topostats", ".jpk",
+                         ".jpk-qi-image")
 
 
 CHANNEL_COLOURS = ("green", "magenta", "cyan", "yellow", "red", "blue", "gray")
