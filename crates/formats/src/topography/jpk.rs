@@ -196,6 +196,17 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
     let (width, height) = decoder.dimensions().map_err(tiff_error(path))?;
     let (nx, ny) = (width as usize, height as usize);
     grid_bytes(path, nx, ny, 8)?;
+    // The pixel size comes from the scan grid: a page of another size would get a wrong one.
+    if (nx as f64, ny as f64) != (points_x, points_y) {
+        return Err(bad(
+            path,
+            format!(
+                "JPK channel '{}' is {nx} × {ny} pixels but the scan grid has {points_x} × \
+                 {points_y} points",
+                page.entry.name
+            ),
+        ));
+    }
     let raw: Vec<f64> = match decoder.read_image().map_err(tiff_error(path))? {
         DecodingResult::I32(v) => v.into_iter().map(f64::from).collect(),
         DecodingResult::U32(v) => v.into_iter().map(f64::from).collect(),
@@ -357,6 +368,21 @@ mod tests {
             .to_string();
         assert!(
             err.contains("'N', not a length") && err.contains("tiny.jpk"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_page_that_does_not_match_the_scan_grid_is_refused() {
+        // The first page's grid-points tag (32838, one SLONG: 5) says 6: the pixel size would be
+        // wrong, so the page is refused naming both sizes.
+        let (path, mut data) = fixture();
+        let entry = [0x46, 0x80, 9, 0, 1, 0, 0, 0, 5, 0, 0, 0];
+        let at = data.windows(12).position(|w| w == entry).unwrap();
+        data[at + 8] = 6;
+        let err = read(&path, &data, None).unwrap_err().to_string();
+        assert!(
+            err.contains("5 × 4 pixels") && err.contains("6 × 4 points"),
             "{err}"
         );
     }
