@@ -177,3 +177,21 @@ def test_jpk_tiff_reads_its_default_calibration_slot(cli):
     assert summary["channel"] == "height (retrace)"
     with pytest.raises(cs.InputError, match="'N', not a length"):
         cs.read_topography(path, channel="vDeflection")
+
+
+def test_a_tiny_map_is_levelled_as_asked_and_says_what_it_cannot_compute(tmp_path):
+    """A 2 × 2 map has no interior point for the slope: its summary leaves the slope null with a
+    note, and its heights are still levelled as asked (plane: they sum to zero)."""
+    import struct
+    header = (b"Gwyddion Simple Field 1.0\nXRes = 2\nYRes = 2\nXReal = 2e-6\nYReal = 2e-6\n"
+              b"XYUnits = m\nZUnits = m\n")
+    header += b"\0" * (4 - len(header) % 4)
+    path = tmp_path / "tiny.gsf"
+    path.write_bytes(header + struct.pack("<4f", 1e-9, 2e-9, 3e-9, 5e-9))
+    t = cs.read_topography(path)
+    assert t.summary["h_prime_rms_as_stored"] is None
+    assert "needs at least 3 × 3 pixels" in t.summary["note"]
+    assert t.pixel_size_m == pytest.approx((1e-6, 1e-6), rel=1e-12)
+    assert abs(t.heights.sum()) < 1e-20
+    stored = cs.read_topography(path, detrend="none")
+    np.testing.assert_allclose(stored.heights.ravel(), [1e-9, 2e-9, 3e-9, 5e-9], rtol=1e-7)

@@ -527,7 +527,12 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
     for text in result.get("notes") or ():
         _warnings.warn(text, ContactscopeWarning, stacklevel=2)
     d = result["summary"]["detrended"]
-    result["pixel_size_m"] = (d["pixel_size_x_m"], d["pixel_size_y_m"])
+    if d is not None:
+        result["pixel_size_m"] = (d["pixel_size_x_m"], d["pixel_size_y_m"])
+    else:
+        # A map too small for the roughness statistics: the file's own grid (as read).
+        p = result["summary"]["pixel_size_m"]
+        result["pixel_size_m"] = (p["x"], p["y"])
     return result
 
 

@@ -191,17 +191,27 @@ fn other_format(path: &Path) -> Option<Error> {
     None
 }
 
+/// A decoder of the file at `path` (its first IFD read), pages limited to [`MAX_PAGE_BYTES`];
+/// `on_error` turns a decoder error into ours.
+fn decoder(
+    path: &Path,
+    on_error: impl FnOnce(TiffError) -> Error,
+) -> Result<Decoder<BufReader<File>>> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut limits = Limits::default();
+    limits.decoding_buffer_size = MAX_PAGE_BYTES;
+    Ok(Decoder::new(BufReader::new(file))
+        .map_err(on_error)?
+        .with_limits(limits))
+}
+
 impl TiffReader {
     /// Open a TIFF file and read its headers (every IFD, no pixel data).
     pub fn open(path: &Path) -> Result<Self> {
         crate::inputs::note_input(path);
-        let file = File::open(path).map_err(|e| Error::io(path, e))?;
-        let mut decoder = Decoder::new(BufReader::new(file)).map_err(|e| {
+        let mut decoder = decoder(path, |e| {
             other_format(path).unwrap_or_else(|| tiff_error(Location::file(path), e))
         })?;
-        let mut limits = Limits::default();
-        limits.decoding_buffer_size = MAX_PAGE_BYTES;
-        decoder = decoder.with_limits(limits);
         let info = read_info(path, &mut decoder)?;
         Ok(TiffReader { decoder, info })
     }
@@ -213,13 +223,7 @@ impl TiffReader {
     /// series checks) when its pages are read, never a panic. The file was noted as an input
     /// ([`crate::inputs::note_input`]) when it was first opened.
     pub fn reopen(info: TiffInfo) -> Result<Self> {
-        let path = info.path.clone();
-        let file = File::open(&path).map_err(|e| Error::io(&path, e))?;
-        let mut decoder =
-            Decoder::new(BufReader::new(file)).map_err(|e| tiff_error(Location::file(&path), e))?;
-        let mut limits = Limits::default();
-        limits.decoding_buffer_size = MAX_PAGE_BYTES;
-        decoder = decoder.with_limits(limits);
+        let decoder = decoder(&info.path, |e| tiff_error(Location::file(&info.path), e))?;
         Ok(TiffReader { decoder, info })
     }
 

@@ -19,7 +19,7 @@ use std::path::Path;
 
 use super::vendor::{choose, grid_bytes, height_map, length_factor, length_scale, ChannelEntry};
 use super::{latin1, HeightMap, TopographyFormat};
-use crate::binary::{bad, slice, unsupported};
+use crate::binary::{bad, decode_values, slice, unsupported};
 use crate::error::Result;
 
 /// The first bytes of every SXM file.
@@ -65,19 +65,16 @@ impl Header {
         let words = self
             .words(tag)
             .ok_or_else(|| bad(path, format!("SXM header has no :{tag}:")))?;
-        match words.as_slice() {
-            [a, b] => match (a.parse(), b.parse()) {
-                (Ok(a), Ok(b)) => Ok((a, b)),
-                _ => Err(bad(
-                    path,
-                    format!("SXM :{tag}: '{}' is not two numbers", words.join(" ")),
-                )),
-            },
-            _ => Err(bad(
+        let pair = match words.as_slice() {
+            [a, b] => a.parse().ok().zip(b.parse().ok()),
+            _ => None,
+        };
+        pair.ok_or_else(|| {
+            bad(
                 path,
                 format!("SXM :{tag}: '{}' is not two numbers", words.join(" ")),
-            )),
-        }
+            )
+        })
     }
 }
 
@@ -159,31 +156,15 @@ pub fn read(path: &Path, bytes: &[u8], channel: Option<&str>) -> Result<HeightMa
         .and_then(|o| o.checked_add(data_start))
         .ok_or_else(|| unsupported(path, "SXM data offset overflows"))?;
     let raw = slice(path, bytes, offset, image_bytes, "channel data")?;
-    let value = |c: &[u8]| {
-        let four = [c[0], c[1], c[2], c[3]];
-        let v = if big_endian {
-            f32::from_be_bytes(four)
-        } else {
-            f32::from_le_bytes(four)
-        };
-        f64::from(v) * scale
-    };
+    let values = decode_values(raw, 4, true, true, big_endian);
     let mut heights = Vec::with_capacity(nx * ny);
-    let lines: Vec<&[u8]> = raw.chunks_exact(nx * 4).collect();
-    let in_order: Box<dyn Iterator<Item = &&[u8]>> = if scan_up {
-        Box::new(lines.iter().rev())
-    } else {
-        Box::new(lines.iter())
+    let mut add = |line: &[f64]| match image.backward {
+        true => heights.extend(line.iter().rev().map(|v| v * scale)),
+        false => heights.extend(line.iter().map(|v| v * scale)),
     };
-    for line in in_order {
-        let values = line.chunks_exact(4).map(value);
-        if image.backward {
-            let mut row: Vec<f64> = values.collect();
-            row.reverse();
-            heights.extend(row);
-        } else {
-            heights.extend(values);
-        }
+    match scan_up {
+        true => values.chunks_exact(nx).rev().for_each(&mut add),
+        false => values.chunks_exact(nx).for_each(&mut add),
     }
     height_map(
         path,

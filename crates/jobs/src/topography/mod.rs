@@ -256,30 +256,29 @@ pub fn run(request: &TopographyRequest) -> Result<TopographyOutcome> {
     let detrend = source.detrend;
     let mut notes = notes;
     match usable(path, map) {
-        // Too small for the finite-difference slope and curvature: the heights' own statistics
-        // (as stored) are what can be said; the others are null, and the note says why.
-        Ok(topography) if topography.nx() < 3 || topography.ny() < 3 => {
-            notes.extend(physics_notes(path, stored.h_rms_m, None));
-            Ok(TopographyOutcome {
-                summary: TopographyDescription {
-                    note: Some(format!(
-                        "{}: the rms slope and curvature need at least 3 × 3 points (the map \
-                         is {} × {}); its heights are summarised as stored",
-                        path.display(),
-                        topography.nx(),
-                        topography.ny()
-                    )),
-                    stored,
-                    detrended: None,
-                },
-                notes,
-                heights: Some(topography),
-            })
-        }
         Ok(mut topography) => {
             topography.detrend(detrend);
-            let stats = SurfaceStats::finite_differences(&topography)
-                .map_err(|e| Error::bad_input(Location::file(path), e.to_string()))?;
+            let stats = match SurfaceStats::finite_differences(&topography) {
+                Ok(stats) => stats,
+                // Too small for the finite-difference slope and curvature (fewer than 3 × 3
+                // points): the heights' own statistics (as stored) are what can be said, the
+                // others are null and the note says why; the heights are levelled as asked.
+                Err(e) => {
+                    notes.extend(physics_notes(path, stored.h_rms_m, None));
+                    return Ok(TopographyOutcome {
+                        summary: TopographyDescription {
+                            note: Some(format!(
+                                "{}: {e}; its heights are summarised as stored",
+                                path.display()
+                            )),
+                            stored,
+                            detrended: None,
+                        },
+                        notes,
+                        heights: Some(topography),
+                    });
+                }
+            };
             notes.extend(physics_notes(path, stats.h_rms_m, Some(stats.h_prime_rms)));
             Ok(TopographyOutcome {
                 summary: TopographyDescription {
