@@ -73,6 +73,11 @@ pub struct Args {
     /// Write the contact masks as TIFF.
     #[arg(long)]
     save_masks: bool,
+    /// Also write the contact masks (NGFF label image `labels/contact`) and the per-image table
+    /// (`tables/contact_areas`) into an OME-Zarr store: a new one (the analysed planes copied
+    /// beside them), or the one OME-Zarr store analysed (its images untouched).
+    #[arg(long, value_name = "STORE")]
+    zarr_out: Option<PathBuf>,
     /// Decoded images of compressed files kept in memory between the two passes, in MiB.
     #[arg(long, default_value_t = DEFAULT_MEMORY_BUDGET >> 20)]
     memory_mib: usize,
@@ -128,6 +133,7 @@ pub fn run(args: Args) -> Result<Finished> {
     let images = ImageOutputs {
         overlays: args.overlays,
         masks: args.save_masks,
+        zarr: args.zarr_out.clone(),
     };
     let bar = progress_bar(
         match &request.micrographs {

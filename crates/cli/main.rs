@@ -56,7 +56,7 @@ enum Command {
     /// A lab's archive in one command: every series of a samplesheet or a folder, one table.
     #[command(
         long_about = "A lab's archive in one command: every series of a samplesheet (id, input, per-series options, metadata columns) or of a folder walk is analysed as `analyze` would (series/ID), fitted with fit-hardening where a row names a height map (fit/ID), and tabulated: images.parquet/.csv (one row per image), series.parquet/.csv (one row per series), batch.json (provenance), index.html (QC page). A re-run redoes only the series whose inputs, options or outputs changed.\n\nExit status: 0 when every series succeeded, 3 when some failed (their rows in series.csv say why; the tables and the page are written), 1 when the batch could not run.",
-        after_help = "Examples:\n  contactscope batch archive/ --out results   (every folder with manifest.csv, every .czi/.nd2/.lif)\n  contactscope batch --samplesheet sheet.csv --out results --color-by lubricant\n  contactscope batch archive/ --pattern '*.czi' --load-axis t --forces 4mN..400mN:8 --out results"
+        after_help = "Examples:\n  contactscope batch archive/ --out results   (every folder with manifest.csv, every .czi/.nd2/.lif/.zarr)\n  contactscope batch --samplesheet sheet.csv --out results --color-by lubricant\n  contactscope batch archive/ --pattern '*.czi' --load-axis t --forces 4mN..400mN:8 --out results"
     )]
     Batch(Box<batch::Args>),
     /// Print the global Otsu threshold of all pages of all inputs.

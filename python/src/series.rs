@@ -261,10 +261,11 @@ impl<'a, 'py> FromPyObject<'a, 'py> for MethodArg {
 /// masks as a (images, rows, columns) bool array. With `out`, the folder the command line's
 /// `analyze --out` writes, by the same writer (`areas.csv`, `summary.json` with `command_line`
 /// as its `command_line`, `area_vs_load.png/.svg`; `overlays` and `save_masks` as its
-/// `--overlays` and `--save-masks`), and `written`: the files' paths. `progress(pass, done,
+/// `--overlays` and `--save-masks`; `zarr_out` as its `--zarr-out`), and `written`: the files'
+/// paths. `progress(pass, done,
 /// total)` is called as the images are read ("histogram") and measured ("measure").
 #[pyfunction]
-#[pyo3(signature = (images, forces=None, pixel_size=None, method=None, radius=None, modulus=None, masks=false, out=None, command_line=None, overlays=false, save_masks=false, progress=None, pixel_size_uncertainty=0.0, psf_fwhm=None))]
+#[pyo3(signature = (images, forces=None, pixel_size=None, method=None, radius=None, modulus=None, masks=false, out=None, command_line=None, overlays=false, save_masks=false, progress=None, pixel_size_uncertainty=0.0, psf_fwhm=None, zarr_out=None))]
 #[allow(clippy::too_many_arguments)]
 fn analyze<'py>(
     py: Python<'py>,
@@ -282,6 +283,7 @@ fn analyze<'py>(
     progress: Option<Py<PyAny>>,
     pixel_size_uncertainty: f64,
     psf_fwhm: Option<f64>,
+    zarr_out: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut request = AnalyzeRequest::new(micrographs(images, forces)?);
     request.pixel_size_uncertainty = pixel_size_uncertainty;
@@ -332,6 +334,7 @@ fn analyze<'py>(
         let outputs = ImageOutputs {
             overlays,
             masks: save_masks,
+            zarr: zarr_out,
         };
         let (outcome, written) = compute(py, move || {
             run_to_folder(&request, &out, &command_line, outputs, &report)

@@ -3,6 +3,7 @@
 
 mod commands;
 mod files;
+mod ome_zarr;
 mod peer;
 mod real;
 mod reference_readers;

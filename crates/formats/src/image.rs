@@ -135,6 +135,8 @@ pub enum PixelSizeSource {
     Nd2Calibration,
     /// Leica LIF `DimensionDescription` (DimID 1, 2) `Length/(NumberOfElements − 1)`.
     LifDimensions,
+    /// OME-Zarr: the full-resolution level's `scale` (times the image's own) in the axis `unit`.
+    OmeZarrScale,
     /// Given for files that state none (`--pixel-size-default`; a batch's `--pixel-size`),
     /// used because these files state none.
     DefaultForUncalibrated,
@@ -157,6 +159,7 @@ impl PixelSizeSource {
             PixelSizeSource::LifDimensions => {
                 "LIF DimensionDescription DimID 1/2 Length/(NumberOfElements-1)"
             }
+            PixelSizeSource::OmeZarrScale => "OME-Zarr level-0 scale × axis unit",
             PixelSizeSource::DefaultForUncalibrated => match crate::param::front_end() {
                 crate::param::FrontEnd::Python => {
                     "given for files without one (pixel_size_default=)"

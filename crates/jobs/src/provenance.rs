@@ -81,9 +81,22 @@ pub struct Stat {
 }
 
 impl Stat {
-    /// The size and modification time of `path` (following symbolic links).
+    /// The size and modification time of `path` (following symbolic links). A folder (an
+    /// OME-Zarr store) counts as the sum of its files' sizes and the latest of their times.
     pub fn of(path: &Path) -> Result<Stat> {
         let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+        if meta.is_dir() {
+            let mut total = Stat {
+                size_bytes: 0,
+                modified_ns: 0,
+            };
+            for (_, file) in tree_files(path)? {
+                let one = Stat::of(&file)?;
+                total.size_bytes += one.size_bytes;
+                total.modified_ns = total.modified_ns.max(one.modified_ns);
+            }
+            return Ok(total);
+        }
         let modified_ns = meta
             .modified()
             .ok()
@@ -96,14 +109,67 @@ impl Stat {
     }
 }
 
+/// The regular files below a folder (symbolic links not followed), as (path relative to the
+/// folder with `/` separators, path), sorted by the relative path's bytes.
+fn tree_files(dir: &Path) -> Result<Vec<(String, std::path::PathBuf)>> {
+    let mut files = Vec::new();
+    for entry in walkdir::WalkDir::new(dir).follow_links(false) {
+        let entry = entry.map_err(|e| {
+            let at = e.path().unwrap_or(dir).to_path_buf();
+            Error::io(at, e.into())
+        })?;
+        if entry.file_type().is_file() {
+            let relative = entry.path().strip_prefix(dir).unwrap_or(entry.path());
+            let name: Vec<String> = relative
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                .collect();
+            files.push((name.join("/"), entry.path().to_path_buf()));
+        }
+    }
+    files.sort();
+    Ok(files)
+}
+
 /// SHA-256 of a file's bytes, as 64 lowercase hex digits, and the number of bytes hashed.
+///
+/// A folder (an OME-Zarr store) has a tree hash: SHA-256 over its regular files in the byte
+/// order of their relative paths, each as its relative path (`/`-separated, UTF-8), a zero
+/// byte, its length as 8 little-endian bytes and its bytes, so that renaming, moving or changing
+/// any file changes the hash.
 pub fn sha256_file(path: &Path) -> Result<(String, u64)> {
-    let mut file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let mut hasher = Sha256::new();
     let mut buffer = vec![0u8; 1 << 20];
+    if path.is_dir() {
+        let mut total = 0u64;
+        for (name, file) in tree_files(path)? {
+            hasher.update(name.as_bytes());
+            hasher.update([0u8]);
+            let len = std::fs::metadata(&file)
+                .map_err(|e| Error::io(&file, e))?
+                .len();
+            hasher.update(len.to_le_bytes());
+            let n = hash_into(&file, &mut hasher, &mut buffer)?;
+            if n != len {
+                return Err(Error::io(
+                    &file,
+                    std::io::Error::other("the file changed while it was hashed"),
+                ));
+            }
+            total += n;
+        }
+        return Ok((hex(&hasher.finalize()), total));
+    }
+    let total = hash_into(path, &mut hasher, &mut buffer)?;
+    Ok((hex(&hasher.finalize()), total))
+}
+
+/// Feed a file's bytes to `hasher`; the number of bytes read.
+fn hash_into(path: &Path, hasher: &mut Sha256, buffer: &mut [u8]) -> Result<u64> {
+    let mut file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let mut total = 0u64;
     loop {
-        let n = match file.read(&mut buffer) {
+        let n = match file.read(buffer) {
             Ok(0) => break,
             Ok(n) => n,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
@@ -112,7 +178,7 @@ pub fn sha256_file(path: &Path) -> Result<(String, u64)> {
         hasher.update(&buffer[..n]);
         total += n as u64;
     }
-    Ok((hex(&hasher.finalize()), total))
+    Ok(total)
 }
 
 /// SHA-256 of bytes in memory, as 64 lowercase hex digits.
@@ -153,6 +219,29 @@ mod tests {
             (sha256_bytes(&bytes), bytes.len() as u64)
         );
         assert!(sha256_file(&dir.path().join("missing")).is_err());
+    }
+
+    #[test]
+    fn a_folder_hashes_as_its_named_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let store = dir.path().join("s.zarr");
+        std::fs::create_dir_all(store.join("0/c")).unwrap();
+        std::fs::write(store.join("zarr.json"), b"{}").unwrap();
+        std::fs::write(store.join("0/c/0"), b"abc").unwrap();
+        // The tree hash by hand: names in byte order, each with its length and bytes.
+        let mut expected = Vec::new();
+        for (name, bytes) in [("0/c/0", &b"abc"[..]), ("zarr.json", &b"{}"[..])] {
+            expected.extend_from_slice(name.as_bytes());
+            expected.push(0);
+            expected.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
+            expected.extend_from_slice(bytes);
+        }
+        let (hash, n) = sha256_file(&store).unwrap();
+        assert_eq!((hash.as_str(), n), (sha256_bytes(&expected).as_str(), 5));
+        assert_eq!(Stat::of(&store).unwrap().size_bytes, 5);
+        // A renamed chunk with the same bytes is another store.
+        std::fs::rename(store.join("0/c/0"), store.join("0/c/1")).unwrap();
+        assert_ne!(sha256_file(&store).unwrap().0, hash);
     }
 
     #[test]

@@ -170,7 +170,7 @@ def batch(samplesheet: Any, out: Union[str, "os.PathLike[str]"], *, base: Any = 
     ``samplesheet``: a samplesheet CSV file, a pandas DataFrame of the same columns (``id``,
     ``input``, per-series options, metadata; relative inputs against ``base``, default the
     working folder) or an archive folder to walk (every folder holding ``manifest.csv``, every
-    file matching ``patterns`` — ``*.czi``, ``*.nd2``, ``*.lif`` by default —, with
+    file matching ``patterns`` — ``*.czi``, ``*.nd2``, ``*.lif``, ``*.zarr`` (OME-Zarr stores) by default —, with
     ``tiff_folders`` every folder of TIFFs). ``out``: the batch's folder.
 
     ``**options``: per-series options for every row that leaves them empty, named as the

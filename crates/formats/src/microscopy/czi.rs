@@ -316,7 +316,7 @@ fn zstd1_decode(
     if !hilo {
         return Ok(data);
     }
-    if pixel % 2 != 0 || data.len() % 2 != 0 {
+    if !pixel.is_multiple_of(2) || data.len() % 2 != 0 {
         return Err(bad(path, "zstd1 hi/lo packing of 8-bit samples"));
     }
     let half = data.len() / 2;

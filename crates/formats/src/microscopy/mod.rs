@@ -29,6 +29,8 @@ pub mod nd2;
 pub mod select;
 pub mod summary;
 mod tiff;
+pub mod zarr;
+pub mod zarr_write;
 
 pub use tiff::{series_of_tiff, LoadDefault};
 
@@ -54,6 +56,9 @@ pub enum MicroscopyFormat {
     Lif,
     /// TIFF, classic or BigTIFF, either byte order.
     Tiff,
+    /// OME-Zarr (OME-NGFF 0.4 on Zarr v2, 0.5 on Zarr v3): a folder, not a file ([`zarr`]).
+    #[serde(rename = "ome-zarr")]
+    OmeZarr,
 }
 
 impl MicroscopyFormat {
@@ -64,6 +69,7 @@ impl MicroscopyFormat {
             MicroscopyFormat::Nd2 => "nd2",
             MicroscopyFormat::Lif => "lif",
             MicroscopyFormat::Tiff => "tiff",
+            MicroscopyFormat::OmeZarr => "ome-zarr",
         }
     }
 }
@@ -311,6 +317,7 @@ enum Backend {
     Nd2(Box<nd2::Nd2Reader>),
     Lif(Box<lif::LifReader>),
     Tiff(Box<tiff::TiffBackend>),
+    Zarr(Box<zarr::ZarrReader>),
 }
 
 /// An open microscopy file: its series, and a reader of their planes.
@@ -339,6 +346,27 @@ impl std::fmt::Debug for MicroscopyFile {
 impl MicroscopyFile {
     /// Open a file, detecting its format from its first bytes, and read its headers.
     pub fn open(path: &Path) -> Result<Self> {
+        if zarr::is_store(path) {
+            let r = zarr::ZarrReader::open(path)?;
+            let series: Vec<SeriesInfo> = r.series();
+            return Ok(MicroscopyFile {
+                path: path.to_path_buf(),
+                format: MicroscopyFormat::OmeZarr,
+                series: series
+                    .iter()
+                    .cloned()
+                    .map(SeriesInfo::as_line_scan)
+                    .collect(),
+                stored: series,
+                backend: Backend::Zarr(Box::new(r)),
+            });
+        }
+        if path.is_dir() {
+            return Err(unsupported(
+                path,
+                "a folder that is not a Zarr store (no zarr.json, .zgroup or .zattrs in it)",
+            ));
+        }
         let mut source = super::binary::FileSource::open(path)?;
         let head = source.read_up_to(0, 64)?;
         let format = detect(&head).ok_or_else(|| match crate::topography::detect(&head) {
@@ -363,7 +391,8 @@ impl MicroscopyFile {
             }
             None => unsupported(
                 path,
-                "not a CZI, ND2, LIF or TIFF file (unknown magic bytes at the start)",
+                "not a CZI, ND2, LIF or TIFF file nor an OME-Zarr folder (unknown magic bytes \
+                 at the start)",
             ),
         })?;
         let (series, backend) = match format {
@@ -383,6 +412,7 @@ impl MicroscopyFile {
                 let r = tiff::TiffBackend::open(path)?;
                 (r.series(), Backend::Tiff(Box::new(r)))
             }
+            MicroscopyFormat::OmeZarr => return Err(unsupported(path, "a Zarr store is a folder")),
         };
         // TIFF files keep their own model (one page, one image).
         let shown = if format == MicroscopyFormat::Tiff {
@@ -417,6 +447,7 @@ impl MicroscopyFile {
         match &self.backend {
             Backend::Czi(r) => r.compressed(),
             Backend::Nd2(r) => r.compressed(),
+            Backend::Zarr(r) => r.compressed(),
             Backend::Lif(_) | Backend::Tiff(_) => false,
         }
     }
@@ -461,6 +492,7 @@ impl Backend {
             Backend::Nd2(r) => r.read_plane(info, index),
             Backend::Lif(r) => r.read_plane(info, index),
             Backend::Tiff(r) => r.read_plane(info, index),
+            Backend::Zarr(r) => r.read_plane(info, index),
         }
     }
 }

@@ -493,6 +493,7 @@ pub fn series_pixel_size(format: MicroscopyFormat, info: &SeriesInfo) -> Option<
         MicroscopyFormat::Czi => PixelSizeSource::CziScaling,
         MicroscopyFormat::Nd2 => PixelSizeSource::Nd2Calibration,
         MicroscopyFormat::Lif => PixelSizeSource::LifDimensions,
+        MicroscopyFormat::OmeZarr => PixelSizeSource::OmeZarrScale,
         // TIFF files go through `crate::tiff`, which knows the finer source.
         MicroscopyFormat::Tiff => return None,
     };
@@ -506,6 +507,9 @@ pub fn series_pixel_size(format: MicroscopyFormat, info: &SeriesInfo) -> Option<
 /// Whether a file is a TIFF (by content; an unreadable file counts as TIFF so that the TIFF
 /// reader reports the problem as before).
 pub fn is_tiff(path: &Path) -> bool {
+    if path.is_dir() {
+        return false;
+    }
     let mut head = [0u8; 16];
     let n = std::fs::File::open(path)
         .and_then(|mut f| std::io::Read::read(&mut f, &mut head))

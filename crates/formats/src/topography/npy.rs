@@ -77,7 +77,7 @@ pub fn encode_npy(heights: &ndarray::Array2<f64>) -> Vec<u8> {
         heights.ncols()
     );
     // Pad with spaces so that magic + version + length + dict + '\n' is a multiple of 64.
-    while (MAGIC.len() + 4 + dict.len() + 1) % 64 != 0 {
+    while !(MAGIC.len() + 4 + dict.len() + 1).is_multiple_of(64) {
         dict.push(' ');
     }
     dict.push('\n');

@@ -669,7 +669,7 @@ mod tests {
                 seed ^= seed << 13;
                 seed ^= seed >> 7;
                 seed ^= seed << 17;
-                if seed % 7 == 0 {
+                if seed.is_multiple_of(7) {
                     *b = (seed >> 24) as u8;
                 }
             }

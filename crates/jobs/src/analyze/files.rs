@@ -12,6 +12,7 @@ use contactscope::image::Plane;
 use contactscope::measure::Mask;
 use contactscope_formats::tiff::write::encode_u8_stack;
 
+use super::zarr_out::ZarrOut;
 use super::{run_open, AnalyzeOutcome, AnalyzeRequest};
 use crate::error::Result;
 use crate::series::{ImageRef, OpenSeries};
@@ -20,12 +21,15 @@ use crate::summary::summary_json_without;
 use crate::table::rows_csv;
 
 /// Per-image outputs of the folder.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ImageOutputs {
     /// One PNG per image with the contact edges in green.
     pub overlays: bool,
     /// The contact masks as TIFF.
     pub masks: bool,
+    /// The masks and the table into an OME-Zarr store ([`super::zarr_out`]): a new one, or
+    /// the one store analysed.
+    pub zarr: Option<PathBuf>,
 }
 
 /// Run `analyze` and write its folder: the outcome and the files written (final paths).
@@ -68,8 +72,15 @@ pub fn run_open_to_folder(
         .chain(open.series.manifest.clone())
         .collect();
     let staging = Staging::new(out_dir, &inputs)?;
+    let zarr = match &images.zarr {
+        Some(path) => Some(ZarrOut::prepare(path, open, pixel_size_m(request, open))?),
+        None => None,
+    };
     let sink = |i: usize, plane: &Plane, mask: &Mask| -> contactscope::Result<()> {
-        write_image_outputs(&staging, request, open, images, i, plane, mask)?;
+        write_image_outputs(&staging, request, open, &images, i, plane, mask)?;
+        if let Some(z) = &zarr {
+            z.write(i, plane, mask)?;
+        }
         observer(i, plane, mask)
     };
     let sink: ImageSink = &sink;
@@ -85,8 +96,22 @@ pub fn run_open_to_folder(
         "summary.json",
         &summary_json_without(command_line, &outcome, &["rows"])?,
     )?;
-    let written = staging.commit()?;
+    let zarr_path = match zarr {
+        Some(z) => Some(z.finish(&outcome.rows)?),
+        None => None,
+    };
+    let mut written = staging.commit()?;
+    written.extend(zarr_path);
     Ok((outcome, written))
+}
+
+/// The pixel size the masks are measured in, (x, y) m: the one given, else the first file's.
+fn pixel_size_m(request: &AnalyzeRequest, open: &OpenSeries) -> Option<(f64, f64)> {
+    request.pixel_size_m.or_else(|| {
+        let file = open.series.files.first()?;
+        let size = file.pixel_size.map(|p| (p.x_m, p.y_m));
+        size.or(request.pixel_size_default_m)
+    })
 }
 
 /// `areas.csv`: one row per image, every column named with its unit.
@@ -123,7 +148,7 @@ fn write_image_outputs(
     staging: &Staging,
     request: &AnalyzeRequest,
     open: &OpenSeries,
-    images: ImageOutputs,
+    images: &ImageOutputs,
     index: usize,
     plane: &Plane,
     mask: &Mask,

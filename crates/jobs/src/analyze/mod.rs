@@ -7,6 +7,7 @@
 
 pub mod files;
 pub mod report;
+pub mod zarr_out;
 
 use serde::Serialize;
 

@@ -207,6 +207,7 @@ fn stages(task: &SeriesTask, progress: &mut Progress) -> std::result::Result<(),
     let images = ImageOutputs {
         overlays: task.settings.overlays,
         masks: task.settings.masks,
+        zarr: None,
     };
     let (hashed, analysed) = rayon::join(
         || hash_files(&to_hash),

@@ -4,7 +4,8 @@
 //! series of its own; with `tiff_folders`, so is every other folder holding TIFF files. A series'
 //! id is its path below the archive with `/` as `-` (`sampleA/run1.czi` → `sampleA-run1`).
 //! Hidden entries (names starting with `.`) and the batch's own output folder are skipped;
-//! symbolic links are not followed. A folder holding TIFF files that no pattern takes, and no
+//! symbolic links are not followed. An OME-Zarr store (`*.zarr`, a folder) is one series taken
+//! whole (`plate.ome.zarr` → `plate`); the walk never looks inside it. A folder holding TIFF files that no pattern takes, and no
 //! manifest, is not a series unless `tiff_folders`: it is listed in [`Sheet::skipped`] with the
 //! options that would take it (the batch prints it as a warning). The walk is in natural order (`run2` before `run10`) and
 //! writes the samplesheet it used, so that the next run can be edited by hand and repeated.
@@ -16,10 +17,11 @@ use globset::{GlobSet, GlobSetBuilder};
 use super::sheet::{id_from, Row, Sheet};
 use crate::error::{Error, Location, Result};
 use crate::series::natural_cmp;
+use contactscope_formats::microscopy::zarr;
 
 /// The default patterns of single-file series: the vendor formats that hold a load series in
-/// one file.
-pub const DEFAULT_PATTERNS: &[&str] = &["*.czi", "*.nd2", "*.lif"];
+/// one file, and OME-Zarr stores (folders, taken whole).
+pub const DEFAULT_PATTERNS: &[&str] = &["*.czi", "*.nd2", "*.lif", "*.zarr"];
 
 /// What a folder walk takes.
 #[derive(Debug, Clone, PartialEq)]
@@ -79,6 +81,17 @@ pub fn walk(spec: &WalkSpec, skip: Option<&Path>) -> Result<Sheet> {
             if path.join("manifest.csv").is_file() {
                 found.push((path.to_path_buf(), true));
                 entries.skip_current_dir();
+            } else if entry.depth() > 0 && zarr::is_store(path) {
+                // An OME-Zarr store is one input: never a folder of files to look into.
+                if patterns.is_match(entry.file_name()) {
+                    found.push((path.to_path_buf(), false));
+                } else {
+                    skipped.push(format!(
+                        "{}: an OME-Zarr store that no --pattern takes (add --pattern '*.zarr')",
+                        path.display()
+                    ));
+                }
+                entries.skip_current_dir();
             } else if spec.tiff_folders && holds_tiffs(path) {
                 found.push((path.to_path_buf(), true));
             } else if let Some(n) = unmatched_tiffs(path, &patterns) {
@@ -118,7 +131,15 @@ pub fn walk(spec: &WalkSpec, skip: Option<&Path>) -> Result<Sheet> {
         let named = if folder {
             relative.clone()
         } else {
-            relative.with_extension("")
+            // `plate.ome.zarr` → `plate`, `run1.czi` → `run1`.
+            let bare = relative.with_extension("");
+            match bare
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("ome"))
+            {
+                true => bare.with_extension(""),
+                false => bare,
+            }
         };
         let text: Vec<String> = named
             .components()

@@ -317,7 +317,7 @@ fn analyze(work: &Path, manifest: &Path, psf_fwhm_m: f64) -> Result<MeasuredCurv
         &["contactscope demo".into()],
         ImageOutputs {
             overlays: true,
-            masks: false,
+            ..ImageOutputs::default()
         },
         &|_, _, _| {},
     )?;

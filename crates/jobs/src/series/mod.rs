@@ -42,7 +42,7 @@ use crate::error::{Error, Location, Result};
 use contactscope::analysis::PlaneSource;
 use contactscope::image::{Plane, SampleType, Samples};
 use contactscope_formats::microscopy::select::{ChannelChoice, LoadAxis, SelectedPlane, Selection};
-use contactscope_formats::microscopy::{LoadDefault, MicroscopyFile};
+use contactscope_formats::microscopy::{zarr, LoadDefault, MicroscopyFile};
 use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
 use contactscope_formats::tiff::{TiffInfo, TiffReader};
@@ -100,7 +100,8 @@ fn is_image_name(path: &Path) -> bool {
 }
 
 /// Expand inputs into files: directories give their image files (.tif, .tiff, .czi, .nd2,
-/// .lif) in natural order, files are kept in the order given.
+/// .lif) and OME-Zarr stores in natural order, files are kept in the order given. An OME-Zarr
+/// store (a folder) is one input, as a file is.
 pub fn collect_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     if inputs.is_empty() {
         return Err(Error::InvalidArgument("no input files given".into()));
@@ -108,19 +109,19 @@ pub fn collect_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for input in inputs {
         let meta = std::fs::metadata(input).map_err(|e| Error::io(input, e))?;
-        if !meta.is_dir() {
+        if !meta.is_dir() || zarr::is_store(input) {
             files.push(input.clone());
             continue;
         }
         let mut found: Vec<PathBuf> = std::fs::read_dir(input)
             .map_err(|e| Error::io(input, e))?
             .filter_map(|entry| entry.ok().map(|e| e.path()))
-            .filter(|p| p.is_file() && is_image_name(p))
+            .filter(|p| (p.is_file() && is_image_name(p)) || zarr::is_store(p))
             .collect();
         if found.is_empty() {
             return Err(Error::bad_input(
                 Location::file(input),
-                "directory holds no .tif, .tiff, .czi, .nd2 or .lif files",
+                "directory holds no .tif, .tiff, .czi, .nd2 or .lif files nor OME-Zarr stores",
             ));
         }
         found.sort_by(|a, b| natural_cmp(&a.to_string_lossy(), &b.to_string_lossy()));

@@ -35,7 +35,7 @@ from ._common import ERRORS, META, guarded, layer_meta, notify_error, one_line, 
 LayerData = Tuple[Any, Dict[str, Any], str]
 PathOrPaths = Union[str, Sequence[str]]
 
-MICROGRAPH_EXTENSIONS = (".tif", ".tiff", ".czi", ".nd2", ".lif")
+MICROGRAPH_EXTENSIONS = (".tif", ".tiff", ".czi", ".nd2", ".lif", ".zarr")
 TIFF_EXTENSIONS = (".tif", ".tiff")
 TOPOGRAPHY_EXTENSIONS = (".ibw", ".nid", ".mi", ".gwy", ".x3p", ".sdf", ".opd", ".plu", ".sur",
                          ".frt", ".gsf", ".top", ".stp", ".di", ".spm", ".001", ".al3d", ".tmd",
@@ -50,8 +50,17 @@ def _ext(path: str) -> str:
     return os.path.splitext(os.fspath(path))[1].lower()
 
 
+def _is_zarr_store(path: str) -> bool:
+    """A folder holding Zarr metadata at its root (an OME-Zarr image, plate or bioformats2raw
+    output): one micrograph file, not a folder of them."""
+    return os.path.isdir(path) and any(
+        os.path.isfile(os.path.join(path, n)) for n in ("zarr.json", ".zgroup", ".zattrs"))
+
+
 def _micrographs_in(folder: str) -> List[str]:
-    return [n for n in os.listdir(folder) if _ext(n) in MICROGRAPH_EXTENSIONS]
+    return [n for n in os.listdir(folder)
+            if _ext(n) in MICROGRAPH_EXTENSIONS
+            and (_ext(n) != ".zarr" or _is_zarr_store(os.path.join(folder, n)))]
 
 
 def get_micrograph_reader(path: PathOrPaths) -> Optional[Callable[[PathOrPaths], List[LayerData]]]:
@@ -62,10 +71,10 @@ def get_micrograph_reader(path: PathOrPaths) -> Optional[Callable[[PathOrPaths],
         if not paths or any(_ext(p) not in MICROGRAPH_EXTENSIONS for p in paths):
             return None
         return read_stack
-    path = os.fspath(path)
-    if os.path.isdir(path):
+    path = os.fspath(path).rstrip("/\\") or os.fspath(path)
+    if os.path.isdir(path) and not _is_zarr_store(path):
         return read_stack if _micrographs_in(path) else None
-    if _ext(path) not in MICROGRAPH_EXTENSIONS:
+    if _ext(path) not in MICROGRAPH_EXTENSIONS and not _is_zarr_store(path):
         return None
     try:
         cs.info(path)

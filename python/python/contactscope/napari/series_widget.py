@@ -595,7 +595,7 @@ def choose_micrographs(parent: Any, field: Any) -> bool:
     (``;``-separated). Whether any were chosen."""
     names, _ = QFileDialog.getOpenFileNames(
         parent, "Micrographs or a manifest", "",
-        "Micrographs (*.tif *.tiff *.czi *.nd2 *.lif);;Manifest (*.csv);;All files (*)")
+        "Micrographs (*.tif *.tiff *.czi *.nd2 *.lif *.zarr);;Manifest (*.csv);;All files (*)")
     if names:
         field.setText(";".join(names))
     return bool(names)

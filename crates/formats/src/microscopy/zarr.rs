@@ -1,0 +1,714 @@
+//! OME-Zarr (OME-NGFF) images: NGFF 0.4 on Zarr v2 and 0.5 on Zarr v3, read through the
+//! `zarrs` crates (chunks, codecs, sharding) and `ome_zarr_metadata` (the NGFF attributes).
+//!
+//! A store is a folder (`image.ome.zarr`) whose root group holds one of:
+//! - `multiscales` (an image written by ome-zarr-py, ngff-zarr, bioio, …): one series per
+//!   multiscale image;
+//! - `bioformats2raw.layout` (bioformats2raw's output): the images `0`, `1`, … each a series;
+//! - `plate` (a high-content screening plate): every field of every well a series, named
+//!   `row/column/field` as the plate's paths give them.
+//!
+//! Of each multiscale image the full-resolution level (the first `datasets` entry, NGFF 0.4
+//! §"multiscales") is read. Axes are taken by name and type (`t`/time, `c`/channel, `z`, `y`,
+//! `x`; any other name becomes an extra axis); y must come before x, as NGFF requires of the
+//! last two spatial axes. The pixel size is the level's `scale` times the image's own `scale`
+//! (when it has one) in the axis's `unit` (NGFF 0.4 §"coordinateTransformations", §"axes"): an
+//! axis without a length unit gives no pixel size, and the summary says why. Channel names are
+//! the `omero` channel labels. Per the Zarr specification a chunk missing from the store holds
+//! the array's fill value.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use ome_zarr_metadata::v0_4::{
+    Axis, AxisType, AxisUnit, AxisUnitSpace, CoordinateTransform, CoordinateTransformScale,
+    MultiscaleImageDataset,
+};
+use ome_zarr_metadata::AnyOmeFields;
+use zarrs::array::{data_type, Array, ArraySubset};
+use zarrs::group::Group;
+use zarrs::storage::{ReadableStorage, ReadableStorageTraits};
+
+use super::{Axes, ChannelInfo, PlaneIndex, Rows, SeriesInfo, VoxelSize};
+use crate::binary::{bad, checked_bytes, unsupported};
+use crate::error::Result;
+use crate::image::{Plane, SampleType, Samples};
+
+/// At most this many bioformats2raw images are looked for.
+const MAX_IMAGES: usize = 100_000;
+
+/// Whether `path` is a Zarr store (a folder with `zarr.json`, `.zgroup` or `.zattrs` at its
+/// root).
+pub fn is_store(path: &Path) -> bool {
+    path.is_dir()
+        && ["zarr.json", ".zgroup", ".zattrs"]
+            .iter()
+            .any(|f| path.join(f).is_file())
+}
+
+/// The NGFF facts of one multiscale image, whatever the version.
+struct Multiscale<'a> {
+    name: Option<&'a str>,
+    axes: &'a [Axis],
+    datasets: &'a [MultiscaleImageDataset],
+    global: Option<&'a [CoordinateTransform]>,
+}
+
+/// One group's NGFF attributes, read whatever the version.
+struct GroupFields {
+    version: String,
+    fields: Option<AnyOmeFields>,
+    bioformats2raw: bool,
+}
+
+impl GroupFields {
+    fn multiscales(&self) -> Vec<Multiscale<'_>> {
+        match &self.fields {
+            Some(AnyOmeFields::V0_4(f)) => f
+                .multiscales
+                .iter()
+                .flatten()
+                .map(|m| Multiscale {
+                    name: m.name.as_deref(),
+                    axes: &m.axes,
+                    datasets: &m.datasets,
+                    global: m.coordinate_transformations.as_deref(),
+                })
+                .collect(),
+            Some(AnyOmeFields::V0_5(f)) => f
+                .multiscales
+                .iter()
+                .flatten()
+                .map(|m| Multiscale {
+                    name: m.name.as_deref(),
+                    axes: &m.axes,
+                    datasets: &m.datasets,
+                    global: m.coordinate_transformations.as_deref(),
+                })
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The `omero` channel labels, in channel order.
+    fn channel_labels(&self) -> Vec<Option<String>> {
+        let omero = match &self.fields {
+            Some(AnyOmeFields::V0_4(f)) => f.omero.as_ref(),
+            Some(AnyOmeFields::V0_5(f)) => f.omero.as_ref(),
+            _ => None,
+        };
+        omero
+            .map(|o| {
+                o.channels
+                    .iter()
+                    .map(|c| {
+                        c.other
+                            .get("label")
+                            .and_then(|l| l.as_str())
+                            .map(str::to_string)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    /// The wells of a plate (paths `row/column`).
+    fn plate_wells(&self) -> Option<Vec<String>> {
+        let path = |p: &Path| p.to_string_lossy().trim_matches('/').to_string();
+        match &self.fields {
+            Some(AnyOmeFields::V0_4(f)) => f
+                .plate
+                .as_ref()
+                .map(|p| p.wells.iter().map(|w| path(&w.path)).collect()),
+            Some(AnyOmeFields::V0_5(f)) => f
+                .plate
+                .as_ref()
+                .map(|p| p.wells.iter().map(|w| path(&w.path)).collect()),
+            _ => None,
+        }
+    }
+
+    /// The fields (image paths) of a well.
+    fn well_images(&self) -> Vec<String> {
+        let path = |p: &Path| p.to_string_lossy().trim_matches('/').to_string();
+        match &self.fields {
+            Some(AnyOmeFields::V0_4(f)) => f
+                .well
+                .iter()
+                .flat_map(|w| w.images.iter().map(|i| path(&i.path)))
+                .collect(),
+            Some(AnyOmeFields::V0_5(f)) => f
+                .well
+                .iter()
+                .flat_map(|w| w.images.iter().map(|i| path(&i.path)))
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+}
+
+/// Read the NGFF attributes of the group at `node` (`/` for the root).
+fn group_fields(path: &Path, store: &ReadableStorage, node: &str) -> Result<GroupFields> {
+    let group = Group::open(store.clone(), node).map_err(|e| {
+        bad(
+            path,
+            format!("group '{node}' of the Zarr store cannot be opened: {e}"),
+        )
+    })?;
+    let attrs = serde_json::Value::Object(group.attributes().clone());
+    let layout = |v: &serde_json::Value| v.get("bioformats2raw.layout").is_some();
+    let bioformats2raw = layout(&attrs) || attrs.get("ome").is_some_and(layout);
+    let known = ["multiscales", "plate", "well", "omero"];
+    let has_ngff = known
+        .iter()
+        .any(|k| attrs.get(k).is_some() || attrs.get("ome").and_then(|o| o.get(k)).is_some());
+    if !has_ngff {
+        return Ok(GroupFields {
+            version: String::new(),
+            fields: None,
+            bioformats2raw,
+        });
+    }
+    let fields: AnyOmeFields = serde_json::from_value(attrs).map_err(|e| {
+        bad(
+            path,
+            format!("group '{node}': OME-Zarr attributes not understood: {e}"),
+        )
+    })?;
+    Ok(GroupFields {
+        version: fields.version(),
+        fields: Some(fields),
+        bioformats2raw,
+    })
+}
+
+/// Where each axis of an image sits in its array.
+#[derive(Debug, Clone, Default, PartialEq)]
+struct AxisPlaces {
+    t: Option<usize>,
+    c: Option<usize>,
+    z: Option<usize>,
+    y: usize,
+    x: usize,
+    /// Other axes by name.
+    extra: Vec<(String, usize)>,
+}
+
+/// Where one image sits in its store and how its axes are described: what a label image
+/// written beside it must repeat.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImageLayout {
+    /// The image's group (`/`, `/A/1/0`, `/0`).
+    pub node: String,
+    /// Its axes as (name, type, unit), as the store gives them (type `space` when absent for
+    /// x, y and z).
+    pub axes: Vec<(String, String, Option<String>)>,
+    /// The level-0 scale per axis (1 where none is given).
+    pub scale: Vec<f64>,
+    /// The level-0 array's shape.
+    pub shape: Vec<u64>,
+    /// Every level (resolution) as (path below the image group, shape, scale per axis with
+    /// the image's own scale folded in), the full resolution first.
+    pub levels: Vec<(String, Vec<u64>, Vec<f64>)>,
+    /// The array dimension of the channel axis, if any.
+    pub channel_dim: Option<usize>,
+    places: AxisPlaces,
+}
+
+impl ImageLayout {
+    /// The array indices before y and x of plane `index`, with the channel (if any) at `0`
+    /// when `single_channel` (a label image has one channel). `None` unless y and x are the
+    /// last two dimensions.
+    pub fn plane_at(&self, index: &PlaneIndex, single_channel: bool) -> Option<Vec<u64>> {
+        let n = self.shape.len();
+        if (self.places.y, self.places.x) != (n - 2, n - 1) {
+            return None;
+        }
+        let mut at = vec![0u64; n - 2];
+        let p = &self.places;
+        for (dim, i) in [(p.t, index.t), (p.z, index.z)] {
+            if let Some(d) = dim {
+                at[d] = i as u64;
+            }
+        }
+        if let (Some(d), false) = (p.c, single_channel) {
+            at[d] = index.c as u64;
+        }
+        for (name, d) in &p.extra {
+            at[*d] = index.get(name) as u64;
+        }
+        Some(at)
+    }
+}
+
+/// One image of the store: its level-0 array and where its axes sit.
+struct ZarrImage {
+    layout: ImageLayout,
+    array: Array<dyn ReadableStorageTraits>,
+    places: AxisPlaces,
+    info: SeriesInfo,
+    /// The store path of the array read (`0`, `A/1/0/0`).
+    array_path: String,
+}
+
+/// An open OME-Zarr store.
+pub struct ZarrReader {
+    path: PathBuf,
+    images: Vec<ZarrImage>,
+    compressed: bool,
+    /// NGFF version of the root (`0.4`, `0.5`).
+    pub version: String,
+}
+
+impl ZarrReader {
+    /// Open the store at `path` (a folder) and read the metadata of every image in it.
+    pub fn open(path: &Path) -> Result<Self> {
+        crate::inputs::note_input(path);
+        let fs = zarrs::filesystem::FilesystemStore::new(path)
+            .map_err(|e| bad(path, format!("not a readable Zarr store: {e}")))?;
+        let store: ReadableStorage = Arc::new(fs);
+        Self::open_store(path, store)
+    }
+
+    /// Read the images of a store opened elsewhere; `path` names it in messages.
+    pub fn open_store(path: &Path, store: ReadableStorage) -> Result<Self> {
+        let root = group_fields(path, &store, "/")?;
+        // (group node, series name, group fields) of every image.
+        let mut groups: Vec<(String, String, GroupFields)> = Vec::new();
+        if let Some(wells) = root.plate_wells() {
+            for well in wells {
+                let node = format!("/{well}");
+                let fields = group_fields(path, &store, &node)?;
+                for field in fields.well_images() {
+                    let node = format!("/{well}/{field}");
+                    let image = group_fields(path, &store, &node)?;
+                    groups.push((node, format!("{well}/{field}"), image));
+                }
+            }
+        } else if !root.multiscales().is_empty() {
+            groups.push(("/".into(), String::new(), root));
+        } else if root.bioformats2raw {
+            // Bounded by the store: the images are numbered from 0 without gaps.
+            for i in 0..MAX_IMAGES {
+                let node = format!("/{i}");
+                if Group::open(store.clone(), &node).is_err() {
+                    break;
+                }
+                let image = group_fields(path, &store, &node)?;
+                groups.push((node, i.to_string(), image));
+            }
+        }
+        let version = groups
+            .first()
+            .map(|(_, _, f)| f.version.clone())
+            .unwrap_or_default();
+        let mut images = Vec::new();
+        for (node, name, fields) in &groups {
+            let labels = fields.channel_labels();
+            for (k, ms) in fields.multiscales().iter().enumerate() {
+                let index = images.len();
+                let name = match (name.is_empty(), ms.name) {
+                    (true, Some(n)) => n.to_string(),
+                    (true, None) if k > 0 => k.to_string(),
+                    _ => name.clone(),
+                };
+                images.push(open_image(path, &store, node, ms, &labels, (index, name))?);
+            }
+        }
+        if images.is_empty() {
+            return Err(unsupported(
+                path,
+                "a Zarr store without OME-Zarr images (no 'multiscales', 'plate' or \
+                 'bioformats2raw.layout' at its root)",
+            ));
+        }
+        let compressed = images.iter().any(|i| !is_uncompressed(&i.array));
+        Ok(ZarrReader {
+            path: path.to_path_buf(),
+            images,
+            compressed,
+            version,
+        })
+    }
+
+    /// The series (one per image).
+    pub fn series(&self) -> Vec<SeriesInfo> {
+        self.images.iter().map(|i| i.info.clone()).collect()
+    }
+
+    /// Whether any image's chunks go through a compressor.
+    pub fn compressed(&self) -> bool {
+        self.compressed
+    }
+
+    /// The store path of the array each series is read from.
+    pub fn array_paths(&self) -> Vec<&str> {
+        self.images.iter().map(|i| i.array_path.as_str()).collect()
+    }
+
+    /// Where series `series` sits and how its axes are described.
+    pub fn layout(&self, series: usize) -> Option<&ImageLayout> {
+        self.images.get(series).map(|i| &i.layout)
+    }
+
+    /// Decode one plane of series `info.index`.
+    pub fn read_plane(&mut self, info: &SeriesInfo, index: &PlaneIndex) -> Result<Plane> {
+        let image = &self.images[info.index];
+        let p = &image.places;
+        let shape = image.array.shape();
+        let mut ranges: Vec<std::ops::Range<u64>> = shape.iter().map(|_| 0..1).collect();
+        let mut set = |at: Option<usize>, i: usize| {
+            if let Some(at) = at {
+                ranges[at] = i as u64..i as u64 + 1;
+            }
+        };
+        set(p.t, index.t);
+        set(p.c, index.c);
+        set(p.z, index.z);
+        for (name, at) in &p.extra {
+            set(Some(*at), index.get(name));
+        }
+        ranges[p.y] = 0..shape[p.y];
+        ranges[p.x] = 0..shape[p.x];
+        let (w, h) = (info.axes.x, info.axes.y);
+        checked_bytes(&self.path, "plane", &[w, h], 8)?;
+        let subset = ArraySubset::new_with_ranges(&ranges);
+        let failed = |e: zarrs::array::ArrayError| {
+            bad(
+                &self.path,
+                format!("array '{}': plane {index:?}: {e}", image.array_path),
+            )
+        };
+        let array = &image.array;
+        let samples = match info.dtype {
+            SampleType::U8 => Samples::Int {
+                codes: array
+                    .retrieve_array_subset::<Vec<u8>>(&subset)
+                    .map_err(failed)?
+                    .into_iter()
+                    .map(u16::from)
+                    .collect(),
+                offset: 0,
+            },
+            SampleType::U16 => Samples::Int {
+                codes: array
+                    .retrieve_array_subset::<Vec<u16>>(&subset)
+                    .map_err(failed)?,
+                offset: 0,
+            },
+            SampleType::I16 => Samples::Int {
+                codes: array
+                    .retrieve_array_subset::<Vec<i16>>(&subset)
+                    .map_err(failed)?
+                    .into_iter()
+                    .map(|v| (i32::from(v) + 32768) as u16)
+                    .collect(),
+                offset: -32768,
+            },
+            SampleType::F32 => Samples::Float(
+                array
+                    .retrieve_array_subset::<Vec<f32>>(&subset)
+                    .map_err(failed)?,
+            ),
+            SampleType::F64 => Samples::Float(
+                array
+                    .retrieve_array_subset::<Vec<f64>>(&subset)
+                    .map_err(failed)?
+                    .into_iter()
+                    .map(|v| v as f32)
+                    .collect(),
+            ),
+        };
+        Ok(Plane {
+            width: w,
+            height: h,
+            sample_type: info.dtype,
+            samples,
+        })
+    }
+}
+
+/// Whether an array's chunks are stored as raw bytes (no compressor).
+fn is_uncompressed(array: &Array<dyn ReadableStorageTraits>) -> bool {
+    let text = array.metadata().to_string();
+    !(text.contains("blosc")
+        || text.contains("zstd")
+        || text.contains("gzip")
+        || text.contains("zlib"))
+}
+
+/// The sample type of an array, or an error naming its data type.
+fn sample_type(
+    path: &Path,
+    node: &str,
+    array: &Array<dyn ReadableStorageTraits>,
+) -> Result<SampleType> {
+    let dt = array.data_type();
+    let table = [
+        (data_type::uint8(), SampleType::U8),
+        (data_type::uint16(), SampleType::U16),
+        (data_type::int16(), SampleType::I16),
+        (data_type::float32(), SampleType::F32),
+        (data_type::float64(), SampleType::F64),
+    ];
+    table
+        .into_iter()
+        .find(|(d, _)| d == dt)
+        .map(|(_, s)| s)
+        .ok_or_else(|| {
+            unsupported(
+                path,
+                format!(
+                    "array '{node}' holds {dt:?} samples; uint8, uint16, int16, float32 and \
+                     float64 are read"
+                ),
+            )
+        })
+}
+
+/// Place every axis of a multiscale image in its array.
+fn place_axes(path: &Path, node: &str, axes: &[Axis]) -> Result<AxisPlaces> {
+    let mut places = AxisPlaces::default();
+    let (mut y, mut x) = (None, None);
+    for (i, axis) in axes.iter().enumerate() {
+        let name = axis.name.to_ascii_lowercase();
+        let slot = match (name.as_str(), &axis.r#type) {
+            ("x", _) => &mut x,
+            ("y", _) => &mut y,
+            ("z", _) => &mut places.z,
+            ("t", _) | (_, Some(AxisType::Time)) => &mut places.t,
+            ("c", _) | (_, Some(AxisType::Channel)) => &mut places.c,
+            _ => {
+                places.extra.push((axis.name.clone(), i));
+                continue;
+            }
+        };
+        if slot.replace(i).is_some() {
+            return Err(bad(
+                path,
+                format!(
+                    "image '{node}': two axes are named or typed '{}'",
+                    axis.name
+                ),
+            ));
+        }
+    }
+    match (y, x) {
+        (Some(y), Some(x)) if y < x => {
+            places.y = y;
+            places.x = x;
+            Ok(places)
+        }
+        (Some(_), Some(_)) => Err(unsupported(
+            path,
+            format!("image '{node}': axis x comes before y (NGFF orders them ... y, x)"),
+        )),
+        _ => Err(bad(
+            path,
+            format!(
+                "image '{node}': axes [{}] have no 'y' and 'x'",
+                axes.iter()
+                    .map(|a| a.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )),
+    }
+}
+
+/// The `scale` of a list of transformations (NGFF: at most one, before any translation).
+fn scale_of(transforms: &[CoordinateTransform]) -> Option<Vec<f64>> {
+    transforms.iter().find_map(|t| match t {
+        // NGFF stores decimal numbers; the metadata crate holds them as f32, whose shortest
+        // decimal form gives back the number written (0.2, not 0.200000003).
+        CoordinateTransform::Scale(CoordinateTransformScale::List { scale }) => Some(
+            scale
+                .iter()
+                .map(|v| v.to_string().parse::<f64>().unwrap_or(f64::from(*v)))
+                .collect(),
+        ),
+        _ => None,
+    })
+}
+
+/// Metres per unit of a space axis, or `None` for an axis without a length unit.
+fn metres_per_unit(unit: Option<&AxisUnit>) -> Option<f64> {
+    use AxisUnitSpace as S;
+    let m = match unit? {
+        AxisUnit::Space(s) => match s {
+            S::Angstrom => 1e-10,
+            S::Attometer => 1e-18,
+            S::Centimeter => 1e-2,
+            S::Decimeter => 1e-1,
+            S::Femtometer => 1e-15,
+            S::Foot => 0.3048,
+            S::Hectometer => 1e2,
+            S::Inch => 0.0254,
+            S::Kilometer => 1e3,
+            S::Meter => 1.0,
+            S::Micrometer => 1e-6,
+            S::Millimeter => 1e-3,
+            S::Nanometer => 1e-9,
+            S::Picometer => 1e-12,
+            _ => return None,
+        },
+        // A unit outside UDUNITS' names (`µm`, `um`) read as a length where it is one.
+        AxisUnit::Custom(text) => {
+            crate::units::parse_positive(&format!("1{text}"), crate::units::Dimension::Length)
+                .ok()?
+        }
+        _ => return None,
+    };
+    Some(m)
+}
+
+/// Open the level-0 array of one multiscale image and describe it as a series.
+fn open_image(
+    path: &Path,
+    store: &ReadableStorage,
+    node: &str,
+    ms: &Multiscale<'_>,
+    labels: &[Option<String>],
+    (index, name): (usize, String),
+) -> Result<ZarrImage> {
+    let level = ms
+        .datasets
+        .first()
+        .ok_or_else(|| bad(path, format!("image '{node}' lists no datasets")))?;
+    let base = node.trim_end_matches('/');
+    let array_path = format!("{base}/{}", level.path.trim_matches('/'));
+    let array = Array::open(store.clone(), &array_path)
+        .map_err(|e| bad(path, format!("array '{array_path}' cannot be opened: {e}")))?;
+    let shape = array.shape().to_vec();
+    if shape.len() != ms.axes.len() {
+        return Err(bad(
+            path,
+            format!(
+                "array '{array_path}' has {} dimensions, its image lists {} axes",
+                shape.len(),
+                ms.axes.len()
+            ),
+        ));
+    }
+    let places = place_axes(path, node, ms.axes)?;
+    let dtype = sample_type(path, &array_path, &array)?;
+    let size = |at: Option<usize>| at.map_or(Ok(1), |i| to_usize(path, shape[i]));
+    let mut extra = BTreeMap::new();
+    for (n, at) in &places.extra {
+        let len = to_usize(path, shape[*at])?;
+        if len > 1 {
+            extra.insert(n.clone(), len);
+        }
+    }
+    let axes = Axes {
+        t: size(places.t)?,
+        z: size(places.z)?,
+        c: size(places.c)?,
+        y: to_usize(path, shape[places.y])?,
+        x: to_usize(path, shape[places.x])?,
+        extra,
+    };
+    checked_bytes(path, "plane", &[axes.x, axes.y], 1)?;
+    // Level scale × image scale, in the axis unit.
+    let level_scale = scale_of(&level.coordinate_transformations);
+    let global = ms.global.and_then(scale_of);
+    let scale_at = |i: usize| -> Option<f64> {
+        let s = level_scale.as_ref()?.get(i)?
+            * global.as_ref().map_or(Some(1.0), |g| g.get(i).copied())?;
+        VoxelSize::valid(Some(s * metres_per_unit(ms.axes[i].unit.as_ref())?))
+    };
+    let (x_m, y_m) = (scale_at(places.x), scale_at(places.y));
+    let source = (x_m.is_some() && y_m.is_some())
+        .then(|| format!("OME-Zarr {array_path} scale × axis unit"));
+    let pixel_size = VoxelSize {
+        x_m,
+        y_m,
+        z_m: places.z.and_then(scale_at),
+        source,
+    };
+    let channels = (0..axes.c)
+        .map(|c| ChannelInfo {
+            name: labels.get(c).cloned().flatten(),
+            ..ChannelInfo::default()
+        })
+        .collect();
+    // The image's own scale folded into a level's (1 where either is absent).
+    let fold = |level: Option<&[f64]>| -> Vec<f64> {
+        (0..shape.len())
+            .map(|i| {
+                let l = level.and_then(|s| s.get(i)).copied();
+                let g = global.as_ref().and_then(|s| s.get(i)).copied();
+                l.unwrap_or(1.0) * g.unwrap_or(1.0)
+            })
+            .collect()
+    };
+    let mut levels = Vec::with_capacity(ms.datasets.len());
+    for d in ms.datasets {
+        let path_in = d.path.trim_matches('/').to_string();
+        let array_at = format!("{base}/{path_in}");
+        let level_shape = match array_at == array_path {
+            true => shape.clone(),
+            false => Array::open(store.clone(), &array_at)
+                .map_err(|e| bad(path, format!("array '{array_at}' cannot be opened: {e}")))?
+                .shape()
+                .to_vec(),
+        };
+        if level_shape.len() != shape.len() {
+            return Err(bad(
+                path,
+                format!("array '{array_at}' has another number of dimensions than level 0"),
+            ));
+        }
+        levels.push((
+            path_in,
+            level_shape,
+            fold(scale_of(&d.coordinate_transformations).as_deref()),
+        ));
+    }
+    let text = |v: serde_json::Result<serde_json::Value>| {
+        v.ok().and_then(|v| v.as_str().map(str::to_string))
+    };
+    let layout = ImageLayout {
+        node: node.to_string(),
+        axes: ms
+            .axes
+            .iter()
+            .map(|a| {
+                let kind = a
+                    .r#type
+                    .as_ref()
+                    .and_then(|t| text(serde_json::to_value(t)));
+                let space = ["x", "y", "z"].contains(&a.name.to_ascii_lowercase().as_str());
+                let kind = kind.unwrap_or_else(|| if space { "space" } else { "" }.into());
+                let unit = a.unit.as_ref().and_then(|u| text(serde_json::to_value(u)));
+                (a.name.clone(), kind, unit)
+            })
+            .collect(),
+        scale: fold(level_scale.as_deref()),
+        shape: shape.clone(),
+        levels,
+        channel_dim: places.c,
+        places: places.clone(),
+    };
+    Ok(ZarrImage {
+        layout,
+        array,
+        places,
+        info: SeriesInfo {
+            index,
+            name,
+            axes,
+            dtype,
+            pixel_size,
+            channels,
+            rows: Rows::Y,
+            tiff_axes: None,
+        },
+        array_path,
+    })
+}
+
+fn to_usize(path: &Path, n: u64) -> Result<usize> {
+    usize::try_from(n).map_err(|_| bad(path, format!("an axis of {n} elements")))
+}
