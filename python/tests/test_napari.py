@@ -97,6 +97,27 @@ def test_tiff_reader_scale_and_values(series_tif):
     assert kwargs["metadata"]["contactscope"]["path"] == str(path)
 
 
+def _store_with_masks(series_tif, tmp_path, cli):
+    """A new OME-Zarr store written by `analyze --zarr-out` from the series TIFF."""
+    path, _ = series_tif
+    store = tmp_path / "series.ome.zarr"
+    cli("analyze", path, "--forces", "2mN,4mN,8mN", "--out", tmp_path / "out", "--zarr-out", store)
+    return store
+
+
+@needs_napari
+def test_ome_zarr_store_reader_scale_and_values(series_tif, tmp_path, cli):
+    from contactscope.napari import readers
+
+    store = _store_with_masks(series_tif, tmp_path, cli)
+    reader = readers.get_micrograph_reader(str(store))
+    assert reader is not None
+    [(data, kwargs, kind)] = reader(str(store))
+    assert kind == "image"
+    np.testing.assert_array_equal(data.reshape(series_tif[1].images.shape), series_tif[1].images)
+    assert kwargs["scale"][-2:] == pytest.approx([0.2, 0.2])
+
+
 @needs_napari
 def test_folder_reader_natural_order(tmp_path):
     from contactscope.napari import readers
@@ -245,6 +266,36 @@ def test_open_czi_in_viewer_with_scale(viewer):
     image = viewer.screenshot(canvas_only=False)
     assert image[..., :3].std() > 1  # the micrograph is drawn, not a blank canvas
     _docs_image(image, "napari-czi.png")
+
+
+@needs_napari
+@needs_display
+def test_napari_ome_zarr_opens_our_store_with_the_contact_labels(viewer, series_tif, tmp_path,
+                                                                  cli):
+    pytest.importorskip("napari_ome_zarr")
+    store = _store_with_masks(series_tif, tmp_path, cli)
+    layers = viewer.open(str(store), plugin="napari-ome-zarr")
+    kinds = {type(layer).__name__: layer for layer in layers}
+    assert set(kinds) == {"Image", "Labels"}, kinds
+    image, labels = kinds["Image"], kinds["Labels"]
+    # The labels lie on the image: same shape, same scale (0.2 µm pixels).
+    assert labels.data[0].shape == image.data[0].shape if labels.multiscale else True
+    assert list(labels.scale[-2:]) == pytest.approx([0.2, 0.2])
+    assert list(image.scale[-2:]) == pytest.approx([0.2, 0.2])
+    masks = np.asarray(labels.data[0] if labels.multiscale else labels.data)
+    rows = (tmp_path / "out" / "areas.csv").read_text().splitlines()
+    header = rows[0].split(",")
+    pixels = [int(r.split(",")[header.index("contact_pixels")]) for r in rows[1:]]
+    assert masks.reshape(len(pixels), -1).sum(axis=1).tolist() == pixels
+    # napari-ome-zarr adds the labels it finds beside an image hidden; shown, the contact is
+    # drawn in the label's colour (magenta) over the micrograph.
+    labels.visible = True
+    viewer.dims.set_point(0, 2)
+    viewer.reset_view()
+    shot = viewer.screenshot(canvas_only=False)
+    _docs_image(shot, "napari-ome-zarr-labels.png")
+    magenta = (shot[..., 0] > 150) & (shot[..., 1] < 120) & (shot[..., 2] > 150)
+    assert magenta.sum() > 1000
 
 
 @needs_napari

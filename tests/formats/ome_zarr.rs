@@ -342,7 +342,14 @@ fn what_cannot_be_written_or_read_is_refused_in_one_line() {
         serde_json::from_slice(&std::fs::read(flat.join("zarr.json")).unwrap()).unwrap();
     group["attributes"]["ome"]["multiscales"][0]["axes"][2]["name"] = json!("q");
     write_json(&flat.join("zarr.json"), &group);
+    // Chunks far larger than memory, refused from the metadata before any is decoded.
+    let huge = store_v3(&dir.path().join("h"), &planes);
+    let mut meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(huge.join("0/zarr.json")).unwrap()).unwrap();
+    meta["chunk_grid"]["configuration"]["chunk_shape"] = json!([1, 1, 200_000, 200_000]);
+    write_json(&huge.join("0/zarr.json"), &meta);
     for (path, expected) in [
+        (&huge, "exceeds"),
         (&plain, "not a Zarr store"),
         (&empty, "without OME-Zarr images"),
         (&complex, "complex64"),

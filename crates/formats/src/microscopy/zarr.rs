@@ -21,11 +21,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use ome_zarr_metadata::v0_4::{
-    Axis, AxisType, AxisUnit, AxisUnitSpace, CoordinateTransform, CoordinateTransformScale,
-    MultiscaleImageDataset,
-};
-use ome_zarr_metadata::AnyOmeFields;
+use serde::Deserialize;
 use zarrs::array::{data_type, Array, ArraySubset};
 use zarrs::group::Group;
 use zarrs::storage::{ReadableStorage, ReadableStorageTraits};
@@ -47,104 +43,84 @@ pub fn is_store(path: &Path) -> bool {
             .any(|f| path.join(f).is_file())
 }
 
-/// The NGFF facts of one multiscale image, whatever the version.
-struct Multiscale<'a> {
-    name: Option<&'a str>,
-    axes: &'a [Axis],
-    datasets: &'a [MultiscaleImageDataset],
-    global: Option<&'a [CoordinateTransform]>,
+/// One NGFF axis: name, type (`space`, `time`, `channel`, other) and unit, as written.
+#[derive(Debug, Clone, Deserialize)]
+struct Axis {
+    name: String,
+    #[serde(rename = "type", default)]
+    kind: Option<String>,
+    #[serde(default)]
+    unit: Option<String>,
 }
 
-/// One group's NGFF attributes, read whatever the version.
+/// One level of a multiscale image (its coordinate transformations are read from the JSON).
+#[derive(Debug, Clone, Deserialize)]
+struct Dataset {
+    path: String,
+}
+
+/// The NGFF facts of one multiscale image, whatever the version (NGFF 0.4 §"multiscales").
+/// Read leniently: writers add keys of their own (ngff-zarr's `@type`), which are ignored.
+#[derive(Debug, Clone, Deserialize)]
+struct Multiscale {
+    #[serde(default)]
+    name: Option<String>,
+    axes: Vec<Axis>,
+    datasets: Vec<Dataset>,
+    /// The entry as JSON, for its transformations' numbers as written.
+    #[serde(skip)]
+    raw: serde_json::Value,
+}
+
+/// One group's NGFF attributes, whatever the version: the attributes themselves (0.4) or their
+/// `ome` object (0.5).
 struct GroupFields {
+    raw: serde_json::Value,
     version: String,
-    fields: Option<AnyOmeFields>,
     bioformats2raw: bool,
 }
 
 impl GroupFields {
-    fn multiscales(&self) -> Vec<Multiscale<'_>> {
-        match &self.fields {
-            Some(AnyOmeFields::V0_4(f)) => f
-                .multiscales
-                .iter()
-                .flatten()
-                .map(|m| Multiscale {
-                    name: m.name.as_deref(),
-                    axes: &m.axes,
-                    datasets: &m.datasets,
-                    global: m.coordinate_transformations.as_deref(),
-                })
-                .collect(),
-            Some(AnyOmeFields::V0_5(f)) => f
-                .multiscales
-                .iter()
-                .flatten()
-                .map(|m| Multiscale {
-                    name: m.name.as_deref(),
-                    axes: &m.axes,
-                    datasets: &m.datasets,
-                    global: m.coordinate_transformations.as_deref(),
-                })
-                .collect(),
-            _ => Vec::new(),
-        }
+    fn multiscales(&self, path: &Path, node: &str) -> Result<Vec<Multiscale>> {
+        let Some(list) = self.raw.get("multiscales") else {
+            return Ok(Vec::new());
+        };
+        let list = list
+            .as_array()
+            .ok_or_else(|| bad(path, format!("group '{node}': 'multiscales' is not a list")))?;
+        list.iter()
+            .map(|m| {
+                let mut ms: Multiscale = serde_json::from_value(m.clone()).map_err(|e| {
+                    bad(path, format!("group '{node}': a 'multiscales' entry: {e}"))
+                })?;
+                ms.raw = m.clone();
+                Ok(ms)
+            })
+            .collect()
     }
 
     /// The `omero` channel labels, in channel order.
     fn channel_labels(&self) -> Vec<Option<String>> {
-        let omero = match &self.fields {
-            Some(AnyOmeFields::V0_4(f)) => f.omero.as_ref(),
-            Some(AnyOmeFields::V0_5(f)) => f.omero.as_ref(),
-            _ => None,
-        };
-        omero
-            .map(|o| {
-                o.channels
-                    .iter()
-                    .map(|c| {
-                        c.other
-                            .get("label")
-                            .and_then(|l| l.as_str())
-                            .map(str::to_string)
-                    })
+        self.raw["omero"]["channels"]
+            .as_array()
+            .map(|cs| {
+                cs.iter()
+                    .map(|c| c["label"].as_str().map(str::to_string))
                     .collect()
             })
             .unwrap_or_default()
     }
 
-    /// The wells of a plate (paths `row/column`).
-    fn plate_wells(&self) -> Option<Vec<String>> {
-        let path = |p: &Path| p.to_string_lossy().trim_matches('/').to_string();
-        match &self.fields {
-            Some(AnyOmeFields::V0_4(f)) => f
-                .plate
-                .as_ref()
-                .map(|p| p.wells.iter().map(|w| path(&w.path)).collect()),
-            Some(AnyOmeFields::V0_5(f)) => f
-                .plate
-                .as_ref()
-                .map(|p| p.wells.iter().map(|w| path(&w.path)).collect()),
-            _ => None,
-        }
-    }
-
-    /// The fields (image paths) of a well.
-    fn well_images(&self) -> Vec<String> {
-        let path = |p: &Path| p.to_string_lossy().trim_matches('/').to_string();
-        match &self.fields {
-            Some(AnyOmeFields::V0_4(f)) => f
-                .well
+    /// The paths listed under `key` (`plate.wells`, `well.images`), `None` without the key.
+    fn paths(&self, group: &str, list: &str) -> Option<Vec<String>> {
+        let items = self.raw.get(group)?.get(list)?.as_array()?;
+        Some(
+            items
                 .iter()
-                .flat_map(|w| w.images.iter().map(|i| path(&i.path)))
+                .filter_map(|w| w["path"].as_str())
+                .map(|p| p.trim_matches('/').to_string())
                 .collect(),
-            Some(AnyOmeFields::V0_5(f)) => f
-                .well
-                .iter()
-                .flat_map(|w| w.images.iter().map(|i| path(&i.path)))
-                .collect(),
-            _ => Vec::new(),
-        }
+        )
     }
 }
 
@@ -157,28 +133,23 @@ fn group_fields(path: &Path, store: &ReadableStorage, node: &str) -> Result<Grou
         )
     })?;
     let attrs = serde_json::Value::Object(group.attributes().clone());
-    let layout = |v: &serde_json::Value| v.get("bioformats2raw.layout").is_some();
-    let bioformats2raw = layout(&attrs) || attrs.get("ome").is_some_and(layout);
-    let known = ["multiscales", "plate", "well", "omero"];
-    let has_ngff = known
-        .iter()
-        .any(|k| attrs.get(k).is_some() || attrs.get("ome").and_then(|o| o.get(k)).is_some());
-    if !has_ngff {
-        return Ok(GroupFields {
-            version: String::new(),
-            fields: None,
-            bioformats2raw,
-        });
-    }
-    let fields: AnyOmeFields = serde_json::from_value(attrs).map_err(|e| {
-        bad(
-            path,
-            format!("group '{node}': OME-Zarr attributes not understood: {e}"),
-        )
-    })?;
+    let raw = attrs.get("ome").unwrap_or(&attrs).clone();
+    let bioformats2raw = raw.get("bioformats2raw.layout").is_some();
+    // 0.5 names its version once, in `ome`; 0.4 in each `multiscales` (or plate, well) entry.
+    let version = raw["version"]
+        .as_str()
+        .or_else(|| raw["multiscales"][0]["version"].as_str())
+        .or_else(|| raw["plate"]["version"].as_str())
+        .or_else(|| raw["well"]["version"].as_str())
+        .unwrap_or(if attrs.get("ome").is_some() {
+            "0.5"
+        } else {
+            "0.4"
+        })
+        .to_string();
     Ok(GroupFields {
-        version: fields.version(),
-        fields: Some(fields),
+        raw,
+        version,
         bioformats2raw,
     })
 }
@@ -276,17 +247,17 @@ impl ZarrReader {
         let root = group_fields(path, &store, "/")?;
         // (group node, series name, group fields) of every image.
         let mut groups: Vec<(String, String, GroupFields)> = Vec::new();
-        if let Some(wells) = root.plate_wells() {
+        if let Some(wells) = root.paths("plate", "wells") {
             for well in wells {
                 let node = format!("/{well}");
                 let fields = group_fields(path, &store, &node)?;
-                for field in fields.well_images() {
+                for field in fields.paths("well", "images").unwrap_or_default() {
                     let node = format!("/{well}/{field}");
                     let image = group_fields(path, &store, &node)?;
                     groups.push((node, format!("{well}/{field}"), image));
                 }
             }
-        } else if !root.multiscales().is_empty() {
+        } else if !root.multiscales(path, "/")?.is_empty() {
             groups.push(("/".into(), String::new(), root));
         } else if root.bioformats2raw {
             // Bounded by the store: the images are numbered from 0 without gaps.
@@ -306,9 +277,9 @@ impl ZarrReader {
         let mut images = Vec::new();
         for (node, name, fields) in &groups {
             let labels = fields.channel_labels();
-            for (k, ms) in fields.multiscales().iter().enumerate() {
+            for (k, ms) in fields.multiscales(path, node)?.iter().enumerate() {
                 let index = images.len();
-                let name = match (name.is_empty(), ms.name) {
+                let name = match (name.is_empty(), ms.name.as_deref()) {
                     (true, Some(n)) => n.to_string(),
                     (true, None) if k > 0 => k.to_string(),
                     _ => name.clone(),
@@ -473,12 +444,12 @@ fn place_axes(path: &Path, node: &str, axes: &[Axis]) -> Result<AxisPlaces> {
     let (mut y, mut x) = (None, None);
     for (i, axis) in axes.iter().enumerate() {
         let name = axis.name.to_ascii_lowercase();
-        let slot = match (name.as_str(), &axis.r#type) {
+        let slot = match (name.as_str(), axis.kind.as_deref()) {
             ("x", _) => &mut x,
             ("y", _) => &mut y,
             ("z", _) => &mut places.z,
-            ("t", _) | (_, Some(AxisType::Time)) => &mut places.t,
-            ("c", _) | (_, Some(AxisType::Channel)) => &mut places.c,
+            ("t", _) | (_, Some("time")) => &mut places.t,
+            ("c", _) | (_, Some("channel")) => &mut places.c,
             _ => {
                 places.extra.push((axis.name.clone(), i));
                 continue;
@@ -517,48 +488,42 @@ fn place_axes(path: &Path, node: &str, axes: &[Axis]) -> Result<AxisPlaces> {
     }
 }
 
-/// The `scale` of a list of transformations (NGFF: at most one, before any translation).
-fn scale_of(transforms: &[CoordinateTransform]) -> Option<Vec<f64>> {
-    transforms.iter().find_map(|t| match t {
-        // NGFF stores decimal numbers; the metadata crate holds them as f32, whose shortest
-        // decimal form gives back the number written (0.2, not 0.200000003).
-        CoordinateTransform::Scale(CoordinateTransformScale::List { scale }) => Some(
-            scale
-                .iter()
-                .map(|v| v.to_string().parse::<f64>().unwrap_or(f64::from(*v)))
-                .collect(),
-        ),
-        _ => None,
+/// The `scale` of a JSON list of coordinate transformations (NGFF: at most one, before any
+/// translation), its numbers as written.
+fn scale_of(transforms: &serde_json::Value) -> Option<Vec<f64>> {
+    transforms.as_array()?.iter().find_map(|t| {
+        if t.get("type")?.as_str()? != "scale" {
+            return None;
+        }
+        t.get("scale")?
+            .as_array()?
+            .iter()
+            .map(|v| v.as_f64())
+            .collect()
     })
 }
 
 /// Metres per unit of a space axis, or `None` for an axis without a length unit.
-fn metres_per_unit(unit: Option<&AxisUnit>) -> Option<f64> {
-    use AxisUnitSpace as S;
+fn metres_per_unit(unit: Option<&str>) -> Option<f64> {
+    // The UDUNITS-2 length names NGFF lists (0.4 §"axes"), prefixed metres and the rest.
     let m = match unit? {
-        AxisUnit::Space(s) => match s {
-            S::Angstrom => 1e-10,
-            S::Attometer => 1e-18,
-            S::Centimeter => 1e-2,
-            S::Decimeter => 1e-1,
-            S::Femtometer => 1e-15,
-            S::Foot => 0.3048,
-            S::Hectometer => 1e2,
-            S::Inch => 0.0254,
-            S::Kilometer => 1e3,
-            S::Meter => 1.0,
-            S::Micrometer => 1e-6,
-            S::Millimeter => 1e-3,
-            S::Nanometer => 1e-9,
-            S::Picometer => 1e-12,
-            _ => return None,
-        },
-        // A unit outside UDUNITS' names (`µm`, `um`) read as a length where it is one.
-        AxisUnit::Custom(text) => {
-            crate::units::parse_positive(&format!("1{text}"), crate::units::Dimension::Length)
-                .ok()?
-        }
-        _ => return None,
+        "angstrom" => 1e-10,
+        "attometer" => 1e-18,
+        "femtometer" => 1e-15,
+        "picometer" => 1e-12,
+        "nanometer" => 1e-9,
+        "micrometer" => 1e-6,
+        "millimeter" => 1e-3,
+        "centimeter" => 1e-2,
+        "decimeter" => 1e-1,
+        "meter" => 1.0,
+        "hectometer" => 1e2,
+        "kilometer" => 1e3,
+        "inch" => 0.0254,
+        "foot" => 0.3048,
+        // A unit outside those names (`µm`, `um`, `nm`) read as a length where it is one.
+        text => crate::units::parse_positive(&format!("1{text}"), crate::units::Dimension::Length)
+            .ok()?,
     };
     Some(m)
 }
@@ -568,7 +533,7 @@ fn open_image(
     path: &Path,
     store: &ReadableStorage,
     node: &str,
-    ms: &Multiscale<'_>,
+    ms: &Multiscale,
     labels: &[Option<String>],
     (index, name): (usize, String),
 ) -> Result<ZarrImage> {
@@ -591,7 +556,7 @@ fn open_image(
             ),
         ));
     }
-    let places = place_axes(path, node, ms.axes)?;
+    let places = place_axes(path, node, &ms.axes)?;
     let dtype = sample_type(path, &array_path, &array)?;
     let size = |at: Option<usize>| at.map_or(Ok(1), |i| to_usize(path, shape[i]));
     let mut extra = BTreeMap::new();
@@ -610,13 +575,34 @@ fn open_image(
         extra,
     };
     checked_bytes(path, "plane", &[axes.x, axes.y], 1)?;
+    // A chunk is decoded whole: its size, from the metadata, is checked before any is read.
+    let chunk = array
+        .chunk_shape(&vec![0; shape.len()])
+        .map_err(|e| bad(path, format!("array '{array_path}': {e}")))?;
+    let dims: Vec<usize> = chunk
+        .iter()
+        .map(|n| usize::try_from(n.get()).unwrap_or(usize::MAX))
+        .collect();
+    let sample = match dtype {
+        SampleType::U8 => 1,
+        SampleType::U16 | SampleType::I16 => 2,
+        SampleType::F32 => 4,
+        SampleType::F64 => 8,
+    };
+    checked_bytes(
+        path,
+        &format!("chunk of array '{array_path}'"),
+        &dims,
+        sample,
+    )?;
     // Level scale × image scale, in the axis unit.
-    let level_scale = scale_of(&level.coordinate_transformations);
-    let global = ms.global.and_then(scale_of);
+    let transforms = |d: usize| &ms.raw["datasets"][d]["coordinateTransformations"];
+    let level_scale = scale_of(transforms(0));
+    let global = scale_of(&ms.raw["coordinateTransformations"]);
     let scale_at = |i: usize| -> Option<f64> {
         let s = level_scale.as_ref()?.get(i)?
             * global.as_ref().map_or(Some(1.0), |g| g.get(i).copied())?;
-        VoxelSize::valid(Some(s * metres_per_unit(ms.axes[i].unit.as_ref())?))
+        VoxelSize::valid(Some(s * metres_per_unit(ms.axes[i].unit.as_deref())?))
     };
     let (x_m, y_m) = (scale_at(places.x), scale_at(places.y));
     let source = (x_m.is_some() && y_m.is_some())
@@ -644,7 +630,7 @@ fn open_image(
             .collect()
     };
     let mut levels = Vec::with_capacity(ms.datasets.len());
-    for d in ms.datasets {
+    for (k, d) in ms.datasets.iter().enumerate() {
         let path_in = d.path.trim_matches('/').to_string();
         let array_at = format!("{base}/{path_in}");
         let level_shape = match array_at == array_path {
@@ -663,26 +649,19 @@ fn open_image(
         levels.push((
             path_in,
             level_shape,
-            fold(scale_of(&d.coordinate_transformations).as_deref()),
+            fold(scale_of(transforms(k)).as_deref()),
         ));
     }
-    let text = |v: serde_json::Result<serde_json::Value>| {
-        v.ok().and_then(|v| v.as_str().map(str::to_string))
-    };
     let layout = ImageLayout {
         node: node.to_string(),
         axes: ms
             .axes
             .iter()
             .map(|a| {
-                let kind = a
-                    .r#type
-                    .as_ref()
-                    .and_then(|t| text(serde_json::to_value(t)));
                 let space = ["x", "y", "z"].contains(&a.name.to_ascii_lowercase().as_str());
+                let kind = a.kind.clone();
                 let kind = kind.unwrap_or_else(|| if space { "space" } else { "" }.into());
-                let unit = a.unit.as_ref().and_then(|u| text(serde_json::to_value(u)));
-                (a.name.clone(), kind, unit)
+                (a.name.clone(), kind, a.unit.clone())
             })
             .collect(),
         scale: fold(level_scale.as_deref()),
