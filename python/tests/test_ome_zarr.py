@@ -179,3 +179,43 @@ def test_generated_series_masks_back_into_the_store(cli, tmp_path):
     attrs = g["tables/contact_areas"].attrs
     assert attrs["backend"] == "parquet" and attrs["region"]["path"] == "../labels/contact"
     del models
+
+
+def test_a_plate_is_one_series_per_field_in_the_batch(cli, tmp_path):
+    """An HCS plate written by ome-zarr-py: `batch` takes each field of each well as a series
+    (the well and field as columns), each analysed as the same planes alone would be."""
+    zarr = pytest.importorskip("zarr")
+    pytest.importorskip("ome_zarr")
+    from ome_zarr.format import FormatV04
+    from ome_zarr.io import parse_url
+    from ome_zarr.writer import write_image, write_plate_metadata, write_well_metadata
+    s = cs.synth_series(128, 128, 200e-9, [2e-3, 4e-3, 8e-3], seed=7)
+    data = np.asarray(s.images)
+    fmt = FormatV04()
+    archive = tmp_path / "archive"
+    store = parse_url(str(archive / "plate1.ome.zarr"), mode="w", fmt=fmt).store
+    root = zarr.group(store=store, zarr_format=2)
+    write_plate_metadata(root, ["A", "B"], ["1", "2"], ["A/1", "B/2"], fmt=fmt)
+    for row, col in (("A", "1"), ("B", "2")):
+        well = root.require_group(row).require_group(col)
+        write_well_metadata(well, [{"path": "0"}, {"path": "1"}], fmt=fmt)
+        for field in range(2):
+            # Field 1 holds the loads in reverse order.
+            write_image(data if field == 0 else data[::-1], well.require_group(str(field)),
+                        axes="tyx", fmt=fmt, scale_factors=(), scale={"y": 0.2, "x": 0.2},
+                        axes_units={"y": "micrometer", "x": "micrometer"})
+    cs.write_tiff(tmp_path / "alone.tif", data, 200e-9)
+    cli("analyze", tmp_path / "alone.tif", "--forces", "2mN,4mN,8mN", "--out", tmp_path / "alone")
+    alone = [r["contact_pixels"] for r in _areas(tmp_path / "alone")]
+    out = tmp_path / "res"
+    cli("batch", archive, "--load-axis", "t", "--forces", "2mN,4mN,8mN", "--out", out)
+    with open(out / "series.csv", newline="") as f:
+        series = list(csv.DictReader(f))
+    assert [(r["series_id"], r["plate_well"], r["plate_field"], r["status"]) for r in series] == [
+        ("plate1-A-1-0", "A/1", "0", "ok"), ("plate1-A-1-1", "A/1", "1", "ok"),
+        ("plate1-B-2-0", "B/2", "0", "ok"), ("plate1-B-2-1", "B/2", "1", "ok")]
+    with open(out / "images.csv", newline="") as f:
+        images = list(csv.DictReader(f))
+    for sid in ("plate1-A-1-0", "plate1-B-2-0"):
+        assert [r["contact_pixels"] for r in images if r["series_id"] == sid] == alone
+    assert [r["contact_pixels"] for r in images if r["series_id"] == "plate1-A-1-1"] == alone[::-1]

@@ -230,6 +230,8 @@ pub struct ZarrReader {
     compressed: bool,
     /// NGFF version of the root (`0.4`, `0.5`).
     pub version: String,
+    /// The store is an HCS plate (its series are the wells' fields).
+    pub plate: bool,
 }
 
 impl ZarrReader {
@@ -247,7 +249,8 @@ impl ZarrReader {
         let root = group_fields(path, &store, "/")?;
         // (group node, series name, group fields) of every image.
         let mut groups: Vec<(String, String, GroupFields)> = Vec::new();
-        if let Some(wells) = root.paths("plate", "wells") {
+        let plate = root.paths("plate", "wells");
+        if let Some(wells) = plate.clone() {
             for well in wells {
                 let node = format!("/{well}");
                 let fields = group_fields(path, &store, &node)?;
@@ -300,7 +303,16 @@ impl ZarrReader {
             images,
             compressed,
             version,
+            plate: plate.is_some(),
         })
+    }
+
+    /// The fields of an HCS plate store as `row/column/field`, in series order; `None` for a
+    /// store that is no plate or cannot be read (the batch then takes it whole).
+    pub fn plate_fields(path: &Path) -> Option<Vec<String>> {
+        let r = ZarrReader::open(path).ok()?;
+        r.plate
+            .then(|| r.images.iter().map(|i| i.info.name.clone()).collect())
     }
 
     /// The series (one per image).

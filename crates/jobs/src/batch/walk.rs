@@ -14,10 +14,11 @@ use std::path::{Component, Path, PathBuf};
 
 use globset::{GlobSet, GlobSetBuilder};
 
-use super::sheet::{id_from, Row, Sheet};
+use super::options::{Opt, SeriesOptions};
+use super::sheet::{id_from, MetaColumn, MetaKind, Row, Sheet};
 use crate::error::{Error, Location, Result};
 use crate::series::natural_cmp;
-use contactscope_formats::microscopy::zarr;
+use contactscope_formats::microscopy::zarr::{self, ZarrReader};
 
 /// The default patterns of single-file series: the vendor formats that hold a load series in
 /// one file, and OME-Zarr stores (folders, taken whole).
@@ -126,6 +127,7 @@ pub fn walk(spec: &WalkSpec, skip: Option<&Path>) -> Result<Sheet> {
     }
     let mut rows: Vec<Row> = Vec::new();
     let mut origin: Vec<PathBuf> = Vec::new();
+    let mut plates = false;
     for (path, folder) in found {
         let relative = path.strip_prefix(root).unwrap_or(&path).to_path_buf();
         let named = if folder {
@@ -167,20 +169,71 @@ pub fn walk(spec: &WalkSpec, skip: Option<&Path>) -> Result<Sheet> {
                 ),
             ));
         }
-        rows.push(Row {
-            line: 0,
-            id,
-            input_text: path.display().to_string(),
-            input: path.clone(),
-            options: Default::default(),
-            metadata: Vec::new(),
-        });
-        origin.push(path);
+        // An HCS plate: each field of each well a series of its own (`--series` in the sheet),
+        // its well and field as metadata.
+        let fields = match folder {
+            false if zarr::is_store(&path) => ZarrReader::plate_fields(&path),
+            _ => None,
+        };
+        let Some(fields) = fields else {
+            rows.push(Row {
+                line: 0,
+                id,
+                input_text: path.display().to_string(),
+                input: path.clone(),
+                options: Default::default(),
+                metadata: Vec::new(),
+            });
+            origin.push(path);
+            continue;
+        };
+        plates = true;
+        for (index, field) in fields.iter().enumerate() {
+            let mut options = SeriesOptions::default();
+            options.0.insert(Opt::Series, index.to_string());
+            let (well, f) = field.rsplit_once('/').unwrap_or((field.as_str(), ""));
+            let field_id = id_from(&format!("{id}-{}", field.replace('/', "-")));
+            if let Some(k) = rows
+                .iter()
+                .position(|r| r.id.eq_ignore_ascii_case(&field_id))
+            {
+                return Err(Error::bad_input(
+                    Location::file(&path),
+                    format!(
+                        "its field {field} has the series id '{field_id}' of {}",
+                        origin[k].display()
+                    ),
+                ));
+            }
+            rows.push(Row {
+                line: 0,
+                id: field_id,
+                input_text: path.display().to_string(),
+                input: path.clone(),
+                options,
+                metadata: vec![well.to_string(), f.to_string()],
+            });
+            origin.push(path.clone());
+        }
+    }
+    // Plate fields carry their well and field; every other row leaves those cells empty.
+    let mut metadata = Vec::new();
+    if plates {
+        for row in &mut rows {
+            row.metadata.resize(2, String::new());
+        }
+        metadata = ["plate_well", "plate_field"]
+            .iter()
+            .map(|n| MetaColumn {
+                name: n.to_string(),
+                kind: MetaKind::Text,
+            })
+            .collect();
     }
     Ok(Sheet {
         label: root.clone(),
         base: PathBuf::new(),
-        metadata: Vec::new(),
+        metadata,
         option_columns: Vec::new(),
         rows,
         sha256: String::new(),
