@@ -23,7 +23,7 @@ default_out!(Out, "contactscope-out/analyze");
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// TIFF, CZI, ND2 or LIF files, or directories of them (natural sort order). Not with
+    /// TIFF, CZI, ND2, LIF or OME-Zarr files, or directories of them (natural sort order). Not with
     /// --manifest.
     inputs: Vec<PathBuf>,
     /// Manifest CSV with columns file, [page], force_mN (or force_N), [friction_mN]; paths
@@ -36,7 +36,7 @@ pub struct Args {
     forces: Option<Forces>,
     #[command(flatten)]
     select: SelectionArgs,
-    /// Axis of a CZI, ND2 or LIF file whose planes are the loads, in order.
+    /// Axis of a CZI, ND2, LIF or OME-Zarr file whose planes are the loads, in order.
     #[arg(long, value_enum)]
     load_axis: Option<LoadAxisArg>,
     /// otsu (one threshold for the series), per-image, or a number (contact is value > t).

@@ -334,13 +334,13 @@ pub struct SelectionArgs {
     /// when the file has several (TIFF: samples or ImageJ channels, by index).
     #[arg(long)]
     pub channel: Option<ChannelChoice>,
-    /// Focal plane of a CZI, ND2 or LIF file; needed when it has several.
+    /// Focal plane of a CZI, ND2, LIF or OME-Zarr file; needed when it has several.
     #[arg(long)]
     pub z: Option<usize>,
-    /// Time point of a CZI, ND2 or LIF file; needed when it has several.
+    /// Time point of a CZI, ND2, LIF or OME-Zarr file; needed when it has several.
     #[arg(long)]
     pub t: Option<usize>,
-    /// Index along another axis of a CZI, ND2 or LIF file, by the name `info` shows: H=0
+    /// Index along another axis of a CZI, ND2, LIF or OME-Zarr file, by the name `info` shows: H=0
     /// (Airyscan phase), S=1 (green of an RGB pixel), lambda_emission=3, … Repeatable.
     #[arg(long = "axis", value_name = "NAME=INDEX", value_parser = parse_axis)]
     pub axis: Vec<(String, usize)>,
@@ -377,7 +377,7 @@ impl SelectionArgs {
     }
 }
 
-/// `--load-axis`: the axis of one CZI, ND2 or LIF file whose planes are the loads.
+/// `--load-axis`: the axis of one CZI, ND2, LIF or OME-Zarr file whose planes are the loads.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum LoadAxisArg {
     /// Time points.

@@ -16,7 +16,7 @@ default_out!(Out, "contactscope-out/autocorr");
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// TIFF images (every page of a multi-page file counts as one image), or CZI, ND2, LIF
+    /// TIFF images (every page of a multi-page file counts as one image), or CZI, ND2, LIF, OME-Zarr
     /// files (the one plane the selection flags name).
     #[arg(required = true)]
     inputs: Vec<PathBuf>,

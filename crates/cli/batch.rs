@@ -42,7 +42,7 @@ struct Defaults {
     /// Indices along other axes, e.g. "H=0;S=1" (column axis).
     #[arg(long)]
     axis: Option<String>,
-    /// The axis of CZI, ND2 or LIF files whose planes are the loads: t, z or series (column
+    /// The axis of CZI, ND2, LIF or OME-Zarr files whose planes are the loads: t, z or series (column
     /// load_axis).
     #[arg(long)]
     load_axis: Option<String>,

@@ -22,7 +22,7 @@ default_out!(Out, "contactscope-out/compare");
 #[command(group(clap::ArgGroup::new("psf_source").required(true).args(["psf", "psf_fwhm"])))]
 pub struct Args {
     /// The micrographs: a manifest CSV (file, page, force_mN), a folder holding manifest.csv,
-    /// or TIFF/CZI/ND2/LIF files or folders together with --forces.
+    /// or TIFF/CZI/ND2/LIF/OME-Zarr files or folders together with --forces.
     #[arg(long, alias = "experiment", required = true, num_args = 1..)]
     micrographs: Vec<PathBuf>,
     /// Normal force per micrograph when --micrographs names image files (e.g. 0,4,8mN or
@@ -42,7 +42,7 @@ pub struct Args {
     pixel_size: PixelSizeArg,
     #[command(flatten)]
     select: SelectionArgs,
-    /// Axis of a CZI, ND2 or LIF micrograph file whose planes are the loads, in order.
+    /// Axis of a CZI, ND2, LIF or OME-Zarr micrograph file whose planes are the loads, in order.
     #[arg(long, value_enum)]
     load_axis: Option<LoadAxisArg>,
     /// Also try mirror images and 90° rotations when registering.

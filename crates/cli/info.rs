@@ -15,7 +15,7 @@ use super::args::SelectionArgs;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// A TIFF, CZI, ND2 or LIF file.
+    /// A TIFF, CZI, ND2, LIF or OME-Zarr file.
     file: PathBuf,
     /// Print JSON: {"file", "format", "series": [{"index", "name", "axes", "dtype",
     /// "pixel_size_um": {"x", "y", "z"}, "pixel_size_source", "rows" (X–Z/X–T scans), "planes"}]} (docs/formats.md).

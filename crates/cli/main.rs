@@ -64,7 +64,7 @@ enum Command {
         after_help = "Examples:\n  contactscope threshold series.tif\n  contactscope threshold ramp.czi --channel 0"
     )]
     Threshold(threshold::Args),
-    /// Describe a micrograph file (TIFF, CZI, ND2, LIF): series, axes, channels, sample type, pixel size.
+    /// Describe a micrograph file (TIFF, CZI, ND2, LIF, OME-Zarr): series, axes, channels, sample type, pixel size.
     #[command(
         after_help = "Examples:\n  contactscope info ramp.czi\n  contactscope info series.tif"
     )]

@@ -26,7 +26,7 @@ enum PhaseArg {
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Reflection image with Newton rings (single-page TIFF, or one plane of a CZI, ND2, LIF).
+    /// Reflection image with Newton rings (single-page TIFF, or one plane of a CZI, ND2, LIF, OME-Zarr).
     reflection: PathBuf,
     /// Fluorescence image of the contact, same field and size.
     #[arg(long = "contact")]
@@ -36,7 +36,7 @@ pub struct Args {
     #[command(flatten)]
     select: SelectionArgs,
     /// Channel of the contact image when it differs from --channel (e.g. reflection and
-    /// fluorescence as two channels of one CZI, ND2 or LIF file).
+    /// fluorescence as two channels of one CZI, ND2, LIF or OME-Zarr file).
     #[arg(long)]
     contact_channel: Option<usize>,
     /// Illumination wavelength.

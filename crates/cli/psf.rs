@@ -17,7 +17,7 @@ default_out!(Out, "contactscope-out/psf");
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Bead image or z stack: TIFF (every page of the chosen channel), or CZI, ND2, LIF (every
+    /// Bead image or z stack: TIFF (every page of the chosen channel), or CZI, ND2, LIF, OME-Zarr (every
     /// z plane of the selected series, channel and time point, or the one plane of --z).
     input: PathBuf,
     #[command(flatten)]

@@ -11,12 +11,12 @@ use super::args::{LoadAxisArg, SelectionArgs};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// TIFF, CZI, ND2 or LIF files, or directories of them.
+    /// TIFF, CZI, ND2, LIF or OME-Zarr files, or directories of them.
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
     #[command(flatten)]
     select: SelectionArgs,
-    /// Axis of a CZI, ND2 or LIF file whose planes are the loads, in order.
+    /// Axis of a CZI, ND2, LIF or OME-Zarr file whose planes are the loads, in order.
     #[arg(long, value_enum)]
     load_axis: Option<LoadAxisArg>,
     /// Print a JSON object.

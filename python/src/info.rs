@@ -11,7 +11,7 @@ use contactscope_jobs::info::InfoRequest;
 use crate::compute;
 use crate::convert::outcome_dict;
 
-/// The series, axes, sample type and voxel size (m) of a TIFF, CZI, ND2 or LIF file and, with
+/// The series, axes, sample type and voxel size (m) of a TIFF, CZI, ND2, LIF or OME-Zarr file and, with
 /// `stats`, every plane's min, max, mean and sum.
 #[pyfunction]
 #[pyo3(signature = (path, stats=false))]

@@ -30,7 +30,7 @@ use crate::{bad, compute, pixel_opt, PixelArg};
 enum ImageArg<'py> {
     /// A stack (planes, rows, columns).
     Stack(StackIn<'py>),
-    /// A file (TIFF, CZI, ND2, LIF).
+    /// A file (TIFF, CZI, ND2, LIF, OME-Zarr).
     File(PathBuf),
 }
 
@@ -46,7 +46,7 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ImageArg<'py> {
             .map_err(|_| {
                 crate::extract::wrong_type(
                     "an image",
-                    "a file (TIFF, CZI, ND2, LIF) or a (planes, rows, columns) array of uint8, uint16, int16, float32 or float64",
+                    "a file (TIFF, CZI, ND2, LIF, OME-Zarr) or a (planes, rows, columns) array of uint8, uint16, int16, float32 or float64",
                     &obj,
                 )
             })

@@ -232,7 +232,7 @@ def read_series(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
                 z: Optional[int] = None, t: Optional[int] = None,
                 axes: Optional[Dict[str, int]] = None,
                 load_axis: Optional[str] = None) -> Series:
-    """A load series: TIFF, CZI, ND2 or LIF files and folders (natural order) or one manifest
+    """A load series: TIFF, CZI, ND2, LIF or OME-Zarr files and folders (natural order) or one manifest
     CSV (``.csv``: columns ``file``, ``page``, ``force_mN``… as for the command line).
 
     ``forces`` (N), one per image, when the files do not come with a manifest; ``pixel_size``
@@ -379,7 +379,7 @@ def autocorrelation(images: Any, pixel_size: Optional[PixelSize] = None,
     """Radially averaged intensity autocorrelation C(r), the command line's ``autocorr``.
 
     ``images``: one file or a list of files (every page of a multi-page TIFF is one image; a
-    CZI, ND2 or LIF file gives the plane its selection ``series``, ``channel``, ``z``, ``t``,
+    CZI, ND2, LIF or OME-Zarr file gives the plane its selection ``series``, ``channel``, ``z``, ``t``,
     ``axes`` names), or an array (a 2-D image or a 3-D stack, each plane one image) with its
     ``pixel_size`` (m). Lags go up to ``max_lag`` m (default, and at most, half the shorter
     side of each image).
@@ -411,7 +411,7 @@ def newton(reflection: Any, contact: Any, pixel_size: Optional[PixelSize] = None
     ``newton``.
 
     ``reflection`` (the rings) and ``contact`` (the fluorescence image of the same field): files
-    (a single-page TIFF or the plane of a CZI, ND2 or LIF file that ``series``, ``channel``,
+    (a single-page TIFF or the plane of a CZI, ND2, LIF or OME-Zarr file that ``series``, ``channel``,
     ``z``, ``t``, ``axes`` select; ``contact_channel`` when the contact image is another
     channel of the same file) or 2-D arrays in their stored sample type with their
     ``pixel_size`` (m). Defaults as on the command line: ``wavelength`` 488e-9 m,

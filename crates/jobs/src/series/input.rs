@@ -1,4 +1,4 @@
-//! Micrographs as a request carries them: files (folders, a manifest, CZI/ND2/LIF planes along a
+//! Micrographs as a request carries them: files (folders, a manifest, CZI/ND2/LIF/OME-Zarr planes along a
 //! load axis) or planes already in memory (Python hands over numpy arrays in their stored
 //! sample type). Both become an [`OpenSeries`], whose [`Planes`] the analysis reads, so that a
 //! series gives one threshold and one set of areas whichever front-end handed it over.
@@ -19,7 +19,7 @@ use crate::error::{Error, Location, Result};
 /// force per image when the files do not come with a manifest.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SeriesSpec {
-    /// TIFF, CZI, ND2 or LIF files, or folders of them (not with a manifest); a single folder
+    /// TIFF, CZI, ND2, LIF or OME-Zarr files, or folders of them (not with a manifest); a single folder
     /// holding `manifest.csv` (and no forces) is read as that manifest.
     pub inputs: Vec<PathBuf>,
     /// A manifest CSV (`file`, `page`, `force_mN` or `force_N`, `friction_mN`), or a folder
@@ -27,7 +27,7 @@ pub struct SeriesSpec {
     pub manifest: Option<PathBuf>,
     /// Which planes of confocal files (and the channel of TIFFs).
     pub selection: Selection,
-    /// Axis of a CZI, ND2 or LIF file whose planes are the loads.
+    /// Axis of a CZI, ND2, LIF or OME-Zarr file whose planes are the loads.
     pub load_axis: Option<LoadAxis>,
     /// Normal forces, N, one per image (not with a manifest).
     pub forces_n: Option<Vec<f64>>,

@@ -8,7 +8,7 @@ line's ``analyze`` — and "Export…" writes the command line's folder (``areas
 ``summary.json``, ``area_vs_load.png``/``.svg``) through the command line's own writer, with the
 equivalent command recorded in ``summary.json``.
 
-The series: files (TIFF, CZI, ND2, LIF), a folder, a manifest CSV (``file``, ``page``,
+The series: files (TIFF, CZI, ND2, LIF, OME-Zarr), a folder, a manifest CSV (``file``, ``page``,
 ``force_mN``…) or an image layer a reader or the sample made; forces as the command line's
 ``--forces`` (``4,10,20,40mN``, ``4mN..400mN:12``); for a vendor file the load axis and channel.
 The work runs in a napari worker thread; the viewer stays responsive and a bar shows progress.
