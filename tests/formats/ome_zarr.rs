@@ -310,6 +310,31 @@ fn what_cannot_be_written_or_read_is_refused_in_one_line() {
     );
     assert_eq!(e.trim().lines().count(), 1, "{e}");
     assert!(!out.exists() && !store.join("tables").exists());
+    // An analysis that fails after the output was begun leaves no store, hidden or not.
+    let blank = dir.path().join("blank.tif");
+    let zeros = vec![0u16; W * H];
+    std::fs::write(
+        &blank,
+        contactscope_formats::tiff::encode_u16_stack(&[&zeros, &zeros], W, H, None, "").unwrap(),
+    )
+    .unwrap();
+    let new = dir.path().join("new.ome.zarr");
+    let o = run(&[
+        "analyze",
+        blank.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--zarr-out",
+        new.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success(), "{}", stderr(&o));
+    let left: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("new.ome.zarr"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
     // An existing path that is not the store analysed.
     let o = run(&[
         "analyze",

@@ -66,8 +66,37 @@ enum Target {
     },
 }
 
+/// Hidden folders written so far, removed unless the output is finished (an analysis that
+/// fails, or is refused, leaves nothing behind).
+#[derive(Default)]
+struct Unfinished(Vec<PathBuf>);
+
+impl Unfinished {
+    fn add(&mut self, dir: &Path) {
+        crate::staging::register(dir);
+        self.0.push(dir.to_path_buf());
+    }
+
+    /// Everything is in place: keep it.
+    fn done(&mut self) {
+        for dir in self.0.drain(..) {
+            crate::staging::unregister(&dir);
+        }
+    }
+}
+
+impl Drop for Unfinished {
+    fn drop(&mut self) {
+        for dir in self.0.drain(..) {
+            let _ = std::fs::remove_dir_all(&dir);
+            crate::staging::unregister(&dir);
+        }
+    }
+}
+
 /// An OME-Zarr output being written.
 pub struct ZarrOut {
+    unfinished: Unfinished,
     final_path: PathBuf,
     /// The folder written into: the hidden new store, or the input store.
     root: PathBuf,
@@ -132,7 +161,8 @@ impl ZarrOut {
         std::fs::create_dir_all(&parent).map_err(|e| output_error(&parent, e.to_string()))?;
         let work = hidden(&parent, &name);
         let _ = std::fs::remove_dir_all(&work);
-        crate::staging::register(&work);
+        let mut unfinished = Unfinished::default();
+        unfinished.add(&work);
         let version = NgffVersion::V05;
         let store = ZarrStore::open(&work, version)?;
         let n = series.images.len() as u64;
@@ -171,6 +201,7 @@ impl ZarrOut {
         let mut labels = label_image(&store, "/labels/contact", &axes, &levels, &title)?;
         let labels = labels.remove(0).0;
         Ok(ZarrOut {
+            unfinished,
             final_path: path.to_path_buf(),
             root: work,
             version,
@@ -188,7 +219,8 @@ impl ZarrOut {
         let version = NgffVersion::of(&reader.version);
         let store = ZarrStore::open(path, version)?;
         let mut nodes: Vec<String> = Vec::new();
-        let mut groups = Vec::new();
+        let mut unfinished = Unfinished::default();
+        let mut groups: Vec<InputLabels> = Vec::new();
         let mut places = Vec::new();
         let mut layouts: BTreeMap<usize, usize> = BTreeMap::new();
         for image in &open.series.images {
@@ -203,7 +235,9 @@ impl ZarrOut {
                 Some(&g) => g,
                 None => {
                     let g = groups.len();
-                    groups.push(Self::input_labels(path, &store, layout)?);
+                    let labels = Self::input_labels(path, &store, layout)?;
+                    unfinished.add(&labels.work);
+                    groups.push(labels);
                     nodes.push(layout.node.clone());
                     layouts.insert(plane.series, g);
                     g
@@ -218,6 +252,7 @@ impl ZarrOut {
             places.push((group, at));
         }
         Ok(ZarrOut {
+            unfinished,
             final_path: path.to_path_buf(),
             root: path.to_path_buf(),
             version,
@@ -239,7 +274,6 @@ impl ZarrOut {
         }
         let work = hidden(&labels_dir, LABEL);
         let _ = std::fs::remove_dir_all(&work);
-        crate::staging::register(&work);
         let node = format!(
             "{base}/labels/{}",
             work.file_name()
@@ -290,7 +324,7 @@ impl ZarrOut {
     }
 
     /// Write the table and put everything in place; the final store path.
-    pub fn finish(self, rows: &impl serde::Serialize) -> Result<PathBuf> {
+    pub fn finish(mut self, rows: &impl serde::Serialize) -> Result<PathBuf> {
         let table = table_of_rows(rows)?;
         let parquet = table.to_parquet(TABLE, &[])?;
         let store = ZarrStore::open(&self.root, self.version)?;
@@ -300,7 +334,7 @@ impl ZarrOut {
             let tables = dir.join("tables");
             let work = hidden(&tables, TABLE);
             let _ = std::fs::remove_dir_all(&work);
-            crate::staging::register(&work);
+            self.unfinished.add(&work);
             let work_node = format!(
                 "{base}/tables/{}",
                 work.file_name()
@@ -337,11 +371,10 @@ impl ZarrOut {
             list.insert("tables".into(), json!(listed));
             store.write_group(&format!("{base}/tables"), Map::new(), list)?;
         }
-        match self.target {
+        match &self.target {
             Target::New { .. } => {
                 std::fs::rename(&self.root, &self.final_path)
                     .map_err(|e| output_error(&self.final_path, e.to_string()))?;
-                crate::staging::unregister(&self.root);
             }
             Target::Input { groups, .. } => {
                 for (
@@ -358,6 +391,7 @@ impl ZarrOut {
                 }
             }
         }
+        self.unfinished.done();
         Ok(self.final_path)
     }
 }
@@ -373,7 +407,6 @@ fn replace_dir(work: &Path, final_dir: &Path) -> Result<()> {
         std::fs::remove_dir_all(final_dir).map_err(|e| output_error(final_dir, e.to_string()))?;
     }
     std::fs::rename(work, final_dir).map_err(|e| output_error(final_dir, e.to_string()))?;
-    crate::staging::unregister(work);
     Ok(())
 }
 
