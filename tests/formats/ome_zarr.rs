@@ -335,6 +335,25 @@ fn what_cannot_be_written_or_read_is_refused_in_one_line() {
         .filter(|n| n.contains("new.ome.zarr"))
         .collect();
     assert!(left.is_empty(), "{left:?}");
+    // A plane whose chunks are all missing (an incomplete copy) is refused, not read as zeros.
+    let partial = store_v2(&dir.path().join("p"), &planes);
+    std::fs::remove_dir_all(partial.join("0/2")).unwrap();
+    let o = run(&[
+        "analyze",
+        partial.to_str().unwrap(),
+        "--load-axis",
+        "t",
+        "--forces",
+        "4mN..400mN:4",
+        "--out",
+        dir.path().join("op").to_str().unwrap(),
+    ]);
+    let e = stderr(&o);
+    assert!(
+        !o.status.success() && e.contains("none of its chunks"),
+        "{e}"
+    );
+    assert!(e.contains("plane t 2"), "{e}");
     // An existing path that is not the store analysed.
     let o = run(&[
         "analyze",

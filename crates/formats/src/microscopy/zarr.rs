@@ -363,6 +363,7 @@ impl ZarrReader {
                 format!("array '{}': plane {index:?}: {e}", image.array_path),
             )
         };
+        self.check_written(image, &subset, index)?;
         let array = &image.array;
         let samples = match info.dtype {
             SampleType::U8 => Samples::Int {
@@ -409,6 +410,45 @@ impl ZarrReader {
             sample_type: info.dtype,
             samples,
         })
+    }
+}
+
+impl ZarrReader {
+    /// A plane none of whose chunks is in the store was never written (an incomplete copy, a
+    /// write that stopped): the Zarr rule would read it as the fill value, a plane of zeros
+    /// analysed as an image, so it is refused. A plane with some chunks is read as the rule
+    /// says (zarr-python leaves out chunks that hold only the fill value).
+    fn check_written(
+        &self,
+        image: &ZarrImage,
+        subset: &ArraySubset,
+        index: &PlaneIndex,
+    ) -> Result<()> {
+        let array = &image.array;
+        let Ok(Some(chunks)) = array.chunks_in_array_subset(subset) else {
+            return Ok(());
+        };
+        let store = array.storage();
+        for chunk in &chunks.indices() {
+            let key = array.chunk_key(&chunk);
+            let size = store.size_key(&key).map_err(|e| {
+                bad(
+                    &self.path,
+                    format!("array '{}': chunk {key}: {e}", image.array_path),
+                )
+            })?;
+            if size.is_some() {
+                return Ok(());
+            }
+        }
+        Err(bad(
+            &self.path,
+            format!(
+                "array '{}': plane t {}, c {}, z {} has none of its chunks in the store (never \
+                 written, or an incomplete copy); it would read as the fill value",
+                image.array_path, index.t, index.c, index.z
+            ),
+        ))
     }
 }
 

@@ -188,7 +188,10 @@ impl PlaneArray {
     pub fn write_plane<T: zarrs::array::Element>(&self, at: &[u64], samples: &[T]) -> Result<()> {
         let mut chunk = at.to_vec();
         chunk.extend([0, 0]);
-        self.array.store_chunk(&chunk, samples).map_err(|e| {
+        // Every plane is stored, zeros too: a plane without chunks reads as never written.
+        let options = zarrs::array::CodecOptions::default().with_store_empty_chunks(true);
+        let stored = self.array.store_chunk_opt(&chunk, samples, &options);
+        stored.map_err(|e| {
             bad(
                 &self.path,
                 format!("array '{}', plane {at:?}: {e}", self.node),
