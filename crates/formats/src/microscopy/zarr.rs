@@ -325,11 +325,6 @@ impl ZarrReader {
         self.compressed
     }
 
-    /// The store path of the array each series is read from.
-    pub fn array_paths(&self) -> Vec<&str> {
-        self.images.iter().map(|i| i.array_path.as_str()).collect()
-    }
-
     /// Where series `series` sits and how its axes are described.
     pub fn layout(&self, series: usize) -> Option<&ImageLayout> {
         self.images.get(series).map(|i| &i.layout)
