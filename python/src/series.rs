@@ -314,6 +314,12 @@ fn analyze<'py>(
              (mask TIFFs in the folder) instead",
         ));
     }
+    if out.is_none() && zarr_out.is_some() {
+        return Err(bad(
+            "zarr_out is written with the output folder: give out as well (the command line's \
+             --out with --zarr-out)",
+        ));
+    }
     // Progress reported to Python from the threads the analysis runs on (the GIL taken for
     // each call; an exception in the callback is printed, not raised, and the work goes on).
     let report = move |pass: Pass, done: usize, total: usize| {

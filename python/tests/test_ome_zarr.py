@@ -219,3 +219,26 @@ def test_a_plate_is_one_series_per_field_in_the_batch(cli, tmp_path):
     for sid in ("plate1-A-1-0", "plate1-B-2-0"):
         assert [r["contact_pixels"] for r in images if r["series_id"] == sid] == alone
     assert [r["contact_pixels"] for r in images if r["series_id"] == "plate1-A-1-1"] == alone[::-1]
+
+
+def test_python_analyze_writes_the_same_store_as_the_command_line(cli, tmp_path, series_tif):
+    """``analyze(..., out=, zarr_out=)`` is ``analyze --out --zarr-out``; without ``out`` it is
+    refused (nothing is written)."""
+    path, _ = series_tif
+    series = cs.read_series(path, forces=[2e-3, 4e-3, 8e-3])
+    with pytest.raises(cs.InputError, match="zarr_out"):
+        cs.analyze(series, zarr_out=tmp_path / "alone.ome.zarr")
+    assert not (tmp_path / "alone.ome.zarr").exists()
+    r = cs.analyze(series, out=tmp_path / "py", zarr_out=tmp_path / "py.ome.zarr")
+    cli("analyze", path, "--forces", "2mN,4mN,8mN", "--out", tmp_path / "cli",
+        "--zarr-out", tmp_path / "cli.ome.zarr")
+    assert str(tmp_path / "py.ome.zarr") in [str(p) for p in r["written"]]
+    for name in ("zarr.json", "labels/contact/zarr.json"):
+        a = json.loads((tmp_path / "py.ome.zarr" / name).read_text())
+        b = json.loads((tmp_path / "cli.ome.zarr" / name).read_text())
+        assert a == b, name
+    py = cs.read_series(tmp_path / "py.ome.zarr" / "labels" / "contact", load_axis="t",
+                        forces=[1e-3] * 3).images
+    cli_masks = cs.read_series(tmp_path / "cli.ome.zarr" / "labels" / "contact", load_axis="t",
+                               forces=[1e-3] * 3).images
+    np.testing.assert_array_equal(np.asarray(py), np.asarray(cli_masks))

@@ -291,7 +291,8 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
             command_line: Optional[Sequence[str]] = None,
             progress: Optional[Any] = None,
             pixel_size_uncertainty: float = 0.0,
-            psf_fwhm: Optional[float] = None) -> Results:
+            psf_fwhm: Optional[float] = None,
+            zarr_out: Optional[PathLike] = None) -> Results:
     """The paper's series analysis, the command line's ``analyze``: one global Otsu threshold
     over all images, then each image measured. ``series``: a :class:`Series` (its files are read
     as the command line reads them, with its forces and pixel size unless given here) or
@@ -320,6 +321,11 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
     interpreter and this call) and ``written`` lists the files. ``progress(pass, done, total)``
     is called as the images are read
     (``"histogram"``) and measured (``"measure"``), from the threads doing the work.
+
+    ``zarr_out`` (with ``out``): also write the contact masks as the NGFF label image
+    ``labels/contact`` and the table as ``tables/contact_areas/table.parquet`` into an OME-Zarr
+    store, the command line's ``--zarr-out``: the one store analysed (its images untouched) or
+    a new store holding the analysed planes too.
     """
     if isinstance(series, Series) and pixel_size is None:
         pixel_size = series._pixel_size
@@ -331,7 +337,8 @@ def analyze(series: Any, forces: Optional[Sequence[float]] = None,
                                  _number(pixel_size_uncertainty, "pixel_size_uncertainty",
                                          "fraction (0.01 for ±1 %)"),
                                  None if psf_fwhm is None
-                                 else _number(psf_fwhm, "psf_fwhm", "m (4.5e-7 for 450 nm)")),
+                                 else _number(psf_fwhm, "psf_fwhm", "m (4.5e-7 for 450 nm)"),
+                                 None if zarr_out is None else os.fspath(zarr_out)),
                       table="rows")
     _warn(result)
     return result
