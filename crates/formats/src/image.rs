@@ -40,6 +40,16 @@ impl SampleType {
         }
     }
 
+    /// Bytes of one sample.
+    pub fn bytes(self) -> usize {
+        match self {
+            SampleType::U8 => 1,
+            SampleType::U16 | SampleType::I16 => 2,
+            SampleType::F32 => 4,
+            SampleType::F64 => 8,
+        }
+    }
+
     /// Whether values are integers (one histogram bin per level).
     pub fn is_integer(self) -> bool {
         matches!(self, SampleType::U8 | SampleType::U16 | SampleType::I16)

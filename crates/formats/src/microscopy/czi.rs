@@ -109,15 +109,6 @@ fn pixel_layout(code: i32) -> std::result::Result<(SampleType, usize), String> {
     })
 }
 
-fn sample_bytes(t: SampleType) -> usize {
-    match t {
-        SampleType::U8 => 1,
-        SampleType::U16 | SampleType::I16 => 2,
-        SampleType::F32 => 4,
-        SampleType::F64 => 8,
-    }
-}
-
 fn compression_name(code: i32) -> String {
     match code {
         0 => "uncompressed".into(),
@@ -209,7 +200,7 @@ impl CziReader {
             .collect();
         tiles.sort_by_key(|e| (e.start("M"), e.position));
         let (bx, by, width, height) = scene.bbox;
-        let bytes = sample_bytes(info.dtype);
+        let bytes = info.dtype.bytes();
         let n = checked_bytes(&path, "plane", &[width, height], bytes)? / bytes;
         let mut plane = vec![0u8; n * bytes];
         let sample = index.get("S");

@@ -557,12 +557,7 @@ pub(crate) fn plane_from_le(
     bytes: &[u8],
     stride: usize,
 ) -> Result<Plane> {
-    let size = match dtype {
-        SampleType::U8 => 1,
-        SampleType::U16 | SampleType::I16 => 2,
-        SampleType::F32 => 4,
-        SampleType::F64 => 8,
-    };
+    let size = dtype.bytes();
     checked_bytes(path, "plane", &[width, height], size)?;
     let row = width * size;
     if height > 0 && (stride < row || bytes.len() < stride * (height - 1) + row) {

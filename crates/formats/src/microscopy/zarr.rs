@@ -630,12 +630,7 @@ fn open_image(
         .iter()
         .map(|n| usize::try_from(n.get()).unwrap_or(usize::MAX))
         .collect();
-    let sample = match dtype {
-        SampleType::U8 => 1,
-        SampleType::U16 | SampleType::I16 => 2,
-        SampleType::F32 => 4,
-        SampleType::F64 => 8,
-    };
+    let sample = dtype.bytes();
     checked_bytes(
         path,
         &format!("chunk of array '{array_path}'"),

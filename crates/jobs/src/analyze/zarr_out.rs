@@ -401,12 +401,28 @@ fn tidy(v: f64) -> f64 {
     format!("{v:.11e}").parse().unwrap_or(v)
 }
 
-/// Replace `final_dir` (if any: ours, checked before) by `work`.
+/// Replace `final_dir` (if any: ours, checked before) by `work`. The old folder is moved
+/// aside first and removed only once the new one is in place, so that a kill between the two
+/// renames leaves the earlier result (hidden) rather than none.
 fn replace_dir(work: &Path, final_dir: &Path) -> Result<()> {
-    if final_dir.exists() {
-        std::fs::remove_dir_all(final_dir).map_err(|e| output_error(final_dir, e.to_string()))?;
+    let parent = final_dir.parent().unwrap_or(final_dir);
+    let name = final_dir
+        .file_name()
+        .map_or("old".into(), |n| n.to_string_lossy().into_owned());
+    let old = parent.join(format!(".{name}.old-{}", std::process::id()));
+    let had_old = final_dir.exists();
+    if had_old {
+        std::fs::rename(final_dir, &old).map_err(|e| output_error(final_dir, e.to_string()))?;
     }
-    std::fs::rename(work, final_dir).map_err(|e| output_error(final_dir, e.to_string()))?;
+    if let Err(e) = std::fs::rename(work, final_dir) {
+        if had_old {
+            let _ = std::fs::rename(&old, final_dir);
+        }
+        return Err(output_error(final_dir, e.to_string()));
+    }
+    if had_old {
+        let _ = std::fs::remove_dir_all(&old);
+    }
     Ok(())
 }
 
