@@ -207,6 +207,7 @@ impl HeightMapOptions {
             detrend: self.detrend.detrend(),
             channel: None,
             fill_invalid: None,
+            measurement: None,
         })
     }
 }
@@ -218,6 +219,8 @@ pub enum FillInvalidArg {
     Mean,
     /// The height of the nearest valid point (city-block distance).
     Nearest,
+    /// The harmonic (Laplace) interpolation of the valid heights.
+    Harmonic,
 }
 
 /// `--topography FILE` with its reading options.
@@ -234,9 +237,14 @@ pub struct TopographyInput {
     #[arg(long)]
     pub channel: Option<String>,
     /// Fill a vendor map's invalid (unmeasured, masked) points instead of refusing the map:
-    /// mean (of the valid heights) or nearest (valid point, city-block distance).
+    /// mean (of the valid heights), nearest (valid point, city-block distance) or harmonic
+    /// (Laplace interpolation, as SurfaceTopography's `harmonic`).
     #[arg(long, value_enum)]
     pub fill_invalid: Option<FillInvalidArg>,
+    /// The measurement of a contact.engineering surface container (ZIP or folder), by index
+    /// (0, 1, …) or name (`name` or `surface/name`); default: its only one.
+    #[arg(long)]
+    pub measurement: Option<String>,
 }
 
 impl TopographyInput {
@@ -247,7 +255,9 @@ impl TopographyInput {
             fill_invalid: self.fill_invalid.map(|f| match f {
                 FillInvalidArg::Mean => FillInvalid::Mean,
                 FillInvalidArg::Nearest => FillInvalid::Nearest,
+                FillInvalidArg::Harmonic => FillInvalid::Harmonic,
             }),
+            measurement: self.measurement.clone(),
             ..self.options.source(self.path.clone())?
         })
     }

@@ -21,6 +21,11 @@ pub struct Args {
     /// file's height channel.
     #[arg(long)]
     channel: Option<String>,
+    /// The measurement of a contact.engineering surface container (ZIP or folder), by index
+    /// (0, 1, …) or name (`name` or `surface/name`); without it every measurement is
+    /// summarised, then all of them pooled.
+    #[arg(long)]
+    measurement: Option<String>,
     /// Print JSON: the stored map's summary (file, format, channel, channels, nx, ny,
     /// pixel_size_um,
     /// valid_points, height_*_um, h_rms_as_stored_um, h_prime_rms_as_stored,
@@ -33,7 +38,11 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let mut source = args.options.source(args.file.clone())?;
     source.channel = args.channel.clone();
+    source.measurement = args.measurement.clone();
     let detrend = source.detrend.name();
+    if source.measurement.is_none() && source.is_container() {
+        return whole_container(TopographyRequest { source }, args.json);
+    }
     let outcome = job::run(&TopographyRequest { source })?;
     // A pixel size that replaced the file's own, points filled: on stderr, as every command's.
     super::common::print_warnings(&outcome.notes);
@@ -91,5 +100,60 @@ pub fn run(args: Args) -> Result<()> {
         "h''_rms:     {:.6} 1/µm (5-point Laplacian)",
         stats.roughness.h_double_prime_rms_per_m * 1e-6
     );
+    Ok(())
+}
+
+/// Every measurement of a surface container, one line each, then the pooled statistics.
+fn whole_container(request: TopographyRequest, json: bool) -> Result<()> {
+    let (description, notes) = job::run_container(&request)?;
+    super::common::print_warnings(&notes);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&description)?);
+        return Ok(());
+    }
+    println!("container:   {}", description.container);
+    println!(
+        "{:>5}  {:<32} {:>11} {:>14} {:>11} {:>9} {:>13}",
+        "index", "surface/name", "grid", "pixel size", "h_rms_nm", "h'_rms", "h''_rms_per_um"
+    );
+    for m in &description.measurements {
+        let s = &m.description.stored;
+        let label = format!("{}/{}", m.surface, m.name);
+        let grid = format!("{}×{}", s.nx, s.ny);
+        let pixel = units::format_length(s.pixel_size.x_m);
+        match &m.description.detrended {
+            Some(d) => println!(
+                "{:>5}  {:<32} {:>11} {:>14} {:>11.4} {:>9.5} {:>13.5}{}",
+                m.index,
+                label,
+                grid,
+                pixel,
+                d.roughness.h_rms_m * 1e9,
+                d.roughness.h_prime_rms,
+                d.roughness.h_double_prime_rms_per_m * 1e-6,
+                if m.periodic { "  periodic" } else { "" }
+            ),
+            None => println!(
+                "{:>5}  {:<32} {:>11} {:>14}  {}",
+                m.index,
+                label,
+                grid,
+                pixel,
+                m.description.note.as_deref().unwrap_or("no statistics")
+            ),
+        }
+    }
+    if let Some(c) = &description.combined {
+        println!(
+            "pooled ({} measurements, {} points, detrend {}): h_rms {:.4} nm, h'_rms {:.5}, \
+             h''_rms {:.5} 1/µm",
+            c.measurements,
+            c.points,
+            c.detrend,
+            c.roughness.h_rms_m * 1e9,
+            c.roughness.h_prime_rms,
+            c.roughness.h_double_prime_rms_per_m * 1e-6
+        );
+    }
     Ok(())
 }

@@ -104,6 +104,7 @@ fn body_request(
         height_unit,
         channel,
         fill_invalid,
+        None,
     )?;
     let mut body = BodyRequest::new(input, modulus);
     body.radius_m = radius;

@@ -71,6 +71,7 @@ pub(crate) fn height_input(
     height_unit: Option<f64>,
     channel: Option<String>,
     fill_invalid: Option<&str>,
+    measurement: Option<String>,
 ) -> PyResult<HeightInput> {
     let detrend = detrend_of(detrend)?;
     let pixel = pixel_size.map(PixelArg::xy).transpose()?;
@@ -82,14 +83,20 @@ pub(crate) fn height_input(
             detrend,
             channel,
             fill_invalid: fill_of(fill_invalid)?,
+            measurement,
         })),
         HeightsArg::Array(a) => {
-            if height_unit.is_some() || channel.is_some() || fill_invalid.is_some() {
+            if height_unit.is_some()
+                || channel.is_some()
+                || fill_invalid.is_some()
+                || measurement.is_some()
+            {
                 return Err(bad(format!(
-                    "{}, {} and {} apply to a file; an array holds heights in metres",
+                    "{}, {}, {} and {} apply to a file; an array holds heights in metres",
                     Param::HeightUnit,
                     Param::Channel,
-                    Param::FillInvalid
+                    Param::FillInvalid,
+                    Param::Measurement
                 )));
             }
             let (dx, dy) = pixel.ok_or_else(|| {

@@ -24,7 +24,8 @@ use crate::{bad, compute, PixelArg};
 /// `notes`) and `heights` (m, rows = y, filled as asked and detrended). A map that cannot be used
 /// (invalid points without `fill_invalid`) is refused with the reason.
 #[pyfunction]
-#[pyo3(signature = (path, pixel_size=None, height_unit=None, detrend="plane", channel=None, fill_invalid=None))]
+#[pyo3(signature = (path, pixel_size=None, height_unit=None, detrend="plane", channel=None, fill_invalid=None, measurement=None))]
+#[allow(clippy::too_many_arguments)]
 fn read_topography<'py>(
     py: Python<'py>,
     path: PathBuf,
@@ -33,9 +34,11 @@ fn read_topography<'py>(
     detrend: &str,
     channel: Option<String>,
     fill_invalid: Option<&str>,
+    measurement: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = TopographyRequest {
         source: TopographySource {
+            measurement,
             pixel_size_m: crate::pixel_opt(pixel_size)?,
             height_unit_m: height_unit,
             detrend: detrend_of(detrend)?,

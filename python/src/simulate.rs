@@ -161,7 +161,7 @@ impl LoadObserver for KeepMaps {
 /// A load ramp with one contact model (the command line's `simulate`); see the package's
 /// docstring. Returns the outcome (SI) and the stacks (loads, ny, nx) `maps` asks for.
 #[pyfunction]
-#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=MapsArg::Name("all".into()), detrend="plane", height_unit=None, channel=None, fill_invalid=None, device="cpu"))]
+#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=MapsArg::Name("all".into()), detrend="plane", height_unit=None, channel=None, fill_invalid=None, device="cpu", measurement=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -184,6 +184,7 @@ fn simulate<'py>(
     channel: Option<String>,
     fill_invalid: Option<&str>,
     device: &str,
+    measurement: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let device = crate::convert::device_of(device)?;
     let input = height_input(
@@ -193,6 +194,7 @@ fn simulate<'py>(
         height_unit,
         channel,
         fill_invalid,
+        measurement,
     )?;
     let model = model_of(model, hardness, k, initial_hardness, alpha)?;
     let maps = maps_of(maps)?;

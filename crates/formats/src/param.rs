@@ -119,6 +119,8 @@ params! {
     LoadAxis: "--load-axis", "load_axis", "the load axis";
     /// How to fill a height map's invalid points.
     FillInvalid: "--fill-invalid", "fill_invalid", "the filling of invalid points";
+    /// The measurement of a surface container.
+    Measurement: "--measurement", "measurement", "the measurement";
     /// Normal forces, one per image.
     Forces: "--forces", "forces", "the forces";
     /// Normal forces of a simulated ramp (Python's `loads=`).

@@ -6,11 +6,13 @@
 
 use std::path::PathBuf;
 
-use contactscope::surface::fill::{fill_invalid, FillInvalid};
+use contactscope::surface::fill::{fill_harmonic, fill_invalid, FillInvalid};
 use contactscope::surface::stats::SurfaceStats;
+use contactscope::surface::trend::ContainerDetrend;
 use contactscope::surface::{Detrend, Topography};
 use contactscope_formats::param::Param;
 use contactscope_formats::ranges::Quantity;
+use contactscope_formats::topography::container::{self, Container};
 use contactscope_formats::topography::{read_height_map, HeightMap, ReadOptions};
 use serde::Serialize;
 
@@ -84,6 +86,15 @@ impl HeightInput {
                 t.detrend(*detrend);
                 Ok((t, Vec::new()))
             }
+        }
+    }
+
+    /// Whether the heights are marked periodic (a container's measurement,
+    /// [`TopographySource::stated_periodic`]).
+    pub fn stated_periodic(&self) -> Result<bool> {
+        match self {
+            HeightInput::File(s) => s.stated_periodic(),
+            HeightInput::Memory { .. } => Ok(false),
         }
     }
 
@@ -173,6 +184,9 @@ pub struct TopographySource {
     pub channel: Option<String>,
     /// Fill a vendor map's invalid points this way (default: refuse such a map).
     pub fill_invalid: Option<FillInvalid>,
+    /// The measurement of a contact.engineering surface container, by index or name
+    /// (`surface/name`); default: its only one.
+    pub measurement: Option<String>,
 }
 
 impl TopographySource {
@@ -185,7 +199,23 @@ impl TopographySource {
             detrend: Detrend::None,
             channel: None,
             fill_invalid: None,
+            measurement: None,
         }
+    }
+
+    /// Whether the file is a contact.engineering surface container (ZIP or folder).
+    pub fn is_container(&self) -> bool {
+        container::is_container(&self.path)
+    }
+
+    /// Whether the height map is marked periodic: a container's measurement with
+    /// `is_periodic` (other files state no periodicity).
+    pub fn stated_periodic(&self) -> Result<bool> {
+        if !self.is_container() {
+            return Ok(false);
+        }
+        let c = Container::open(&self.path)?;
+        Ok(c.find(self.measurement.as_deref())?.periodic)
     }
 
     /// Range checks of the overrides: the pixel size and the height unit.
@@ -199,16 +229,48 @@ impl TopographySource {
         }
     }
 
-    /// The map as stored (no filling, no detrending), with every override applied.
+    /// The map as stored (no filling, no detrending), with every override applied; a
+    /// container's measurement with the container's own processing applied
+    /// ([`read_measurement`]).
     pub fn read_raw(&self) -> Result<HeightMap> {
-        Ok(read_height_map(
+        Ok(self.read_raw_with_notes()?.0)
+    }
+
+    /// [`Self::read_raw`] with notes for the user (a container's size that differs from its
+    /// data file's).
+    pub fn read_raw_with_notes(&self) -> Result<(HeightMap, Vec<String>)> {
+        if self.is_container() {
+            if self.pixel_size_m.is_some() || self.height_unit_m.is_some() {
+                return Err(Error::bad_input(
+                    Location::file(&self.path),
+                    format!(
+                        "a surface container states each measurement's size and unit; do not                          give {} or {}",
+                        Param::PixelSize,
+                        Param::HeightUnit
+                    ),
+                ));
+            }
+            let c = Container::open(&self.path)?;
+            let m = c.find(self.measurement.as_deref())?;
+            return read_measurement(&c, m, self.channel.as_deref());
+        }
+        if let Some(m) = &self.measurement {
+            return Err(Error::bad_input(
+                Location::file(&self.path),
+                format!(
+                    "measurement '{m}' asked for, but the file is not a contact.engineering                      surface container (a ZIP archive or folder with index.json or meta.yml)"
+                ),
+            ));
+        }
+        let map = read_height_map(
             &self.path,
             &ReadOptions {
                 pixel_size_m: self.pixel_size_m,
                 height_unit_m: self.height_unit_m,
                 channel: self.channel.clone(),
             },
-        )?)
+        )?;
+        Ok((map, Vec::new()))
     }
 
     /// Read the file, fill and detrend it.
@@ -219,8 +281,8 @@ impl TopographySource {
     /// [`Self::read`], with notes for the user (a pixel size that replaced the file's own, how
     /// many invalid points were filled).
     pub fn read_with_notes(&self) -> Result<(Topography, Vec<String>)> {
-        let mut map = self.read_raw()?;
-        let mut notes: Vec<String> = replaced_pixel_size_note(&map).into_iter().collect();
+        let (mut map, mut notes) = self.read_raw_with_notes()?;
+        notes.extend(replaced_pixel_size_note(&map));
         match self.fill_invalid {
             Some(_) => notes.extend(self.fill(&mut map)),
             None if map.invalid_points > 0 && map.valid_points() > 0 => {
@@ -258,6 +320,42 @@ impl TopographySource {
             )
         })
     }
+}
+
+/// A container's measurement as SurfaceTopography reads it (`read_container`): the data file
+/// with the container's size, unit, channel and height scale, its undefined points filled by
+/// the measurement's `fill_undefined_data_mode` and its heights detrended by its `detrend_mode`
+/// (neither for a squeezed NetCDF file, which holds them applied); notes for the user.
+pub fn read_measurement(
+    c: &Container,
+    m: &container::Measurement,
+    channel: Option<&str>,
+) -> Result<(HeightMap, Vec<String>)> {
+    let read = c.read(m, channel)?;
+    let at = || Location::file(format!("{}:{}", c.path.display(), m.datafile));
+    let mut map = read.map.clone();
+    match read.fill_mode() {
+        None => {}
+        Some("harmonic") => {
+            fill_harmonic(&mut map.heights, read.periodic());
+            map.invalid_points = map.heights.iter().filter(|h| !h.is_finite()).count();
+        }
+        Some(other) => {
+            return Err(Error::bad_input(
+                at(),
+                format!(
+                    "measurement {}: fill_undefined_data_mode '{other}' is not applied by                      contactscope (do-not-fill and harmonic are)",
+                    m.label()
+                ),
+            ))
+        }
+    }
+    if let Some(mode) = read.detrend_mode() {
+        ContainerDetrend::from_mode(mode)
+            .and_then(|d| d.apply(&mut map.heights))
+            .map_err(|e| Error::bad_input(at(), format!("measurement {}: {e}", m.label())))?;
+    }
+    Ok((map, read.notes))
 }
 
 /// Heights given in memory (a Python array) are held to the bound of heights read from a file,

@@ -19,6 +19,7 @@ pub mod fill;
 pub mod generate;
 pub mod masked;
 pub mod stats;
+pub mod trend;
 
 pub use contactscope_formats::topography::HeightMap;
 

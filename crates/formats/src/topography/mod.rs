@@ -77,6 +77,8 @@
 
 pub mod al3d;
 pub mod bcr;
+pub mod container;
+pub mod container_write;
 pub mod frt;
 pub mod gwy;
 pub mod hdf5;
@@ -86,6 +88,7 @@ pub mod metropro;
 pub mod mi;
 pub mod mnt;
 pub mod netcdf;
+pub mod netcdf_write;
 pub mod nid;
 pub mod nms;
 pub mod opd;

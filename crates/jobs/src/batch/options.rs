@@ -560,6 +560,7 @@ impl SeriesOptions {
             fill_invalid: self
                 .get(Opt::FillInvalid)
                 .and_then(|t| FillInvalid::from_name(t.trim())),
+            measurement: None,
         };
         let modulus = self
             .value(Opt::Modulus)

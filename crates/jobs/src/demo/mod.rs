@@ -529,6 +529,7 @@ fn fit(work: &Path, data: &Path, p: &DemoParams) -> Result<FitResult> {
                 detrend: contactscope::surface::Detrend::None,
                 channel: None,
                 fill_invalid: None,
+                measurement: None,
             }),
             p.e_star_pa,
         )

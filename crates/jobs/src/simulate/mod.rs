@@ -476,7 +476,22 @@ pub fn run(
     monitor: Option<Monitor>,
 ) -> Result<SimulateOutcome> {
     request.check()?;
-    let (roughness, notes) = request.heights.read_with_notes()?;
+    let (roughness, mut notes) = request.heights.read_with_notes()?;
+    // A container's measurement marked periodic is solved with periodic boundaries.
+    let periodic_request;
+    let request = if !request.periodic && request.heights.stated_periodic()? {
+        notes.push(format!(
+            "{}: the container marks the measurement periodic: periodic boundaries",
+            request.heights.label()
+        ));
+        periodic_request = SimulateRequest {
+            periodic: true,
+            ..request.clone()
+        };
+        &periodic_request
+    } else {
+        request
+    };
     let stats = SurfaceStats::finite_differences(&roughness).map_err(|e| {
         crate::error::Error::bad_input(
             crate::error::Location::file(request.heights.label()),

@@ -246,11 +246,12 @@ pub fn run(request: &TopographyRequest) -> Result<TopographyOutcome> {
     request.check()?;
     let source = &request.source;
     let path = &source.path;
-    let mut map = source.read_raw()?;
+    let (mut map, read_notes) = source.read_raw_with_notes()?;
     let stored = TopographySummary::of(&path.display().to_string(), &map);
     stored.check_finite(path)?;
-    let notes: Vec<String> = crate::heights::replaced_pixel_size_note(&map)
+    let notes: Vec<String> = read_notes
         .into_iter()
+        .chain(crate::heights::replaced_pixel_size_note(&map))
         .chain(source.fill(&mut map))
         .collect();
     let detrend = source.detrend;
@@ -322,4 +323,110 @@ fn physics_notes(path: &std::path::Path, h_rms_m: f64, slope_rms: Option<f64>) -
         .chain(slope_rms.and_then(|s| check(Checked::SlopeRms, s)))
         .map(|w| format!("{}: {w}", path.display()))
         .collect()
+}
+
+/// One measurement of a surface container in `topography --json` of the container.
+#[derive(Debug, Clone, Serialize)]
+pub struct MeasurementDescription {
+    /// Index over the container (`--measurement` takes it).
+    pub index: usize,
+    /// The surface it belongs to.
+    pub surface: String,
+    /// Its name.
+    pub name: String,
+    /// Marked periodic by the container.
+    pub periodic: bool,
+    /// The same description as for a single map.
+    #[serde(flatten)]
+    pub description: TopographyDescription,
+}
+
+/// The roughness of all measurements together: the rms of each statistic over every
+/// measurement's points, each point weighted alike (sums of squares pooled).
+#[derive(Debug, Clone, Serialize)]
+pub struct CombinedFacts {
+    /// Measurements pooled (those with statistics).
+    pub measurements: usize,
+    /// Points pooled.
+    pub points: usize,
+    /// Detrending applied to each before pooling.
+    pub detrend: &'static str,
+    /// Pooled roughness (written as `h_rms_nm`, `h_prime_rms`, `h_double_prime_rms_per_um`).
+    #[serde(flatten)]
+    pub roughness: Roughness,
+}
+
+/// `topography --json` of a surface container read whole: each measurement, then the pooled
+/// statistics.
+#[derive(Debug, Clone, Serialize)]
+pub struct ContainerDescription {
+    /// The container file or folder.
+    pub container: String,
+    /// Every measurement, in the container's order.
+    pub measurements: Vec<MeasurementDescription>,
+    /// All measurements together; `null` when none has statistics.
+    pub combined: Option<CombinedFacts>,
+}
+
+/// Describe every measurement of a container (`request.source` names it, without a
+/// measurement) with the request's filling and detrending, and pool their statistics.
+pub fn run_container(request: &TopographyRequest) -> Result<(ContainerDescription, Vec<String>)> {
+    use contactscope_formats::topography::container::Container;
+    request.check()?;
+    let path = &request.source.path;
+    let c = Container::open(path)?;
+    let mut measurements = Vec::new();
+    let mut notes = Vec::new();
+    let (mut n, mut h2, mut s2, mut c2) = (0usize, 0.0, 0.0, 0.0);
+    for m in &c.measurements {
+        let one = TopographyRequest {
+            source: TopographySource {
+                measurement: Some(m.index.to_string()),
+                ..request.source.clone()
+            },
+        };
+        let outcome = run(&one)?;
+        notes.extend(
+            outcome
+                .notes
+                .iter()
+                .map(|note| format!("{}: {note}", m.label())),
+        );
+        if let (Some(stats), Some(t)) = (&outcome.summary.detrended, &outcome.heights) {
+            let points = t.heights.len();
+            n += points;
+            h2 += points as f64 * stats.roughness.h_rms_m.powi(2);
+            s2 += points as f64 * stats.roughness.h_prime_rms.powi(2);
+            c2 += points as f64 * stats.roughness.h_double_prime_rms_per_m.powi(2);
+        }
+        measurements.push(MeasurementDescription {
+            index: m.index,
+            surface: m.surface.clone(),
+            name: m.name.clone(),
+            periodic: m.periodic,
+            description: outcome.summary,
+        });
+    }
+    let pooled = measurements
+        .iter()
+        .filter(|m| m.description.detrended.is_some())
+        .count();
+    let combined = (n > 0).then(|| CombinedFacts {
+        measurements: pooled,
+        points: n,
+        detrend: request.source.detrend.name(),
+        roughness: Roughness {
+            h_rms_m: (h2 / n as f64).sqrt(),
+            h_prime_rms: (s2 / n as f64).sqrt(),
+            h_double_prime_rms_per_m: (c2 / n as f64).sqrt(),
+        },
+    });
+    Ok((
+        ContainerDescription {
+            container: path.display().to_string(),
+            measurements,
+            combined,
+        },
+        notes,
+    ))
 }
