@@ -202,7 +202,7 @@ fn whole_job(roughness: &Topography, model: Model, args: &Args, solve_s: f64) {
         let out = dir.path().join("sim");
         let start = (Instant::now(), cpu_seconds());
         let (outcome, written) =
-            run_to_folder(&request, &out, &[], &|_, _| {}, None).expect("simulate job");
+            run_to_folder(&request, &out, &[], &|_, _| {}, None, &[]).expect("simulate job");
         let (wall, cpu) = (start.0.elapsed().as_secs_f64(), cpu_seconds() - start.1);
         let bytes: u64 = written
             .iter()

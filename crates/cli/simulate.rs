@@ -7,7 +7,7 @@ use indicatif::ProgressStyle;
 use contactscope::solver::simulate::Model;
 use contactscope_formats::units::{self, Dimension};
 use contactscope_jobs::heights::HeightInput;
-use contactscope_jobs::simulate::files::run_to_folder;
+use contactscope_jobs::simulate::files::{run_to_folder, Export};
 use contactscope_jobs::simulate::{MapChoice, ModelChoice, SimulateRequest};
 
 use super::args::{default_out, load_forces, BodyArgs, Forces, OutputFolder, Quiet, SolverArgs};
@@ -36,6 +36,15 @@ enum MapsArg {
     Contact,
     /// Contact, pressure, gap, plastic displacement and deformed surface of each load.
     All,
+}
+
+/// `--export`: another tool's layout.
+#[derive(Clone, Copy, ValueEnum)]
+enum ExportArg {
+    /// contact.engineering's contact-mechanics download (contact_mechanics.zip).
+    ContactEngineering,
+    /// The deformed surfaces as a surface container (deformed_surfaces.zip).
+    SurfaceContainer,
 }
 
 #[derive(clap::Args)]
@@ -68,6 +77,13 @@ pub struct Args {
     /// Per-load float32 TIFF maps to write: all, contact (the contact map only) or none.
     #[arg(long, value_enum, default_value = "all")]
     maps: MapsArg,
+    /// Also write the results in other tools' layouts (comma-separated): contact-engineering
+    /// writes contact_mechanics.zip as contact.engineering's contact-mechanics download
+    /// (plot.csv, result-step-N.nc, info.txt); surface-container writes deformed_surfaces.zip,
+    /// the plastically deformed surface and plastic displacement of every load as a surface
+    /// container (docs/outputs.md).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    export: Vec<ExportArg>,
     #[command(flatten)]
     out: OutputFolder<Out>,
     #[command(flatten)]
@@ -156,6 +172,14 @@ pub fn run(args: Args) -> Result<Finished> {
         &command_line(),
         &|done, _| bar.set_position(done as u64),
         Some(&monitor),
+        &args
+            .export
+            .iter()
+            .map(|e| match e {
+                ExportArg::ContactEngineering => Export::ContactEngineering,
+                ExportArg::SurfaceContainer => Export::SurfaceContainer,
+            })
+            .collect::<Vec<_>>(),
     );
     bar.finish_and_clear();
     let (outcome, written) = outcome?;

@@ -35,7 +35,8 @@ pub struct Args {
     /// Random seed.
     #[arg(long, default_value_t = SurfaceRequest::SEED)]
     seed: u64,
-    /// Output file: .npy or .gsf (heights in metres).
+    /// Output file: .npy, .gsf (heights in metres) or .zip (a contact.engineering surface
+    /// container, readable by SurfaceTopography).
     #[arg(long)]
     out: PathBuf,
 }

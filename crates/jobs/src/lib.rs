@@ -21,6 +21,7 @@
 
 #![warn(missing_docs)]
 
+pub mod container_out;
 pub mod error;
 pub mod fits;
 pub mod heights;

@@ -79,6 +79,26 @@ impl Staging {
         Ok(target)
     }
 
+    /// Stage output file `name` written by `write` (for a file too large to hold in memory):
+    /// `write` gets the open staged file.
+    pub fn write_with(
+        &self,
+        name: &str,
+        write: impl FnOnce(&mut fs::File) -> Result<()>,
+    ) -> Result<PathBuf> {
+        let target = self.final_path(name);
+        if is_input(&target, &self.protected) {
+            return Err(input_refusal(target));
+        }
+        let staged = self.staging_dir.join(name);
+        let _open = open_gate(&staged)?;
+        let mut file = fs::File::create(&staged).map_err(|e| output_error(&staged, e))?;
+        write(&mut file)?;
+        file.sync_all().map_err(|e| output_error(&staged, e))?;
+        self.files.lock().expect("lock").push(name.to_string());
+        Ok(target)
+    }
+
     /// Make the staged files the output folder, replacing an earlier run's folder as a whole
     /// (module docs): all of them, or nothing.
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {

@@ -43,81 +43,142 @@ pub struct OutSurface<'a> {
     pub topographies: Vec<OutTopography<'a>>,
 }
 
-/// The container's bytes. `versions`: the software that made it (name, version), `created_at`:
-/// a timestamp as text, `readme`: the text of `README.txt`.
+/// A container being written: each topography's NetCDF file goes to a temporary folder as it
+/// is added (so that a long series is not held in memory), the archive is put together by
+/// [`ContainerBuilder::write_to`].
+pub struct ContainerBuilder {
+    dir: tempfile::TempDir,
+    files: Vec<String>,
+    surfaces: Vec<Value>,
+}
+
+fn fail(what: impl std::fmt::Display) -> Error {
+    Error::InvalidArgument(format!("surface container: {what}"))
+}
+
+impl ContainerBuilder {
+    /// An empty container.
+    pub fn new() -> Result<Self> {
+        Ok(ContainerBuilder {
+            dir: tempfile::tempdir().map_err(fail)?,
+            files: Vec::new(),
+            surfaces: Vec::new(),
+        })
+    }
+
+    /// Start a surface; the topographies added next belong to it.
+    pub fn surface(&mut self, name: &str, description: &str) {
+        self.surfaces.push(json!({
+            "name": name,
+            "description": description,
+            "tags": [],
+            "is_published": false,
+            "topographies": [],
+        }));
+    }
+
+    /// Add a topography to the current surface (a surface named `surface0` is started when
+    /// there is none).
+    pub fn add(&mut self, t: &OutTopography<'_>) -> Result<()> {
+        if self.surfaces.is_empty() {
+            self.surface("surface0", "");
+        }
+        let file = format!("topography{}.nc", self.files.len());
+        let (ny, nx) = t.heights.dim();
+        let path = self.dir.path().join(&file);
+        let info = serde_json::to_string(&t.info).map_err(fail)?;
+        write_netcdf(
+            &path,
+            &height_map_netcdf(t.heights, t.pixel_size_m, t.periodic, Some(&info)),
+        )?;
+        self.files.push(file.clone());
+        let meta = json!({
+            "name": t.name,
+            "datafile": {"squeezed-netcdf": file},
+            "size": [nx as f64 * t.pixel_size_m.0, ny as f64 * t.pixel_size_m.1],
+            "unit": "m",
+            "data_source": 0,
+            "has_undefined_data": t.heights.iter().any(|h| !h.is_finite()),
+            "fill_undefined_data_mode": "do-not-fill",
+            "detrend_mode": "center",
+            "is_periodic": t.periodic,
+            "measurement_date": "1970-01-01",
+            "description": "",
+            "tags": [],
+        });
+        if let Some(Value::Array(list)) = self
+            .surfaces
+            .last_mut()
+            .and_then(|s| s.get_mut("topographies"))
+        {
+            list.push(meta);
+        }
+        Ok(())
+    }
+
+    /// Write the archive to `out`. `versions`: the software that made it (name, version),
+    /// `created_at`: a timestamp as text, `readme`: the text of `README.txt`.
+    pub fn write_to<W: std::io::Write + std::io::Seek>(
+        self,
+        out: W,
+        versions: &[(&str, &str)],
+        created_at: &str,
+        readme: &str,
+    ) -> Result<W> {
+        let mut zip = zip::ZipWriter::new(out);
+        let options = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated)
+            .large_file(true);
+        for file in &self.files {
+            let path = self.dir.path().join(file);
+            let mut f = std::fs::File::open(&path).map_err(|e| Error::io(&path, e))?;
+            zip.start_file(file.as_str(), options).map_err(fail)?;
+            std::io::copy(&mut f, &mut zip).map_err(fail)?;
+        }
+        let versions: serde_json::Map<String, Value> = versions
+            .iter()
+            .map(|(k, v)| (k.to_string(), Value::String(v.to_string())))
+            .collect();
+        let meta = json!({
+            "versions": versions,
+            "surfaces": self.surfaces,
+            "created_at": created_at,
+        });
+        let index = serde_json::to_string_pretty(&meta).map_err(fail)?;
+        let yaml = to_yaml(&meta)?;
+        for (name, text) in [
+            (super::container::INDEX_JSON, index.as_str()),
+            (super::container::META_YML, yaml.as_str()),
+            ("README.txt", readme),
+        ] {
+            zip.start_file(name, options).map_err(fail)?;
+            zip.write_all(text.as_bytes()).map_err(fail)?;
+        }
+        zip.finish().map_err(fail)
+    }
+}
+
+/// The container's bytes, for a few topographies held in memory ([`ContainerBuilder`] for
+/// more). `versions`, `created_at`, `readme` as for [`ContainerBuilder::write_to`].
 pub fn encode_container(
     surfaces: &[OutSurface<'_>],
     versions: &[(&str, &str)],
     created_at: &str,
     readme: &str,
 ) -> Result<Vec<u8>> {
-    let fail = |what: String| Error::InvalidArgument(format!("surface container: {what}"));
-    let dir = tempfile::tempdir().map_err(|e| fail(e.to_string()))?;
-    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
-    let options = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated);
-    let mut counter = 0usize;
-    let mut surface_meta = Vec::new();
+    let mut builder = ContainerBuilder::new()?;
     for surface in surfaces {
-        let mut topographies = Vec::new();
+        builder.surface(&surface.name, &surface.description);
         for t in &surface.topographies {
-            let file = format!("topography{counter}.nc");
-            counter += 1;
-            let (ny, nx) = t.heights.dim();
-            let path = dir.path().join(&file);
-            let info = serde_json::to_string(&t.info).map_err(|e| fail(e.to_string()))?;
-            write_netcdf(
-                &path,
-                &height_map_netcdf(t.heights, t.pixel_size_m, t.periodic, Some(&info)),
-            )?;
-            let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
-            zip.start_file(&file, options)
-                .and_then(|_| zip.write_all(&bytes).map_err(Into::into))
-                .map_err(|e| fail(e.to_string()))?;
-            topographies.push(json!({
-                "name": t.name,
-                "datafile": {"squeezed-netcdf": file},
-                "size": [nx as f64 * t.pixel_size_m.0, ny as f64 * t.pixel_size_m.1],
-                "unit": "m",
-                "data_source": 0,
-                "has_undefined_data": t.heights.iter().any(|h| !h.is_finite()),
-                "fill_undefined_data_mode": "do-not-fill",
-                "detrend_mode": "center",
-                "is_periodic": t.periodic,
-                "measurement_date": "1970-01-01",
-                "description": "",
-                "tags": [],
-            }));
+            builder.add(t)?;
         }
-        surface_meta.push(json!({
-            "name": surface.name,
-            "description": surface.description,
-            "tags": [],
-            "is_published": false,
-            "topographies": topographies,
-        }));
     }
-    let versions: serde_json::Map<String, Value> = versions
-        .iter()
-        .map(|(k, v)| (k.to_string(), Value::String(v.to_string())))
-        .collect();
-    let meta = json!({
-        "versions": versions,
-        "surfaces": surface_meta,
-        "created_at": created_at,
-    });
-    let index = serde_json::to_string_pretty(&meta).map_err(|e| fail(e.to_string()))?;
-    let yaml = to_yaml(&meta)?;
-    for (name, text) in [
-        (super::container::INDEX_JSON, index.as_str()),
-        (super::container::META_YML, yaml.as_str()),
-        ("README.txt", readme),
-    ] {
-        zip.start_file(name, options)
-            .and_then(|_| zip.write_all(text.as_bytes()).map_err(Into::into))
-            .map_err(|e| fail(e.to_string()))?;
-    }
-    let cursor = zip.finish().map_err(|e| fail(e.to_string()))?;
+    let cursor = builder.write_to(
+        std::io::Cursor::new(Vec::new()),
+        versions,
+        created_at,
+        readme,
+    )?;
     Ok(cursor.into_inner())
 }
 

@@ -1,6 +1,7 @@
 //! Writing NetCDF-3 files (the 64-bit offset format, `CDF\x02`, as SurfaceTopography and
 //! contact.engineering write theirs) with the `netcdf3` crate: fixed dimensions, `f64`, `i32`
-//! and `i8` variables, and text or `f64` attributes on variables and on the file.
+//! and `i8` variables, and text, `f64` or `i32` attributes on variables and on the file. A NaN
+//! attribute is refused: the crate finds a variable again by comparing it whole, and NaN ≠ NaN.
 //!
 //! [`height_map_netcdf`] lays a height map out as SurfaceTopography's `write_nc_uniform` does
 //! (the layout [`super::netcdf`] reads): `heights(x, y)` as `f64` with the attribute `unit`,
@@ -104,6 +105,14 @@ pub fn write_netcdf(path: &Path, file: &NcFile) -> Result<()> {
             NcAttr::I32(v) => ds.add_global_attr_i32(name, v.clone()),
         }
         .map_err(|e| fail(format!("attribute {name}: {e:?}")))?;
+    }
+    let nan = |attrs: &[(String, NcAttr)]| {
+        attrs
+            .iter()
+            .any(|(_, a)| matches!(a, NcAttr::F64(v) if v.iter().any(|x| x.is_nan())))
+    };
+    if nan(&file.attrs) || file.vars.iter().any(|v| nan(&v.attrs)) {
+        return Err(fail("a NaN attribute cannot be written".into()));
     }
     for var in &file.vars {
         let expected: usize = var

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use contactscope::solver::cg::Monitor;
 use contactscope_formats::tiff::write::{encode_f32_stack, quantity, values_description};
 
+use super::export_ce::{CeExport, DeformedExport};
 use super::{run, LoadMaps, LoadObserver, MapChoice, SimulateOutcome, SimulateRequest};
 use crate::error::Result;
 use crate::heights::HeightInput;
@@ -25,11 +26,20 @@ pub fn run_to_folder(
     command_line: &[String],
     progress: &dyn Fn(usize, usize),
     monitor: Option<Monitor>,
+    exports: &[Export],
 ) -> Result<(SimulateOutcome, Vec<PathBuf>)> {
     request.check()?;
     let inputs: Vec<PathBuf> = match &request.heights {
         HeightInput::File(source) => vec![source.path.clone()],
         HeightInput::Memory { .. } => Vec::new(),
+    };
+    let ce = match exports.contains(&Export::ContactEngineering) {
+        true => Some(CeExport::new(request)?),
+        false => None,
+    };
+    let deformed = match exports.contains(&Export::SurfaceContainer) {
+        true => Some(DeformedExport::new(request)?),
+        false => None,
     };
     let staging = Staging::new(out_dir, &inputs)?;
     let mut writer = MapWriter {
@@ -37,8 +47,16 @@ pub fn run_to_folder(
         progress,
         maps: request.maps,
         top_m: None,
+        ce,
+        deformed,
     };
     let outcome = run(request, &mut writer, monitor)?;
+    if let Some(ce) = writer.ce.take() {
+        ce.finish(&staging, request, &outcome)?;
+    }
+    if let Some(d) = writer.deformed.take() {
+        d.finish(&staging)?;
+    }
     staging.write("areas.csv", &areas_csv(&outcome)?)?;
     #[cfg(feature = "plots")]
     if outcome.loads.iter().any(|l| l.area_m2 > 0.0) {
@@ -47,6 +65,18 @@ pub fn run_to_folder(
     staging.write("summary.json", &summary_json(command_line, &outcome)?)?;
     let written = staging.commit()?;
     Ok((outcome, written))
+}
+
+/// An export of the results in another tool's layout, beside contactscope's own files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Export {
+    /// contact.engineering's contact-mechanics download (`contact_mechanics.zip`,
+    /// [`super::export_ce`]).
+    ContactEngineering,
+    /// The plastically deformed surface and the plastic displacement of every load as a
+    /// contact.engineering surface container (`deformed_surfaces.zip`,
+    /// [`super::export_ce::DeformedExport`]).
+    SurfaceContainer,
 }
 
 /// `areas.csv`: the `loads` of the summary, one row each; the residual with three digits.
@@ -61,10 +91,20 @@ struct MapWriter<'a> {
     maps: MapChoice,
     /// The top of the undeformed body, the same at every load (found at the first).
     top_m: Option<f64>,
+    /// The contact.engineering export, when asked for.
+    ce: Option<CeExport>,
+    /// The deformed surfaces' container, when asked for.
+    deformed: Option<DeformedExport>,
 }
 
 impl LoadObserver for MapWriter<'_> {
     fn load(&mut self, index: usize, total: usize, maps: LoadMaps<'_>) -> Result<()> {
+        if let Some(ce) = &mut self.ce {
+            ce.step(index, &maps)?;
+        }
+        if let Some(d) = &mut self.deformed {
+            d.step(index, &maps)?;
+        }
         if self.maps != MapChoice::None {
             self.write_maps(index, &maps)?;
         }

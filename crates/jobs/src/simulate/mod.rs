@@ -5,6 +5,7 @@
 //! Python result (SI units, [`crate::lab`]). Per-load maps reach the caller's [`LoadObserver`]
 //! as they come (the command line writes them as TIFFs, [`files`]; Python keeps them as arrays).
 
+pub mod export_ce;
 pub mod files;
 
 use serde::ser::SerializeMap;
