@@ -9,6 +9,7 @@ use pyo3::types::PyDict;
 
 use contactscope::solver::simulate::Model;
 use contactscope_formats::param::Param;
+use contactscope_jobs::simulate::export_ce::{CeExport, Exporting};
 use contactscope_jobs::simulate::{
     run, LoadMaps, LoadObserver, MapChoice, ModelChoice, SimulateRequest,
 };
@@ -161,7 +162,7 @@ impl LoadObserver for KeepMaps {
 /// A load ramp with one contact model (the command line's `simulate`); see the package's
 /// docstring. Returns the outcome (SI) and the stacks (loads, ny, nx) `maps` asks for.
 #[pyfunction]
-#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=MapsArg::Name("all".into()), detrend="plane", height_unit=None, channel=None, fill_invalid=None, device="cpu", measurement=None))]
+#[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=MapsArg::Name("all".into()), detrend="plane", height_unit=None, channel=None, fill_invalid=None, device="cpu", measurement=None, contact_engineering=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -185,6 +186,7 @@ fn simulate<'py>(
     fill_invalid: Option<&str>,
     device: &str,
     measurement: Option<String>,
+    contact_engineering: Option<std::path::PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let device = crate::convert::device_of(device)?;
     let input = height_input(
@@ -210,10 +212,29 @@ fn simulate<'py>(
             contact_only: maps == MapChoice::Contact,
             ..KeepMaps::default()
         };
-        let outcome = if maps == MapChoice::None {
-            run(&request, &mut contactscope_jobs::simulate::NoMaps, None)?
+        let mut none = contactscope_jobs::simulate::NoMaps;
+        let inner: &mut dyn LoadObserver = if maps == MapChoice::None {
+            &mut none
         } else {
-            run(&request, &mut kept, None)?
+            &mut kept
+        };
+        let outcome = match &contact_engineering {
+            // The export hears of every load beside the maps kept; the archive is written
+            // (atomically) only when every load is solved.
+            Some(path) => {
+                let mut export = CeExport::new(&request)?;
+                let outcome = run(
+                    &request,
+                    &mut Exporting {
+                        inner,
+                        export: &mut export,
+                    },
+                    None,
+                )?;
+                export.finish_to(path, &request, &outcome)?;
+                outcome
+            }
+            None => run(&request, inner, None)?,
         };
         Ok::<_, contactscope_jobs::Error>((outcome, kept))
     })?;

@@ -2,6 +2,7 @@
 //! on real and generated files, and vendor files in the optics commands.
 
 mod commands;
+mod container;
 mod files;
 mod ome_zarr;
 mod peer;

@@ -139,6 +139,18 @@ pub const TEMPLATES: &[Template] = &[
         ["topography", "t.jpk", "--json"]
     ),
     t!(
+        "topography-container-zip",
+        ["t.zip"],
+        ["t.zip"],
+        ["topography", "t.zip", "--measurement", "0", "--json"]
+    ),
+    t!(
+        "topography-container-folder",
+        ["tc"],
+        ["tc/index.json", "tc/meta.yml", "tc/topography0.nc"],
+        ["topography", "tc", "--json"]
+    ),
+    t!(
         "topography-topostats",
         ["t.topostats"],
         ["t.topostats"],

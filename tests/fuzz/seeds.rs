@@ -192,6 +192,26 @@ pub fn build(dir: &Path) {
             ],
         );
     }
+    // A contact.engineering surface container, zipped and unpacked (its metadata and NetCDF
+    // file mutable one by one).
+    cli(
+        dir,
+        &[
+            "surface",
+            "--size",
+            "32",
+            "--pixel-size",
+            "200nm",
+            "--rms-height",
+            "20nm",
+            "--out",
+            "t.zip",
+        ],
+    );
+    zip::ZipArchive::new(fs::File::open(dir.join("t.zip")).unwrap())
+        .unwrap()
+        .extract(dir.join("tc"))
+        .unwrap();
     text_matrix(dir);
     wsxm(dir);
     nanoscope(dir);

@@ -244,7 +244,7 @@ impl TopographySource {
                 return Err(Error::bad_input(
                     Location::file(&self.path),
                     format!(
-                        "a surface container states each measurement's size and unit; do not                          give {} or {}",
+                        "a surface container states each measurement's size and unit; do not give {} or {}",
                         Param::PixelSize,
                         Param::HeightUnit
                     ),
@@ -258,7 +258,7 @@ impl TopographySource {
             return Err(Error::bad_input(
                 Location::file(&self.path),
                 format!(
-                    "measurement '{m}' asked for, but the file is not a contact.engineering                      surface container (a ZIP archive or folder with index.json or meta.yml)"
+                    "measurement '{m}' asked for, but the file is not a contact.engineering surface container (a ZIP archive or folder with index.json or meta.yml)"
                 ),
             ));
         }
@@ -344,7 +344,7 @@ pub fn read_measurement(
             return Err(Error::bad_input(
                 at(),
                 format!(
-                    "measurement {}: fill_undefined_data_mode '{other}' is not applied by                      contactscope (do-not-fill and harmonic are)",
+                    "measurement {}: fill_undefined_data_mode '{other}' is not applied by contactscope (do-not-fill and harmonic are)",
                     m.label()
                 ),
             ))

@@ -396,6 +396,46 @@ fn output_error(path: &Path, e: std::io::Error) -> Error {
     }
 }
 
+/// Write one file atomically by `write` (given the open temporary file): a temporary file in
+/// the same folder, then a rename; an input of the run (`inputs`) is never overwritten.
+pub fn write_atomic_with(
+    path: &Path,
+    inputs: &[PathBuf],
+    write: impl FnOnce(&mut fs::File) -> Result<()>,
+) -> Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    fs::create_dir_all(&dir).map_err(|e| output_error(&dir, e))?;
+    let name = path
+        .file_name()
+        .map_or("out".into(), |n| n.to_string_lossy().into_owned());
+    let protected: Vec<PathBuf> = inputs
+        .iter()
+        .filter_map(|p| p.canonicalize().ok())
+        .collect();
+    if is_input(path, &protected) {
+        return Err(input_refusal(path.to_path_buf()));
+    }
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let _open = open_gate(&tmp)?;
+    let written = fs::File::create(&tmp)
+        .map_err(|e| output_error(&tmp, e))
+        .and_then(|mut f| {
+            write(&mut f)?;
+            f.sync_all().map_err(|e| output_error(&tmp, e))
+        });
+    if let Err(e) = written {
+        let _ = fs::remove_file(&tmp);
+        return Err(e);
+    }
+    fs::rename(&tmp, path).map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        output_error(path, e)
+    })
+}
+
 /// Write one file atomically: a temporary file in the same folder, then a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = match path.parent() {

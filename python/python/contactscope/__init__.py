@@ -504,7 +504,8 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
 def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
                     height_unit: Optional[float] = None, detrend: str = "plane", *,
                     channel: Optional[str] = None,
-                    fill_invalid: Optional[str] = None) -> Results:
+                    fill_invalid: Optional[str] = None,
+                    measurement: Optional[str] = None) -> Results:
     """A height map from any format contactscope reads (npy, TIFF, GSF, text matrices with or
     without a Gwyddion or h=/w= header, x y z grids, gzip text, WSxM, Nanoscope, Nanonis sxm, TopoStats, JPK TIFF, Igor ibw,
     Nanosurf nid, PicoView mi, Park TIFF, Gwyddion, X3P, SDF, Wyko opd, Sensofar plu, Digital
@@ -515,7 +516,11 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
     ``pixel_size`` (m, or (x, y)) overrides the file's; ``height_unit``: metres per stored unit
     for files without one. ``channel`` names the channel of a multi-channel file (default: its
     height channel). A map with invalid (unmeasured) points raises :class:`InputError` unless
-    ``fill_invalid`` is "mean" or "nearest"; ``notes`` then says how many points were filled.
+    ``fill_invalid`` is "mean", "nearest" or "harmonic"; ``notes`` then says how many points
+    were filled. A contact.engineering surface container (ZIP or folder) is read with its own
+    processing (size, unit, height scale, filling, detrending, as SurfaceTopography's
+    ``read_container``); ``measurement`` chooses one by index ("0") or name ("name" or
+    "surface/name"), needed when it holds several.
 
     Returns ``heights`` (rows = y, m; filled as asked, then detrended by ``detrend``: "none",
     "mean" or "plane", the command line's default), ``pixel_size_m`` ((x, y), m), ``notes`` and
@@ -529,7 +534,7 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
     ``h_double_prime_rms_per_m``).
     """
     result = Results(_cs.read_topography(os.fspath(path), pixel_size, height_unit, detrend,
-                                         channel, fill_invalid))
+                                         channel, fill_invalid, measurement))
     # The command line's warnings (a pixel size that replaced the file's, points filled).
     for text in result.get("notes") or ():
         _warnings.warn(text, ContactscopeWarning, stacklevel=2)
@@ -577,7 +582,9 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
              max_iterations: Optional[int] = None, maps: Union[str, bool] = "all",
              detrend: str = "plane",
              height_unit: Optional[float] = None, channel: Optional[str] = None,
-             fill_invalid: Optional[str] = None, device: str = "cpu") -> Results:
+             fill_invalid: Optional[str] = None, device: str = "cpu",
+             measurement: Optional[str] = None,
+             contact_engineering: Optional[PathLike] = None) -> Results:
     """A load ramp on a rough body pressed on a flat of contact modulus E* ``modulus`` (Pa) at
     normal forces ``loads`` (N, in order; the plastic state carries from load to load): the
     command line's ``simulate``, with the same defaults, checks and warnings.
@@ -603,6 +610,12 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
     nx): with ``"all"`` (the default) ``pressure`` (Pa), ``gap`` (m), ``contact`` (bool) and
     ``plastic`` (m); with ``"contact"`` ``contact`` only; with ``"none"`` none (``True`` and
     ``False`` mean ``"all"`` and ``"none"``). The command line's ``--maps`` takes the same choice.
+
+    ``measurement`` chooses the measurement of a contact.engineering surface container (a
+    measurement marked periodic is solved with periodic boundaries). ``contact_engineering``: a
+    ``.zip`` path to write contact.engineering's contact-mechanics download to (``plot.csv``,
+    ``result-step-N.nc``, ``info.txt``; the command line's ``--export contact-engineering``,
+    ``docs/outputs.md``), written once every load is solved.
     """
     if not isinstance(heights, (str, os.PathLike)):
         heights = _f64(heights, 2, "heights")
@@ -610,7 +623,9 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
                                   _numbers(loads, "loads", "N"),
                                   model, hardness, k, initial_hardness, alpha, radius, periodic,
                                   tolerance, max_iterations, maps, detrend, height_unit,
-                                  channel, fill_invalid, device), table="loads")
+                                  channel, fill_invalid, device, measurement,
+                                  None if contact_engineering is None
+                                  else os.fspath(contact_engineering)), table="loads")
     _warn(result)
     return result
 

@@ -394,6 +394,7 @@ def read_topography(
     detrend: str = "plane",
     channel: Optional[str] = None,
     fill_invalid: Optional[str] = None,
+    measurement: Optional[str] = None,
 ) -> TopographyResult: ...
 
 class SurfaceResult(TypedDict):
@@ -479,6 +480,8 @@ def simulate(
     channel: Optional[str] = None,
     fill_invalid: Optional[str] = None,
     device: str = "cpu",
+    measurement: Optional[str] = None,
+    contact_engineering: Optional[Path] = None,
 ) -> SimulateResult: ...
 class RampResult(TypedDict):
     areas_m2: npt.NDArray[np.float64]

@@ -149,6 +149,10 @@ pub struct Container {
     zipped: bool,
 }
 
+/// The pixel size a data file is first read with (plausible, and unlikely to be any file's
+/// own): replaced by the file's own pixel size when it states one, else by the container's.
+const PLACEHOLDER_PIXEL_M: (f64, f64) = (1.234_567_9e-6, 1.234_567_9e-6);
+
 /// The most bytes of a metadata file read.
 const MAX_METADATA_BYTES: u64 = 64 << 20;
 
@@ -289,7 +293,7 @@ impl Container {
         // channels (known after a first read; a one-channel file's index 0 is that channel).
         let mut options = ReadOptions {
             // A placeholder: replaced below by the file's own pixel size, or by `size`.
-            pixel_size_m: Some((1.0, 1.0)),
+            pixel_size_m: Some(PLACEHOLDER_PIXEL_M),
             height_unit_m: unit_m,
             channel: channel.map(str::to_string),
         };

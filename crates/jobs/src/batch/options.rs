@@ -124,8 +124,10 @@ options! {
     Detrend: "detrend", Fit, "", "--detrend", None;
     /// Channel of a multi-channel height map, by name.
     TopographyChannel: "topography_channel", Fit, "", "--channel", None;
-    /// Filling of a height map's invalid points (`mean`, `nearest`).
+    /// Filling of a height map's invalid points (`mean`, `nearest`, `harmonic`).
     FillInvalid: "fill_invalid", Fit, "", "--fill-invalid", None;
+    /// The measurement of a contact.engineering surface container, by index or name.
+    TopographyMeasurement: "topography_measurement", Fit, "", "--measurement", None;
     /// Models fitted or scored (`gt,elastic,hardness,hardening`).
     Models: "models", Fit, "", "--models", None;
     /// Search range of k.
@@ -241,12 +243,14 @@ impl Opt {
             Opt::PsfFwhm => json!(checked(text, Dimension::Length, Quantity::Fwhm)?),
             Opt::Modulus => json!(checked(text, Dimension::Pressure, Quantity::Modulus)?),
             Opt::HeightUnit => json!(checked(text, Dimension::Length, Quantity::Height)?),
-            Opt::Topography | Opt::TopographyChannel | Opt::Psf => json!(text.trim()),
+            Opt::Topography | Opt::TopographyChannel | Opt::TopographyMeasurement | Opt::Psf => {
+                json!(text.trim())
+            }
             Opt::Detrend => json!(Detrend::from_name(text.trim())
                 .ok_or_else(|| format!("'{text}' is not none, mean or plane"))?
                 .name()),
             Opt::FillInvalid => json!(FillInvalid::from_name(text.trim())
-                .ok_or_else(|| format!("'{text}' is not mean or nearest"))?
+                .ok_or_else(|| format!("'{text}' is not mean, nearest or harmonic"))?
                 .name()),
             Opt::Models => json!(families_from_text(text)?
                 .iter()
@@ -560,7 +564,9 @@ impl SeriesOptions {
             fill_invalid: self
                 .get(Opt::FillInvalid)
                 .and_then(|t| FillInvalid::from_name(t.trim())),
-            measurement: None,
+            measurement: self
+                .get(Opt::TopographyMeasurement)
+                .map(|t| t.trim().to_string()),
         };
         let modulus = self
             .value(Opt::Modulus)

@@ -30,13 +30,14 @@
 //! contact.engineering averages is zero on the contact to the solver's tolerance).
 
 use std::io::Write;
+use std::path::{Path, PathBuf};
 
 use contactscope::solver::simulate::Model;
 use contactscope_formats::topography::netcdf_write::{
     write_netcdf, NcAttr, NcData, NcFile, NcVariable,
 };
 
-use super::{LoadMaps, ModelChoice, SimulateOutcome, SimulateRequest};
+use super::{LoadMaps, LoadObserver, ModelChoice, SimulateOutcome, SimulateRequest};
 use crate::error::{Error, Result};
 use crate::heights::HeightInput;
 use crate::staging::Staging;
@@ -203,41 +204,76 @@ impl CeExport {
         request: &SimulateRequest,
         outcome: &SimulateOutcome,
     ) -> Result<()> {
+        staging.write_with(ZIP_NAME, |file| self.write_zip(file, request, outcome))?;
+        Ok(())
+    }
+
+    /// Write the archive to `path` (atomically; Python's `simulate(..., contact_engineering=)`).
+    pub fn finish_to(
+        self,
+        path: &Path,
+        request: &SimulateRequest,
+        outcome: &SimulateOutcome,
+    ) -> Result<()> {
+        let inputs: Vec<PathBuf> = match &request.heights {
+            HeightInput::File(s) => vec![s.path.clone()],
+            HeightInput::Memory { .. } => Vec::new(),
+        };
+        crate::staging::write_atomic_with(path, &inputs, |file| {
+            self.write_zip(file, request, outcome)
+        })
+    }
+
+    fn write_zip(
+        &self,
+        file: &mut std::fs::File,
+        request: &SimulateRequest,
+        outcome: &SimulateOutcome,
+    ) -> Result<()> {
         let name = measurement_name(&request.heights);
         let info = info_txt(request, outcome, &name)?;
         let plot = self.plot_csv();
         let mut steps: Vec<usize> = self.rows.iter().map(|r| r.step).collect();
         steps.sort_unstable();
-        let dir = self.dir.path().to_path_buf();
-        staging.write_with(ZIP_NAME, |file| {
-            let fail = |e: String| Error::Output {
-                path: staging.final_path(ZIP_NAME),
-                reason: e,
-            };
-            let mut zip = zip::ZipWriter::new(file);
-            let stored = zip::write::SimpleFileOptions::default()
-                .compression_method(zip::CompressionMethod::Stored)
-                .large_file(true);
-            let mut put = |entry: String, bytes: &mut dyn std::io::Read| -> Result<()> {
-                zip.start_file(entry, stored)
-                    .map_err(|e| fail(e.to_string()))?;
-                std::io::copy(bytes, &mut zip).map_err(|e| fail(e.to_string()))?;
-                Ok(())
-            };
-            put("README.txt".into(), &mut README.as_bytes())?;
-            put(format!("{name}/plot.csv"), &mut plot.as_bytes())?;
-            for s in &steps {
-                let path = dir.join(step_file(*s));
-                let mut f = std::fs::File::open(&path).map_err(|e| Error::io(&path, e))?;
-                put(format!("{name}/{}", step_file(*s)), &mut f)?;
-            }
-            put(format!("{name}/info.txt"), &mut info.as_bytes())?;
-            zip.finish()
-                .map_err(|e| fail(e.to_string()))?
-                .flush()
-                .map_err(|e| fail(e.to_string()))
-        })?;
-        Ok(())
+        let fail = |e: String| Error::InvalidArgument(format!("{ZIP_NAME}: {e}"));
+        let mut zip = zip::ZipWriter::new(file);
+        let stored = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Stored)
+            .large_file(true);
+        let mut put = |entry: String, bytes: &mut dyn std::io::Read| -> Result<()> {
+            zip.start_file(entry, stored)
+                .map_err(|e| fail(e.to_string()))?;
+            std::io::copy(bytes, &mut zip).map_err(|e| fail(e.to_string()))?;
+            Ok(())
+        };
+        put("README.txt".into(), &mut README.as_bytes())?;
+        put(format!("{name}/plot.csv"), &mut plot.as_bytes())?;
+        for s in &steps {
+            let path = self.dir.path().join(step_file(*s));
+            let mut f = std::fs::File::open(&path).map_err(|e| Error::io(&path, e))?;
+            put(format!("{name}/{}", step_file(*s)), &mut f)?;
+        }
+        put(format!("{name}/info.txt"), &mut info.as_bytes())?;
+        zip.finish()
+            .map_err(|e| fail(e.to_string()))?
+            .flush()
+            .map_err(|e| fail(e.to_string()))
+    }
+}
+
+/// An observer that hands every load to the export, then to `inner` (Python's `simulate`,
+/// which keeps the maps it is asked for).
+pub struct Exporting<'a> {
+    /// The caller's observer.
+    pub inner: &'a mut dyn LoadObserver,
+    /// The export.
+    pub export: &'a mut CeExport,
+}
+
+impl LoadObserver for Exporting<'_> {
+    fn load(&mut self, index: usize, total: usize, maps: LoadMaps<'_>) -> Result<()> {
+        self.export.step(index, &maps)?;
+        self.inner.load(index, total, maps)
     }
 }
 

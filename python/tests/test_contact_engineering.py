@@ -1,0 +1,343 @@
+"""contact.engineering interoperability: surface containers written by SurfaceTopography read
+with the same grid, physical size and heights; ours read back by SurfaceTopography; and
+`simulate --export contact-engineering` beside ContactMechanics on the same problem.
+
+SurfaceTopography and ContactMechanics are installed by scripts/test-all; the tests skip
+without them. The AFM files are SurfaceTopography's own examples (``../shared/data/real-afm``,
+skipped when absent); a generated surface is used besides them.
+"""
+
+import csv
+import io
+import json
+import pathlib
+import warnings
+import zipfile
+
+import numpy as np
+import pytest
+
+import contactscope as cs
+
+st = pytest.importorskip("SurfaceTopography")
+from SurfaceTopography import Topography, open_topography, read_container  # noqa: E402
+from SurfaceTopography.Container.IO import write_containers  # noqa: E402
+from SurfaceTopography.Container.SurfaceContainer import (  # noqa: E402
+    InMemorySurfaceContainer,
+)
+from SurfaceTopography.Generation import fourier_synthesis  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+AFM = ROOT.parent / "shared" / "data" / "real-afm"
+AFM_FILES = ["di-3.di", "spot_1-1000nm.ibw", "mi-1.mi", "nid-1.nid", "top-1.top"]
+UNIT_M = {"m": 1.0, "mm": 1e-3, "µm": 1e-6, "um": 1e-6, "nm": 1e-9, "Å": 1e-10, "pm": 1e-12}
+
+# The orientations our (rows = y) arrays may have relative to SurfaceTopography's (x, y).
+ORIENTATIONS = {
+    "transpose": lambda a: a.T,
+    "transpose, rows reversed": lambda a: a.T[::-1],
+    "transpose, columns reversed": lambda a: a.T[:, ::-1],
+    "transpose, both reversed": lambda a: a.T[::-1, ::-1],
+}
+
+
+def quiet(f, *args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return f(*args, **kwargs)
+
+
+def afm(name):
+    path = AFM / name
+    if not path.exists():
+        pytest.skip(f"{path} not found (the shared test data sits beside the checkout)")
+    return path
+
+
+def orientation_of(path):
+    """How our reader lays out this file's heights relative to SurfaceTopography's: found on
+    the file read directly (both sides, no processing), then used for its container copies."""
+    ours = cs.read_topography(path, detrend="none")["heights"]
+    t = quiet(lambda: open_topography(str(path)).topography())
+    theirs = quiet(t.heights) * UNIT_M[t.unit]
+    scale = np.abs(ours).max()
+    for name, f in ORIENTATIONS.items():
+        t = f(theirs)
+        if t.shape == ours.shape and np.abs(t - ours).max() <= 1e-12 * scale:
+            return f
+    pytest.fail(f"{path.name}: no orientation maps SurfaceTopography's heights onto ours")
+
+
+def assert_same_topography(ours, theirs, orient, label):
+    """Same grid, physical size and heights (1e-9 relative to the largest height)."""
+    h = ours["heights"]
+    t = orient(quiet(theirs.heights))
+    assert h.shape == t.shape, label
+    unit = UNIT_M[theirs.unit]
+    size = np.array(theirs.physical_sizes) * unit
+    px = ours["summary"]["pixel_size_m"]
+    ny, nx = h.shape
+    mine = np.array([px["x"] * nx, px["y"] * ny])
+    # Our x is SurfaceTopography's first axis for every orientation above.
+    assert np.allclose(mine, size, rtol=1e-9), (label, mine, size)
+    t = t * unit
+    scale = np.abs(t).max()
+    worst = np.nanmax(np.abs(h - t))
+    assert worst <= 1e-9 * scale, f"{label}: heights differ by {worst:.3e} m of {scale:.3e} m"
+    return worst / scale
+
+
+def test_containers_written_by_surface_topography_read_alike(tmp_path):
+    paths = [afm(f) for f in AFM_FILES]
+    generated = fourier_synthesis((96, 64), (9.6, 6.4), 0.8, rms_height=0.05, unit="µm",
+                                  rng=np.random.default_rng(3), periodic=True,
+                                  info={"name": "generated"})
+    topographies = [quiet(lambda p=p: open_topography(str(p)).topography()) for p in paths]
+    container = tmp_path / "st.zip"
+    quiet(write_containers, [InMemorySurfaceContainer(topographies + [generated])], container)
+    theirs = list(quiet(read_container, str(container))[0])
+    worst = 0.0
+    for k, t in enumerate(theirs):
+        # The container holds SurfaceTopography's arrays as NetCDF heights(x, y), whatever the
+        # original file's line order: a plain transpose of ours.
+        ours = cs.read_topography(container, detrend="none", measurement=str(k))
+        worst = max(worst, assert_same_topography(ours, t, ORIENTATIONS["transpose"],
+                                                  f"measurement {k}"))
+    print(f"SurfaceTopography-written container: largest height difference {worst:.2e} (rel)")
+
+
+def test_topobank_containers_with_originals_apply_the_processing_alike(tmp_path):
+    """A container as contact.engineering downloads it: the original files with their
+    processing in the metadata (detrending, height scale, filling of undefined data)."""
+    paths = [afm(f) for f in AFM_FILES[:4]]
+    orients = [orientation_of(p) for p in paths]
+    # A map with undefined points, stored (NetCDF with a mask) as an original file.
+    rng = np.random.default_rng(9)
+    h = np.cumsum(rng.normal(size=(48, 40)), axis=0) * 1e-9 + 2e-9 * np.arange(40)
+    mask = np.zeros(h.shape, bool)
+    mask[10:14, 5:9] = True
+    mask[30, 20] = True
+    holes = Topography(np.ma.masked_array(h, mask), (4.8e-6, 4.0e-6), unit="m")
+    holes_nc = tmp_path / "holes.nc"
+    quiet(holes.to_netcdf, str(holes_nc))
+    plans = [
+        ("di-3.di", {"detrend_mode": "height"}),
+        ("spot_1-1000nm.ibw", {"detrend_mode": "curvature", "height_scale": 2.0}),
+        ("mi-1.mi", {"detrend_mode": "center"}),
+        ("nid-1.nid", {"detrend_mode": "height", "height_scale": 0.5}),
+        ("holes.nc", {"detrend_mode": "curvature", "fill_undefined_data_mode": "harmonic"}),
+    ]
+    metas = []
+    container = tmp_path / "tb.zip"
+    with zipfile.ZipFile(container, "w") as z:
+        for name, extra in plans:
+            source = holes_nc if name == "holes.nc" else AFM / name
+            z.write(source, f"originals/{name}")
+            metas.append({"name": name, "datafile": {"original": f"originals/{name}"},
+                          "size": [1.0, 1.0], "unit": "um", "is_periodic": False, **extra})
+        z.writestr("index.json", json.dumps({"versions": {}, "surfaces": [
+            {"name": "lab", "topographies": metas}]}))
+    # The same metadata as meta.yml only (older downloads): absent keys mean no step there.
+    yml = tmp_path / "yml"
+    with zipfile.ZipFile(container) as z:
+        z.extractall(yml)
+    (yml / "index.json").unlink()
+    import yaml
+
+    (yml / "meta.yml").write_text(yaml.safe_dump({"surfaces": [
+        {"name": "lab", "topographies": metas}]}))
+    theirs = list(quiet(read_container, str(container))[0])
+    orients = orients + [ORIENTATIONS["transpose"]]  # NetCDF: heights(x, y)
+    worst = 0.0
+    for k, t in enumerate(theirs):
+        for source in (container, yml):
+            ours = cs.read_topography(source, detrend="none", measurement=metas[k]["name"])
+            worst = max(worst, assert_same_topography(ours, t, orients[k],
+                                                      f"{source.name}: {metas[k]['name']}"))
+    print(f"originals with their processing: largest height difference {worst:.2e} (rel)")
+    # Filled and detrended: no undefined point is left.
+    ours = cs.read_topography(container, detrend="none", measurement="lab/holes.nc")
+    assert np.isfinite(ours["heights"]).all()
+
+
+def test_our_containers_read_back_in_surface_topography(cli, tmp_path):
+    out = tmp_path / "gen.zip"
+    cli("surface", "--size", 64, "--pixel-size", "50nm", "--rms-height", "20nm", "--seed", 4,
+        "--out", out)
+    npy = tmp_path / "gen.npy"
+    cli("surface", "--size", 64, "--pixel-size", "50nm", "--rms-height", "20nm", "--seed", 4,
+        "--out", npy)
+    (t,) = list(quiet(read_container, str(out))[0])
+    assert t.is_periodic and t.unit == "m"
+    assert np.allclose(t.physical_sizes, (64 * 50e-9, 64 * 50e-9), rtol=1e-12)
+    assert np.array_equal(t.heights().T, np.load(npy))
+    # Deformed surfaces of a plastic run, one topography per load and map.
+    cli("simulate", "--topography", npy, "--pixel-size", "50nm", "--modulus", "10GPa",
+        "--model", "hardness", "--hardness", "300MPa", "--forces", "0.02mN,0.05mN",
+        "--periodic", "--maps", "all", "--export", "surface-container", "--out", tmp_path / "sim")
+    deformed = list(quiet(read_container, str(tmp_path / "sim" / "deformed_surfaces.zip"))[0])
+    names = [d.info["name"] for d in deformed]
+    assert names == ["load_001 deformed", "load_001 plastic", "load_002 deformed",
+                     "load_002 plastic"]
+    import tifffile
+
+    plastic_um = tifffile.imread(tmp_path / "sim" / "load_002_plastic_um.tif")
+    assert np.abs(deformed[3].heights().T * 1e6 - plastic_um).max() < 1e-6 * plastic_um.max()
+    assert deformed[3].heights().max() > 0, "the hardness model left plastic flow"
+    # And they read back here the same.
+    ours = cs.read_topography(tmp_path / "sim" / "deformed_surfaces.zip", detrend="none",
+                              measurement="load_002 plastic")
+    assert np.array_equal(ours["heights"], deformed[3].heights().T)
+
+
+# ---- contact mechanics beside ContactMechanics ------------------------------------------
+
+PRESSURES = [0.002, 0.01, 0.05]  # p/E*
+
+
+def contact_mechanics_plot(t, kind):
+    """The contact.engineering calculation with explicit pressures (topobank-contact's
+    `_contact_at_given_load`): E* = 1, Polonsky–Keer, pentol from the rms height; the rows and
+    maps its download holds."""
+    cm = pytest.importorskip("ContactMechanics")
+    from ContactMechanics.Systems import NonSmoothContactSystem
+
+    half_space = (cm.PeriodicFFTElasticHalfSpace if kind == "periodic"
+                  else cm.FreeFFTElasticHalfSpace)(t.nb_grid_pts, 1.0, t.physical_sizes)
+    system = NonSmoothContactSystem(half_space, t)
+    a0 = np.prod(t.physical_sizes)
+    rms = t.rms_height_from_area()
+    pentol = max(rms / (10 * np.mean(t.nb_grid_pts)), 1e-12)
+    nx, ny = t.nb_grid_pts
+    rows = []
+    for p in PRESSURES:
+        opt = quiet(system.minimize_proxy, external_force=p * a0, pentol=pentol, maxiter=1000)
+        force = opt.jac[:nx, :ny]
+        displacement = opt.x[:nx, :ny]
+        rows.append({
+            "pressure": force.sum() / a0,
+            "fraction": (force > 0).sum() / (nx * ny),
+            "gap": (displacement.mean() - t.heights().mean() - opt.offset) / rms,
+            "converged": bool(opt.success),
+            "contact": force > 0,
+        })
+    return rows
+
+
+def read_export(zip_path, name):
+    with zipfile.ZipFile(zip_path) as z:
+        names = z.namelist()
+        table = z.read(f"{name}/plot.csv").decode()
+        info = z.read(f"{name}/info.txt").decode()
+        import scipy.io
+
+        steps = {}
+        for n in names:
+            if n.endswith(".nc"):
+                f = scipy.io.netcdf_file(io.BytesIO(z.read(n)), "r", mmap=False)
+                steps[n.split("/")[-1]] = f
+    return names, table, info, steps
+
+
+def test_contact_engineering_export_matches_contact_mechanics(cli, tmp_path):
+    t = fourier_synthesis((128, 128), (12.8e-6, 12.8e-6), 0.8, rms_height=50e-9,
+                          short_cutoff=800e-9, rng=np.random.default_rng(5), periodic=True,
+                          unit="m")
+    periodic = Topography(t.heights(), t.physical_sizes, periodic=True, unit="m",
+                          info={"name": "periodic"})
+    free = Topography(t.heights(), t.physical_sizes, periodic=False, unit="m",
+                      info={"name": "free"})
+    container = tmp_path / "cm.zip"
+    quiet(write_containers, [InMemorySurfaceContainer([periodic, free])], container)
+    a0 = np.prod(t.physical_sizes)
+    modulus = 1e9  # any E*: the normalised results do not depend on it
+    forces = ",".join(f"{float(p * a0 * modulus)!r}N" for p in PRESSURES)
+    report = []
+    for name, kind in [("periodic", "periodic"), ("free", "nonperiodic")]:
+        out = tmp_path / f"sim-{name}"
+        cli("simulate", "--topography", container, "--measurement", name, "--detrend", "none",
+            "--modulus", "1GPa", "--model", "elastic", "--forces", forces, "--maps", "none",
+            "--export", "contact-engineering", "--out", out)
+        names, table, info, steps = read_export(out / "contact_mechanics.zip", name)
+        assert names[0] == "README.txt" and f"{name}/plot.csv" in names
+        lines = table.splitlines()
+        assert lines[0] == (",Normalized pressure p/E*,Fractional contact area A/A0,"
+                            "Normalized mean gap u/h_rms,converged,filename")
+        rows = list(csv.reader(lines[1:]))
+        assert [r[0] for r in rows] == ["0", "1", "2"]
+        assert all(r[4] == "True" for r in rows)
+        assert "Input SHA-256" in info and info.startswith("# topography: ")
+        theirs = contact_mechanics_plot(t, kind)
+        for row, ref in zip(rows, theirs):
+            pressure, fraction, gap = map(float, row[1:4])
+            nc = steps[row[5]]
+            # The file's variables and attributes, as contact.engineering's.
+            assert set(nc.variables) == {"pressure", "contacting_points", "gap", "displacement"}
+            for v in nc.variables.values():
+                assert v.dimensions == ("x", "y") and v.data.shape == (128, 128)
+            assert nc.variables["contacting_points"].data.dtype == np.int8
+            attrs = nc._attributes
+            assert attrs["type"].decode() == kind
+            assert np.isclose(attrs["mean_pressure"], pressure, rtol=1e-12)
+            assert np.isclose(attrs["total_contact_area"], fraction, rtol=1e-12)
+            contact = nc.variables["contacting_points"].data.astype(bool)
+            assert contact.mean() == fraction
+            assert np.isclose(nc.variables["pressure"].data.mean(), pressure, rtol=1e-6)
+            # Beside ContactMechanics: the same pressure, contact area and mean gap.
+            differing = int((contact != ref["contact"]).sum())
+            report.append((kind, ref["pressure"], fraction, ref["fraction"], gap, ref["gap"],
+                           differing))
+            assert np.isclose(pressure, ref["pressure"], rtol=1e-6)
+            assert abs(fraction - ref["fraction"]) <= 5e-4, (kind, fraction, ref["fraction"])
+            assert differing <= 10, (kind, differing)
+            assert abs(gap - ref["gap"]) <= 1e-3 * max(ref["gap"], 0.01), (kind, gap, ref["gap"])
+    print("\nboundary  p/E*  A/A0 ours  A/A0 ContactMechanics  u/h_rms ours  u/h_rms CM  "
+          "pixels differing")
+    for r in report:
+        print("  ".join(f"{v:.8g}" if isinstance(v, float) else str(v) for v in r))
+
+
+def test_container_choices_and_refusals(cli, tmp_path):
+    t = fourier_synthesis((32, 32), (3.2e-6, 3.2e-6), 0.8, rms_height=10e-9, unit="m",
+                          rng=np.random.default_rng(1))
+    container = tmp_path / "two.zip"
+    quiet(write_containers, [InMemorySurfaceContainer([t, t])], container)
+    with pytest.raises(cs.InputError, match="2 measurements.*measurement="):
+        cs.read_topography(container)
+    with pytest.raises(cs.InputError, match="no measurement 5"):
+        cs.read_topography(container, measurement="5")
+    with pytest.raises(cs.InputError, match="not a contact.engineering surface container"):
+        cs.read_topography(afm("mi-1.mi"), measurement="0")
+    whole = json.loads(cli("topography", container, "--detrend", "none", "--json"))
+    assert [m["index"] for m in whole["measurements"]] == [0, 1]
+    one = whole["measurements"][0]["detrended"]["h_rms_nm"]
+    assert np.isclose(whole["combined"]["h_rms_nm"], one, rtol=1e-12)
+    assert np.isclose(one * 1e-9, quiet(t.rms_height_from_area), rtol=1e-9)
+
+
+def test_python_writes_the_same_export_as_the_command_line(cli, tmp_path):
+    t = fourier_synthesis((48, 48), (4.8e-6, 4.8e-6), 0.8, rms_height=30e-9,
+                          rng=np.random.default_rng(7), periodic=True, unit="m",
+                          info={"name": "twin"})
+    container = tmp_path / "twin.zip"
+    quiet(write_containers, [InMemorySurfaceContainer([t])], container)
+    forces = [1e-5, 4e-5]
+    cli("simulate", "--topography", container, "--detrend", "none", "--modulus", "2GPa",
+        "--model", "hardness", "--hardness", "100MPa", "--forces", "0.01mN,0.04mN", "--maps",
+        "none", "--export", "contact-engineering", "--out", tmp_path / "cli")
+    out = tmp_path / "py.zip"
+    result = quiet(cs.simulate, container, None, 2e9, forces, "hardness", hardness=1e8,
+                   detrend="none", maps="none", measurement="0", contact_engineering=out)
+    assert result["boundary"].startswith("periodic"), "the container marks it periodic"
+    with zipfile.ZipFile(out) as a, zipfile.ZipFile(tmp_path / "cli" / "contact_mechanics.zip") as b:
+        assert a.namelist() == b.namelist()
+        assert a.read("twin/plot.csv") == b.read("twin/plot.csv")
+        import scipy.io
+
+        nc = scipy.io.netcdf_file(io.BytesIO(a.read("twin/result-step-1.nc")), "r", mmap=False)
+        assert np.isclose(nc._attributes["hardness"], 1e8 / 2e9)
+        assert nc.variables["pressure"].data.max() <= 1e8 / 2e9 * (1 + 1e-9)
+    with pytest.raises(cs.InputError, match="Greenwood"):
+        quiet(cs.simulate, container, None, 2e9, forces, "gt", radius=290e-6, detrend="none",
+              contact_engineering=tmp_path / "gt.zip")
+    assert not (tmp_path / "gt.zip").exists()
