@@ -175,8 +175,10 @@ pub fn build(dir: &Path) {
             "exp",
         ],
     );
-    // Topographies: npy, gsf (surface), text, WSxM, Nanoscope (writers above).
-    for name in ["t.npy", "t.gsf"] {
+    // Topographies: npy, gsf and a contact.engineering surface container (surface), text,
+    // WSxM, Nanoscope (writers above); the container also unpacked (its metadata and NetCDF
+    // file mutable one by one).
+    for name in ["t.npy", "t.gsf", "t.zip"] {
         cli(
             dir,
             &[
@@ -192,22 +194,6 @@ pub fn build(dir: &Path) {
             ],
         );
     }
-    // A contact.engineering surface container, zipped and unpacked (its metadata and NetCDF
-    // file mutable one by one).
-    cli(
-        dir,
-        &[
-            "surface",
-            "--size",
-            "32",
-            "--pixel-size",
-            "200nm",
-            "--rms-height",
-            "20nm",
-            "--out",
-            "t.zip",
-        ],
-    );
     zip::ZipArchive::new(fs::File::open(dir.join("t.zip")).unwrap())
         .unwrap()
         .extract(dir.join("tc"))

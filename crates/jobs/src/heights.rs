@@ -89,6 +89,18 @@ impl HeightInput {
         }
     }
 
+    /// The container measurement the heights come from (`surface/name`), `None` for other
+    /// inputs.
+    pub fn measurement_label(&self) -> Result<Option<String>> {
+        match self {
+            HeightInput::File(s) if s.is_container() => {
+                let c = Container::open(&s.path)?;
+                Ok(Some(c.find(s.measurement.as_deref())?.label()))
+            }
+            _ => Ok(None),
+        }
+    }
+
     /// Whether the heights are marked periodic (a container's measurement,
     /// [`TopographySource::stated_periodic`]).
     pub fn stated_periodic(&self) -> Result<bool> {
@@ -129,6 +141,8 @@ pub struct HeightFacts {
     pub channel: Option<String>,
     /// How invalid points were filled.
     pub fill_invalid: Option<FillInvalid>,
+    /// The container measurement read (`surface/name`); `null` for other files.
+    pub measurement: Option<String>,
     /// Roughness after detrending (written as `h_rms_nm`, `h_prime_rms`,
     /// `h_double_prime_rms_per_um`).
     #[serde(flatten)]

@@ -94,7 +94,6 @@ impl Staging {
         let _open = open_gate(&staged)?;
         let mut file = fs::File::create(&staged).map_err(|e| output_error(&staged, e))?;
         write(&mut file)?;
-        file.sync_all().map_err(|e| output_error(&staged, e))?;
         self.files.lock().expect("lock").push(name.to_string());
         Ok(target)
     }
@@ -422,10 +421,7 @@ pub fn write_atomic_with(
     let _open = open_gate(&tmp)?;
     let written = fs::File::create(&tmp)
         .map_err(|e| output_error(&tmp, e))
-        .and_then(|mut f| {
-            write(&mut f)?;
-            f.sync_all().map_err(|e| output_error(&tmp, e))
-        });
+        .and_then(|mut f| write(&mut f));
     if let Err(e) = written {
         let _ = fs::remove_file(&tmp);
         return Err(e);
@@ -438,23 +434,9 @@ pub fn write_atomic_with(
 
 /// Write one file atomically: a temporary file in the same folder, then a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    fs::create_dir_all(&dir).map_err(|e| output_error(&dir, e))?;
-    let name = path
-        .file_name()
-        .map_or("out".into(), |n| n.to_string_lossy().into_owned());
-    if is_input(path, &[]) {
-        return Err(input_refusal(path.to_path_buf()));
-    }
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let _open = open_gate(&tmp)?;
-    fs::write(&tmp, bytes).map_err(|e| output_error(&tmp, e))?;
-    fs::rename(&tmp, path).map_err(|e| {
-        let _ = fs::remove_file(&tmp);
-        output_error(path, e)
+    use std::io::Write;
+    write_atomic_with(path, &[], |f| {
+        f.write_all(bytes).map_err(|e| output_error(path, e))
     })
 }
 

@@ -439,6 +439,7 @@ class HeightFacts(TypedDict):
     detrend: str
     channel: Optional[str]
     fill_invalid: Optional[str]
+    measurement: Optional[str]
     h_rms_m: float
     h_prime_rms: float
     h_double_prime_rms_per_m: float

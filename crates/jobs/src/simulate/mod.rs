@@ -536,6 +536,7 @@ pub fn run(
             detrend: request.heights.detrend().name(),
             channel,
             fill_invalid,
+            measurement: request.heights.measurement_label()?,
             roughness: Roughness::from(&stats),
             sphere_radius_m: request.radius_m,
         },
