@@ -341,3 +341,67 @@ def test_python_writes_the_same_export_as_the_command_line(cli, tmp_path):
         quiet(cs.simulate, container, None, 2e9, forces, "gt", radius=290e-6, detrend="none",
               contact_engineering=tmp_path / "gt.zip")
     assert not (tmp_path / "gt.zip").exists()
+
+
+def test_the_export_has_the_layout_topobank_contact_writes(cli, tmp_path):
+    """The reference: the files written the way topobank-contact's worker and download write
+    them (an xarray Dataset of the four fields with its attributes, `to_netcdf` in
+    NETCDF3_64BIT; the plot table through pandas' `to_csv`) from ContactMechanics' results on
+    the same topography; ours must have the same columns, variables, dimensions, types and
+    attributes (`_FillValue` aside: every value of ours is defined)."""
+    xr = pytest.importorskip("xarray")
+    pd = pytest.importorskip("pandas")
+    import scipy.io
+
+    t = fourier_synthesis((64, 64), (6.4e-6, 6.4e-6), 0.8, rms_height=40e-9,
+                          rng=np.random.default_rng(2), periodic=True, unit="m",
+                          info={"name": "ref"})
+    container = tmp_path / "ref.zip"
+    quiet(write_containers, [InMemorySurfaceContainer([t])], container)
+    rows = contact_mechanics_plot(t, "periodic")
+    reference = tmp_path / "reference"
+    reference.mkdir()
+    nx, ny = t.nb_grid_pts
+    for k, r in enumerate(rows):
+        field = np.zeros((nx, ny))
+        ds = xr.Dataset({"pressure": (("x", "y"), field),
+                         "contacting_points": (("x", "y"), r["contact"]),
+                         "gap": (("x", "y"), field),
+                         "displacement": (("x", "y"), field)})
+        ds.attrs["mean_pressure"] = r["pressure"]
+        ds.attrs["total_contact_area"] = r["fraction"]
+        ds.attrs["type"] = "periodic"
+        ds.to_netcdf(reference / f"result-step-{k}.nc", format="NETCDF3_64BIT")
+    table = pd.DataFrame({
+        "Normalized pressure p/E*": [r["pressure"] for r in rows],
+        "Fractional contact area A/A0": [r["fraction"] for r in rows],
+        "Normalized mean gap u/h_rms": [r["gap"] for r in rows],
+        "converged": [r["converged"] for r in rows],
+        "filename": [f"result-step-{k}.nc" for k in range(len(rows))],
+    }).to_csv()
+    a0 = np.prod(t.physical_sizes)
+    forces = ",".join(f"{float(p * a0 * 1e9)!r}N" for p in PRESSURES)
+    cli("simulate", "--topography", container, "--detrend", "none", "--modulus", "1GPa",
+        "--model", "elastic", "--forces", forces, "--maps", "none", "--export",
+        "contact-engineering", "--out", tmp_path / "ours")
+    names, ours_table, _, steps = read_export(tmp_path / "ours" / "contact_mechanics.zip", "ref")
+    assert ours_table.splitlines()[0] == table.splitlines()[0]
+    theirs_df = pd.read_csv(io.StringIO(table), index_col=0)
+    ours_df = pd.read_csv(io.StringIO(ours_table), index_col=0)
+    assert list(ours_df.columns) == list(theirs_df.columns)
+    assert list(ours_df.dtypes) == list(theirs_df.dtypes)
+    for k in range(len(rows)):
+        ref = scipy.io.netcdf_file(reference / f"result-step-{k}.nc", "r", mmap=False)
+        ours = steps[f"result-step-{k}.nc"]
+        assert ref.version_byte == ours.version_byte == 2
+        assert set(ours.variables) == set(ref.variables)
+        assert set(ref._attributes) <= set(ours._attributes)
+        for name, v in ref.variables.items():
+            mine = ours.variables[name]
+            assert mine.dimensions == v.dimensions, name
+            assert mine.data.dtype.kind == v.data.dtype.kind, name
+            assert mine.data.dtype.itemsize == v.data.dtype.itemsize, name
+            wanted = {a for a in v._attributes if a != "_FillValue"}
+            assert wanted <= set(mine._attributes), (name, wanted, mine._attributes)
+            for a in wanted:
+                assert mine._attributes[a] == v._attributes[a], (name, a)

@@ -86,7 +86,16 @@ impl BodyRequest {
 
     /// The model body, with notes on the heights.
     pub fn build(&self, progress: Option<ProgressHook>) -> Result<(ModelBody, Vec<String>)> {
-        let (topography, notes) = self.heights.read_with_notes()?;
+        let (topography, mut notes) = self.heights.read_with_notes()?;
+        // A container's measurement marked periodic is solved with periodic boundaries, as by
+        // `simulate`.
+        let periodic = self.periodic || self.heights.stated_periodic()?;
+        if periodic && !self.periodic {
+            notes.push(format!(
+                "{}: the container marks the measurement periodic: periodic boundaries",
+                self.heights.label()
+            ));
+        }
         if let Some(i) = self.imaging {
             // The micrograph each simulated map becomes, checked before any load is solved.
             contactscope::optics::blur::check_resample(
@@ -103,7 +112,7 @@ impl BodyRequest {
             ..SolverOptions::default()
         };
         let mut body = ModelBody::new(topography, self.radius_m, self.e_star_pa, options)?;
-        body.periodic = self.periodic;
+        body.periodic = periodic;
         body.imaging = self.imaging;
         body.progress = progress;
         Ok((body, notes))
