@@ -52,6 +52,9 @@ pub fn run(args: Args) -> Result<()> {
     }
     let summary = &outcome.summary.stored;
     println!("file:        {}", args.file.display());
+    if let Some(m) = &args.measurement {
+        println!("measurement: {m}");
+    }
     println!(
         "format:      {} (channel {})",
         summary.format, summary.channel

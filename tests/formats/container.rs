@@ -296,6 +296,16 @@ fn surface_writes_a_container_and_simulate_exports_the_download_layout() {
     for key in ["height_min_um", "height_max_um", "h_rms_as_stored_um"] {
         assert_eq!(from_zip[key], from_npy[key], "{key}");
     }
+    // A micrograph command given a container says what it is and which command reads it.
+    for command in ["info", "analyze"] {
+        let out = run(&[command, &p("g.zip")]);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{command}");
+        assert!(
+            err.contains("contact.engineering surface container") && err.contains("topography"),
+            "{command}: {err}"
+        );
+    }
     // The generated container is periodic: simulate takes periodic boundaries from it.
     let out = run_ok(&[
         "simulate",

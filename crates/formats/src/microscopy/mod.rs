@@ -361,6 +361,13 @@ impl MicroscopyFile {
                 backend: Backend::Zarr(Box::new(r)),
             });
         }
+        if crate::topography::container::is_container(path) {
+            return Err(unsupported(
+                path,
+                "a contact.engineering surface container of height maps, not a micrograph: \
+                 read it with `contactscope topography` (or `simulate --topography`)",
+            ));
+        }
         if path.is_dir() {
             return Err(unsupported(
                 path,

@@ -179,12 +179,16 @@ fn other_format(path: &Path) -> Option<Error> {
         .read_to_end(&mut head)
         .ok()?;
     if let Some(map) = crate::topography::detect(&head) {
+        let what = if crate::topography::container::is_container(path) {
+            "a contact.engineering surface container of height maps".to_string()
+        } else {
+            format!("{} height map", map.with_article())
+        };
         return Some(Error::Unsupported {
             at: Location::file(path),
             reason: format!(
-                "{} height map, not a TIFF micrograph: read it with `contactscope topography` \
-                 (or `simulate --topography`)",
-                map.with_article()
+                "{what}, not a TIFF micrograph: read it with `contactscope topography` (or \
+                 `simulate --topography`)"
             ),
         });
     }
