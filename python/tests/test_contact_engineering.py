@@ -167,6 +167,15 @@ def test_our_containers_read_back_in_surface_topography(cli, tmp_path):
     npy = tmp_path / "gen.npy"
     cli("surface", "--size", 64, "--pixel-size", "50nm", "--rms-height", "20nm", "--seed", 4,
         "--out", npy)
+    # Our generated surface in a container SurfaceTopography writes: the same heights here.
+    ours = np.load(npy)
+    theirs = Topography(ours.T.copy(), (64 * 50e-9, 64 * 50e-9), unit="m", periodic=True,
+                        info={"name": "ours"})
+    st_zip = tmp_path / "st-of-ours.zip"
+    quiet(write_containers, [InMemorySurfaceContainer([theirs])], st_zip)
+    back = cs.read_topography(st_zip, detrend="none", measurement="0")
+    assert np.array_equal(back["heights"], ours)
+    assert np.allclose(back["summary"]["pixel_size_m"]["x"], 50e-9, rtol=1e-12)
     (t,) = list(quiet(read_container, str(out))[0])
     assert t.is_periodic and t.unit == "m"
     assert np.allclose(t.physical_sizes, (64 * 50e-9, 64 * 50e-9), rtol=1e-12)
