@@ -171,6 +171,7 @@ fn containers_refuse_what_they_cannot_do_with_one_line() {
     let dir = tempfile::tempdir().unwrap();
     let c = dir.path().join("c");
     write(&c.join("a.npy"), &encode_npy(&heights_nm()));
+    write(&c.join("m.npy"), &encode_npy(&(heights_nm() * 1e-9)));
     let topo = |name: &str, file: &str, mode: &str| {
         json!({"name": name, "datafile": {"original": file}, "size": [6.4, 4.8], "unit": "nm",
                "detrend_mode": mode})
@@ -179,6 +180,7 @@ fn containers_refuse_what_they_cannot_do_with_one_line() {
         topo("ok", "a.npy", "center"),
         topo("escape", "../a.npy", "center"),
         topo("robust", "a.npy", "mad-tilt"),
+        json!({"name": "unitless", "datafile": {"original": "m.npy"}, "size": [6.4, 4.8]}),
     ]}]});
     write(&c.join("index.json"), &serde_json::to_vec(&meta).unwrap());
     let c_arg = c.to_str().unwrap();
@@ -203,7 +205,7 @@ fn containers_refuse_what_they_cannot_do_with_one_line() {
             "--out",
             dir.path().join("o").to_str().unwrap(),
         ],
-        "3 measurements; choose one with --measurement",
+        "4 measurements; choose one with --measurement",
     );
     fails(
         &["topography", c_arg, "--measurement", "escape"],
@@ -216,6 +218,10 @@ fn containers_refuse_what_they_cannot_do_with_one_line() {
     fails(
         &["topography", c_arg, "--measurement", "9"],
         "no measurement 9",
+    );
+    fails(
+        &["topography", c_arg, "--measurement", "unitless"],
+        "the container's size has no unit",
     );
     fails(
         &[

@@ -355,9 +355,14 @@ impl Container {
                 return Err(bad(
                     &shown,
                     format!(
-                        "measurement {}: neither the data file nor the container states the \
-                         physical size",
-                        m.label()
+                        "measurement {}: {}",
+                        m.label(),
+                        if m.size.is_some() {
+                            "the data file states no physical size, and the container's size \
+                             has no unit"
+                        } else {
+                            "neither the data file nor the container states the physical size"
+                        }
                     ),
                 ))
             }
