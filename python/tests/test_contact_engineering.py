@@ -134,7 +134,8 @@ def test_topobank_containers_with_originals_apply_the_processing_alike(tmp_path)
             source = holes_nc if name == "holes.nc" else AFM / name
             z.write(source, f"originals/{name}")
             metas.append({"name": name, "datafile": {"original": f"originals/{name}"},
-                          "size": [1.0, 1.0], "unit": "um", "is_periodic": False, **extra})
+                          "size": [1.0, 1.0], "unit": "um", "is_periodic": False,
+                          "data_source": 0, **extra})
         z.writestr("index.json", json.dumps({"versions": {}, "surfaces": [
             {"name": "lab", "topographies": metas}]}))
     # The same metadata as meta.yml only (older downloads): absent keys mean no step there.
@@ -167,6 +168,19 @@ def test_our_containers_read_back_in_surface_topography(cli, tmp_path):
     npy = tmp_path / "gen.npy"
     cli("surface", "--size", 64, "--pixel-size", "50nm", "--rms-height", "20nm", "--seed", 4,
         "--out", npy)
+    # meta.yml says what index.json says, to a YAML 1.1 reader too (PyYAML takes `1e-6` for a
+    # string: 64 pixels of 15.625 nm are exactly 1e-6 m).
+    import yaml
+
+    exact = tmp_path / "exact.zip"
+    cli("surface", "--size", 64, "--pixel-size", "15.625nm", "--rms-height", "1nm", "--out",
+        exact)
+    with zipfile.ZipFile(exact) as z:
+        index = json.loads(z.read("index.json"))
+        # (A YAML 1.1 reader takes the unquoted measurement_date for a date: as a string it
+        # is the same, and SurfaceTopography's schema takes either.)
+        assert json.loads(json.dumps(yaml.safe_load(z.read("meta.yml")), default=str)) == index
+    assert index["surfaces"][0]["topographies"][0]["size"] == [1e-6, 1e-6]
     # Our generated surface in a container SurfaceTopography writes: the same heights here.
     ours = np.load(npy)
     theirs = Topography(ours.T.copy(), (64 * 50e-9, 64 * 50e-9), unit="m", periodic=True,

@@ -181,6 +181,8 @@ fn containers_refuse_what_they_cannot_do_with_one_line() {
         topo("escape", "../a.npy", "center"),
         topo("robust", "a.npy", "mad-tilt"),
         json!({"name": "unitless", "datafile": {"original": "m.npy"}, "size": [6.4, 4.8]}),
+        json!({"name": "second", "datafile": {"original": "a.npy"}, "size": [6.4, 4.8],
+               "unit": "nm", "data_source": 1}),
     ]}]});
     write(&c.join("index.json"), &serde_json::to_vec(&meta).unwrap());
     let c_arg = c.to_str().unwrap();
@@ -205,7 +207,7 @@ fn containers_refuse_what_they_cannot_do_with_one_line() {
             "--out",
             dir.path().join("o").to_str().unwrap(),
         ],
-        "4 measurements; choose one with --measurement",
+        "5 measurements; choose one with --measurement",
     );
     fails(
         &["topography", c_arg, "--measurement", "escape"],
@@ -222,6 +224,10 @@ fn containers_refuse_what_they_cannot_do_with_one_line() {
     fails(
         &["topography", c_arg, "--measurement", "unitless"],
         "the container's size has no unit",
+    );
+    fails(
+        &["topography", c_arg, "--measurement", "second"],
+        "data_source 1 is a channel index in SurfaceTopography's order",
     );
     fails(
         &[

@@ -347,11 +347,15 @@ pub fn read_measurement(
 ) -> Result<(HeightMap, Vec<String>)> {
     let read = c.read(m, channel)?;
     let at = || Location::file(format!("{}:{}", c.path.display(), m.datafile));
-    let mut map = read.map.clone();
-    match read.fill_mode() {
+    let (fill, detrend) = (
+        read.fill_mode().map(str::to_string),
+        read.detrend_mode().map(str::to_string),
+    );
+    let mut map = read.map;
+    match fill.as_deref() {
         None => {}
         Some("harmonic") => {
-            fill_harmonic(&mut map.heights, read.periodic());
+            fill_harmonic(&mut map.heights, m.periodic);
             map.invalid_points = map.heights.iter().filter(|h| !h.is_finite()).count();
         }
         Some(other) => {
@@ -364,7 +368,7 @@ pub fn read_measurement(
             ))
         }
     }
-    if let Some(mode) = read.detrend_mode() {
+    if let Some(mode) = detrend.as_deref() {
         ContainerDetrend::from_mode(mode)
             .and_then(|d| d.apply(&mut map.heights))
             .map_err(|e| Error::bad_input(at(), format!("measurement {}: {e}", m.label())))?;

@@ -18,7 +18,7 @@
 //! |---|---|
 //! | `size` | the physical size (x, y) in `unit`, used when the data file states no pixel size (a file's own size wins; a difference above 1e-4 relative is noted) |
 //! | `unit` | the unit of `size` and of the heights when the data file states none |
-//! | `data_source` | the index of the data file's channel (default: the file's height channel) |
+//! | `data_source` | SurfaceTopography's index of the data file's channel: 0 (the schema's default, which contact.engineering always writes) or absent is read as the file's height channel (SurfaceTopography's channel 0 of the formats tested, `.di`, `.ibw`, `.mi`, `.nid`); another index is refused, naming the channels for `--channel`, because our readers list channels in their own order |
 //! | `is_periodic` | the measurement is periodic ([`MeasurementMap::periodic`]) |
 //! | `height_scale` | heights multiplied by it (original files only) |
 //! | `fill_undefined_data_mode` | `do-not-fill`, or `harmonic` (original files only; applied by the caller) |
@@ -38,6 +38,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use super::{read_height_map, HeightMap, ReadOptions, MAX_FILE_BYTES};
+use crate::binary::bad;
 use crate::error::{Error, Location, Result};
 
 /// The container's metadata files.
@@ -81,7 +82,7 @@ pub struct Measurement {
     pub size: Option<Vec<f64>>,
     /// Lateral and height unit.
     pub unit: Option<String>,
-    /// Channel index in the data file.
+    /// SurfaceTopography's channel index in the data file (only 0, the height channel, is read).
     pub data_source: Option<usize>,
     /// Height multiplier.
     pub height_scale: Option<f64>,
@@ -289,32 +290,33 @@ impl Container {
             })?),
             None => None,
         };
-        // The channel: by name as asked, else `data_source` as an index into the file's
-        // channels (known after a first read; a one-channel file's index 0 is that channel).
+        // The channel: by name as asked, else the file's height channel; a `data_source` other
+        // than 0 names a channel in SurfaceTopography's order, which is not ours (the Nanosurf
+        // reader's first channel is a deflection there and a height here): refused below.
         let mut options = ReadOptions {
             // A placeholder: replaced below by the file's own pixel size, or by `size`.
             pixel_size_m: Some(PLACEHOLDER_PIXEL_M),
             height_unit_m: unit_m,
             channel: channel.map(str::to_string),
         };
-        let mut map = read_with_unit(&file, &mut options).map_err(relabel)?;
-        if let (None, Some(k)) = (channel, m.data_source) {
-            let name = map.channels.get(k).cloned().ok_or_else(|| {
-                bad(
-                    &shown,
-                    format!(
-                        "data_source {k} of measurement {}: the file has {} channel(s) ({})",
-                        m.label(),
-                        map.channels.len(),
-                        map.channels.join(", ")
-                    ),
-                )
-            })?;
-            if name != map.channel {
-                options.channel = Some(name);
-                map = read_with_unit(&file, &mut options).map_err(relabel)?;
-            }
+        let map_read = read_with_unit(&file, &mut options).map_err(relabel);
+        if let (None, Some(k @ 1..)) = (channel, m.data_source) {
+            let channels = map_read
+                .as_ref()
+                .map(|m| m.channels.join("', '"))
+                .unwrap_or_default();
+            return Err(bad(
+                &shown,
+                format!(
+                    "measurement {}: data_source {k} is a channel index in SurfaceTopography's \
+                     order, which contactscope's reader does not share; name the channel with \
+                     {} (the file has '{channels}')",
+                    m.label(),
+                    crate::param::Param::Channel
+                ),
+            ));
         }
+        let mut map = map_read?;
         let mut notes = Vec::new();
         let stated = map.replaced_pixel_size_m.take();
         let from_size = match (&m.size, unit_m) {
@@ -394,14 +396,14 @@ impl Container {
             return Ok((None, self.path.join(inside)));
         }
         let mut zip = open_zip(&self.path)?;
-        let bytes = read_member(&self.path, &mut zip, &m.datafile, MAX_FILE_BYTES)?;
         let dir = tempfile::tempdir().map_err(|e| Error::io(&self.path, e))?;
         let name = inside
             .file_name()
             .map(|n| n.to_os_string())
             .unwrap_or_else(|| "data".into());
         let file = dir.path().join(name);
-        std::fs::write(&file, bytes).map_err(|e| Error::io(&file, e))?;
+        let mut out = std::fs::File::create(&file).map_err(|e| Error::io(&file, e))?;
+        copy_member(&self.path, &mut zip, &m.datafile, MAX_FILE_BYTES, &mut out)?;
         Ok((Some(dir), file))
     }
 }
@@ -456,22 +458,20 @@ fn relabel(e: Error, temp: &Path, shown: &Path) -> Error {
     }
 }
 
-fn bad(path: &Path, reason: impl Into<String>) -> Error {
-    Error::bad_input(Location::file(path), reason)
-}
-
 fn open_zip(path: &Path) -> Result<zip::ZipArchive<std::fs::File>> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     zip::ZipArchive::new(file).map_err(|e| bad(path, format!("not a readable ZIP archive: {e}")))
 }
 
-/// A member's bytes, refused above `limit` (the size the archive states, then the bytes read).
-fn read_member(
+/// Copy a member to `out`, refused above `limit` bytes (the size the archive states, then the
+/// bytes decompressed: a forged size cannot make it read more); returns the bytes copied.
+fn copy_member(
     path: &Path,
     zip: &mut zip::ZipArchive<std::fs::File>,
     name: &str,
     limit: u64,
-) -> Result<Vec<u8>> {
+    out: &mut dyn std::io::Write,
+) -> Result<u64> {
     let mut member = zip
         .by_name(name)
         .map_err(|e| bad(path, format!("member '{name}': {e}")))?;
@@ -484,14 +484,23 @@ fn read_member(
             ),
         ));
     }
-    let mut bytes = Vec::with_capacity(member.size() as usize);
-    (&mut member)
-        .take(limit + 1)
-        .read_to_end(&mut bytes)
+    let copied = std::io::copy(&mut (&mut member).take(limit + 1), out)
         .map_err(|e| bad(path, format!("member '{name}' does not decompress: {e}")))?;
-    if bytes.len() as u64 > limit {
+    if copied > limit {
         return Err(bad(path, format!("member '{name}' exceeds {limit} bytes")));
     }
+    Ok(copied)
+}
+
+/// A member's bytes, refused above `limit` ([`copy_member`]).
+fn read_member(
+    path: &Path,
+    zip: &mut zip::ZipArchive<std::fs::File>,
+    name: &str,
+    limit: u64,
+) -> Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    copy_member(path, zip, name, limit, &mut bytes)?;
     Ok(bytes)
 }
 

@@ -182,6 +182,25 @@ pub fn encode_container(
     Ok(cursor.into_inner())
 }
 
+/// A float as YAML text that YAML 1.1 readers (PyYAML, which SurfaceTopography uses) also
+/// take for a number: a mantissa with a decimal point and a signed exponent (`1.0e-5`; PyYAML
+/// reads `1e-5` as a string).
+fn yaml_real(v: f64) -> String {
+    let s = format!("{v:e}");
+    let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+    let mantissa = if mantissa.contains('.') {
+        mantissa.to_string()
+    } else {
+        format!("{mantissa}.0")
+    };
+    let exponent = if exponent.starts_with('-') {
+        exponent.to_string()
+    } else {
+        format!("+{exponent}")
+    };
+    format!("{mantissa}e{exponent}")
+}
+
 /// The metadata as block-style YAML.
 fn to_yaml(value: &Value) -> Result<String> {
     use yaml_rust2::{yaml::Hash, Yaml, YamlEmitter};
@@ -191,7 +210,7 @@ fn to_yaml(value: &Value) -> Result<String> {
             Value::Bool(b) => Yaml::Boolean(*b),
             Value::Number(n) => match n.as_i64() {
                 Some(i) => Yaml::Integer(i),
-                None => Yaml::Real(format!("{:e}", n.as_f64().unwrap_or(f64::NAN))),
+                None => Yaml::Real(yaml_real(n.as_f64().unwrap_or(f64::NAN))),
             },
             Value::String(s) => Yaml::String(s.clone()),
             Value::Array(a) => Yaml::Array(a.iter().map(convert).collect()),
@@ -264,5 +283,18 @@ mod tests {
         assert_eq!(y.measurements, c.measurements);
         assert!(c.find(None).is_err(), "two measurements need a choice");
         assert!(c.find(Some("7")).is_err() && c.find(Some("nope")).is_err());
+    }
+
+    #[test]
+    fn yaml_reals_have_a_point_and_a_signed_exponent() {
+        for (v, text) in [
+            (1e-5, "1.0e-5"),
+            (6.4e-6, "6.4e-6"),
+            (2.0, "2.0e+0"),
+            (-3e7, "-3.0e+7"),
+        ] {
+            assert_eq!(yaml_real(v), text);
+            assert_eq!(text.parse::<f64>().unwrap(), v);
+        }
     }
 }

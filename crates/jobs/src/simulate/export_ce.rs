@@ -52,8 +52,8 @@ pub struct CeExport {
     e_star_pa: f64,
     periodic: bool,
     hardness_pa: Option<f64>,
-    /// rms height of the body and its area A0, from the first load.
-    body: Option<(f64, f64)>,
+    /// rms height of the body, its area A0 and its highest point, from the first load.
+    body: Option<(f64, f64, f64)>,
 }
 
 struct Row {
@@ -90,23 +90,21 @@ impl CeExport {
 
     /// Write load `index`'s NetCDF file.
     pub fn step(&mut self, index: usize, maps: &LoadMaps<'_>) -> Result<()> {
-        let LoadMaps::HalfSpace { body, base, step } = maps else {
+        let LoadMaps::HalfSpace { body, step, .. } = maps else {
             return Ok(());
         };
         let periodic = self.periodic;
-        let (h_rms, a0) = *self.body.get_or_insert_with(|| {
-            let n = body.heights.len() as f64;
-            let mean = body.heights.iter().sum::<f64>() / n;
-            let rms = (body.heights.iter().map(|h| (h - mean).powi(2)).sum::<f64>() / n).sqrt();
-            (rms, n * body.dx_m * body.dy_m)
+        // The body is the same at every load: its rms height, area A0 and top, once.
+        let (h_rms, a0, top) = *self.body.get_or_insert_with(|| {
+            let top = body
+                .heights
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max);
+            (body.rms_height(), body.area_m2(), top)
         });
         let (ny, nx) = body.heights.dim();
         let s = &step.solution;
-        let top = base
-            .iter()
-            .zip(body.heights.iter())
-            .map(|(s, h)| s + h)
-            .fold(f64::NEG_INFINITY, f64::max);
         // (x, y) with x the slow index: the transpose of our rows = y.
         let xy = |v: &[f64], f: &dyn Fn(f64) -> f64| -> Vec<f64> {
             (0..nx)
