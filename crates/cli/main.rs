@@ -44,6 +44,10 @@ struct Cli {
     /// On failure, print every cause of the error on its own line (default: one line)
     #[arg(long, global = true)]
     verbose: bool,
+    /// S3-compatible server for s3:// inputs (MinIO, Ceph, a lab's object store), e.g.
+    /// http://127.0.0.1:9000; default: AWS_ENDPOINT_URL_S3, AWS_ENDPOINT_URL, else Amazon S3
+    #[arg(long, global = true, value_name = "URL")]
+    endpoint_url: Option<String>,
 }
 
 #[derive(Subcommand)]
@@ -163,6 +167,10 @@ fn main() -> ExitCode {
         }
     };
     let (command, verbose) = (cli.command, cli.verbose);
+    if let Err(e) = contactscope_formats::remote::set_endpoint_url(cli.endpoint_url.as_deref()) {
+        eprintln!("error: --endpoint-url: {e}");
+        return ExitCode::from(2);
+    }
     // Messages name parameters as flags (`--pixel-size`).
     contactscope_formats::param::set_front_end(contactscope_formats::param::FrontEnd::CommandLine);
     signals::discard_on_interrupt();

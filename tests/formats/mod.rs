@@ -8,6 +8,7 @@ mod ome_zarr;
 mod peer;
 mod real;
 mod reference_readers;
+mod remote;
 mod synthetic;
 mod topography;
 mod vendor_optics;

@@ -20,7 +20,7 @@ const N: usize = 4;
 
 /// Four planes of a growing contact: a bright disc on a dim background with a fixed pattern of
 /// noise (no random source: the test is the same every run).
-fn planes() -> Vec<Vec<u16>> {
+pub(super) fn planes() -> Vec<Vec<u16>> {
     (0..N)
         .map(|t| {
             let r = 8.0 + 7.0 * t as f64;
@@ -71,7 +71,7 @@ fn omero() -> serde_json::Value {
 }
 
 /// An NGFF 0.4 store on Zarr v2: one chunk per plane, no compressor.
-fn store_v2(dir: &Path, planes: &[Vec<u16>]) -> PathBuf {
+pub(super) fn store_v2(dir: &Path, planes: &[Vec<u16>]) -> PathBuf {
     let store = dir.join("ramp04.ome.zarr");
     write_json(&store.join(".zgroup"), &json!({"zarr_format": 2}));
     write_json(
@@ -94,7 +94,7 @@ fn store_v2(dir: &Path, planes: &[Vec<u16>]) -> PathBuf {
 
 /// An NGFF 0.5 store on Zarr v3 whose chunks hold two planes and split each plane in four
 /// (chunk shape 2 × 1 × H/2 × W/2): a plane is read from four chunks, a chunk serves two planes.
-fn store_v3(dir: &Path, planes: &[Vec<u16>]) -> PathBuf {
+pub(super) fn store_v3(dir: &Path, planes: &[Vec<u16>]) -> PathBuf {
     let store = dir.join("ramp05.ome.zarr");
     write_json(
         &store.join("zarr.json"),
@@ -131,7 +131,7 @@ fn store_v3(dir: &Path, planes: &[Vec<u16>]) -> PathBuf {
 }
 
 /// The same planes as a TIFF with the same pixel size.
-fn tiff(dir: &Path, planes: &[Vec<u16>]) -> PathBuf {
+pub(super) fn tiff(dir: &Path, planes: &[Vec<u16>]) -> PathBuf {
     let path = dir.join("ramp.tif");
     let refs: Vec<&[u16]> = planes.iter().map(Vec::as_slice).collect();
     let bytes =
@@ -140,7 +140,7 @@ fn tiff(dir: &Path, planes: &[Vec<u16>]) -> PathBuf {
     path
 }
 
-fn analyze(input: &Path, out: &Path, extra: &[&str]) -> (Vec<String>, Vec<Vec<String>>) {
+pub(super) fn analyze(input: &Path, out: &Path, extra: &[&str]) -> (Vec<String>, Vec<Vec<String>>) {
     let mut args = vec![
         "analyze",
         input.to_str().unwrap(),
@@ -158,7 +158,7 @@ fn analyze(input: &Path, out: &Path, extra: &[&str]) -> (Vec<String>, Vec<Vec<St
 }
 
 /// Every column but the file name.
-fn numbers(table: &(Vec<String>, Vec<Vec<String>>)) -> Vec<Vec<String>> {
+pub(super) fn numbers(table: &(Vec<String>, Vec<Vec<String>>)) -> Vec<Vec<String>> {
     table.1.iter().map(|r| r[1..].to_vec()).collect()
 }
 

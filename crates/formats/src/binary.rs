@@ -190,7 +190,7 @@ pub(crate) fn decode_values(
 pub(crate) struct FileSource {
     /// The file as named.
     pub path: std::path::PathBuf,
-    file: std::fs::File,
+    file: crate::remote::Input,
     /// File length in bytes.
     pub len: u64,
 }
@@ -199,8 +199,7 @@ impl FileSource {
     /// Open `path`.
     pub(crate) fn open(path: &Path) -> Result<Self> {
         crate::inputs::note_input(path);
-        let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-        let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+        let (file, len) = crate::remote::open_input(path)?;
         Ok(FileSource {
             path: path.to_path_buf(),
             file,

@@ -33,6 +33,7 @@ pub mod limits;
 pub mod microscopy;
 pub mod param;
 pub mod ranges;
+pub mod remote;
 pub mod tiff;
 pub mod topography;
 pub mod units;

@@ -37,6 +37,7 @@ impl Staging {
     /// Prepare to write into `out_dir`. `inputs` are files the run reads; writing over any of
     /// them is refused.
     pub fn new(out_dir: &Path, inputs: &[PathBuf]) -> Result<Self> {
+        local_only(out_dir)?;
         let name = out_dir
             .file_name()
             .map_or("out".into(), |n| n.to_string_lossy().into_owned());
@@ -161,6 +162,20 @@ impl Staging {
     }
 }
 
+/// Outputs are written to local folders only: a URL (`s3://…`) would otherwise become a folder
+/// named `s3:` here.
+fn local_only(path: &Path) -> Result<()> {
+    if contactscope_formats::remote::is_url(path) {
+        return Err(Error::Output {
+            path: path.to_path_buf(),
+            reason: "outputs are written to a local folder, not to object storage (inputs \
+                     may be s3:// or https:// URLs); nothing was written"
+                .into(),
+        });
+    }
+    Ok(())
+}
+
 /// Refuse, before any work, an output folder a run's commit would refuse (in the way, holding
 /// files no contactscope run wrote, or holding one of `inputs`); the commit checks again.
 pub fn check_out_dir(out_dir: &Path, inputs: &[PathBuf]) -> Result<()> {
@@ -181,6 +196,7 @@ fn replaceable(out_dir: &Path, protected: &[PathBuf]) -> Result<bool> {
             contactscope_formats::param::Param::Out
         ),
     };
+    local_only(out_dir)?;
     match fs::symlink_metadata(out_dir) {
         Err(_) => return Ok(false),
         Ok(meta) if !meta.is_dir() => {
@@ -338,6 +354,7 @@ pub struct CreatedFolders {
 impl CreatedFolders {
     /// Create `dir` and its missing ancestors, remembering those created.
     pub fn create(dir: &Path) -> Result<Self> {
+        local_only(dir)?;
         let mut dirs = Vec::new();
         let mut at = Some(dir);
         while let Some(d) = at.filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
@@ -402,6 +419,7 @@ pub fn write_atomic_with(
     inputs: &[PathBuf],
     write: impl FnOnce(&mut fs::File) -> Result<()>,
 ) -> Result<()> {
+    local_only(path)?;
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),

@@ -507,12 +507,13 @@ pub fn series_pixel_size(format: MicroscopyFormat, info: &SeriesInfo) -> Option<
 /// Whether a file is a TIFF (by content; an unreadable file counts as TIFF so that the TIFF
 /// reader reports the problem as before).
 pub fn is_tiff(path: &Path) -> bool {
-    if path.is_dir() {
+    if path.is_dir() || (crate::remote::is_url(path) && super::zarr::is_store(path)) {
         return false;
     }
     let mut head = [0u8; 16];
-    let n = std::fs::File::open(path)
-        .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
+    let n = crate::remote::open_input(path)
+        .ok()
+        .and_then(|(mut f, _)| std::io::Read::read(&mut f, &mut head).ok())
         .unwrap_or(0);
     !matches!(
         super::detect(&head[..n]),

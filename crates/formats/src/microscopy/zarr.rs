@@ -35,8 +35,11 @@ use crate::image::{Plane, SampleType, Samples};
 const MAX_IMAGES: usize = 100_000;
 
 /// Whether `path` is a Zarr store (a folder with `zarr.json`, `.zgroup` or `.zattrs` at its
-/// root).
+/// root, or a URL below which the server has one of them).
 pub fn is_store(path: &Path) -> bool {
+    if crate::remote::is_url(path) {
+        return crate::remote::is_zarr_store(path);
+    }
     path.is_dir()
         && ["zarr.json", ".zgroup", ".zattrs"]
             .iter()
@@ -235,8 +238,13 @@ pub struct ZarrReader {
 }
 
 impl ZarrReader {
-    /// Open the store at `path` (a folder) and read the metadata of every image in it.
+    /// Open the store at `path` (a folder, or an `s3://` or `http(s)://` URL) and read the
+    /// metadata of every image in it.
     pub fn open(path: &Path) -> Result<Self> {
+        if crate::remote::is_url(path) {
+            let store: ReadableStorage = Arc::new(crate::remote::RemoteStore::new(path)?);
+            return Self::open_store(path, store);
+        }
         crate::inputs::note_input(path);
         let fs = zarrs::filesystem::FilesystemStore::new(path)
             .map_err(|e| bad(path, format!("not a readable Zarr store: {e}")))?;

@@ -6,7 +6,6 @@
 //! arrived; and packed 12-bit or palette images are reported as unsupported, never guessed at.
 //! Reduced-resolution pages (NewSubfileType bit 0, e.g. LSM thumbnails) are skipped.
 
-use std::fs::File;
 use std::io::{BufReader, Read, Seek};
 use std::path::{Path, PathBuf};
 
@@ -19,6 +18,7 @@ use super::axes::{AxesSource, TiffAxes};
 use super::metadata::{self, ImageJDescription};
 use crate::error::{Error, Location, Result};
 use crate::image::{PixelSize, PixelSizeSource, Plane, SampleType, Samples};
+use crate::remote::{open_input, Input};
 
 /// Largest decoded page we accept (bytes); guards allocations against absurd header dimensions.
 pub const MAX_PAGE_BYTES: usize = crate::limits::Limits::DEFAULT.max_plane_bytes;
@@ -105,7 +105,7 @@ impl TiffInfo {
 
 /// An open TIFF file that decodes pages on request.
 pub struct TiffReader {
-    decoder: Decoder<BufReader<File>>,
+    decoder: Decoder<BufReader<Input>>,
     info: TiffInfo,
 }
 
@@ -122,6 +122,8 @@ fn tiff_error(at: Location, err: TiffError) -> Error {
                 MAX_PAGE_BYTES >> 30
             ),
         },
+        // A file on a server that could not be read: the network, not the file.
+        TiffError::IoError(e) if crate::remote::is_network_error(&e) => Error::Io { at, source: e },
         TiffError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => Error::BadTiff {
             at,
             reason: "file is truncated".into(),
@@ -173,8 +175,9 @@ fn rational(value: Option<tiff::decoder::ifd::Value>) -> Option<f64> {
 /// error that says so and names that command.
 fn other_format(path: &Path) -> Option<Error> {
     let mut head = Vec::new();
-    File::open(path)
+    open_input(path)
         .ok()?
+        .0
         .take(64)
         .read_to_end(&mut head)
         .ok()?;
@@ -200,8 +203,8 @@ fn other_format(path: &Path) -> Option<Error> {
 fn decoder(
     path: &Path,
     on_error: impl FnOnce(TiffError) -> Error,
-) -> Result<Decoder<BufReader<File>>> {
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+) -> Result<Decoder<BufReader<Input>>> {
+    let (file, _) = open_input(path)?;
     let mut limits = Limits::default();
     limits.decoding_buffer_size = MAX_PAGE_BYTES;
     Ok(Decoder::new(BufReader::new(file))
@@ -539,9 +542,7 @@ fn read_info<R: Read + Seek>(path: &Path, decoder: &mut Decoder<R>) -> Result<Ti
 
 fn is_bigtiff(path: &Path) -> bool {
     let mut head = [0u8; 4];
-    File::open(path)
-        .and_then(|mut f| f.read_exact(&mut head))
-        .is_ok()
+    open_input(path).is_ok_and(|(mut f, _)| f.read_exact(&mut head).is_ok())
         && (head[2..] == [0, 43] || head[2..] == [43, 0])
 }
 

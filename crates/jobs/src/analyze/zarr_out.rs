@@ -122,6 +122,12 @@ impl ZarrOut {
     /// when `path` is it. `pixel_m` is the pixel size used (x, y), m, if any.
     pub fn prepare(path: &Path, open: &OpenSeries, pixel_m: Option<(f64, f64)>) -> Result<Self> {
         let series = &open.series;
+        if contactscope_formats::remote::is_url(path) {
+            return Err(output_error(
+                path,
+                "--zarr-out writes a local OME-Zarr store, not one on object storage",
+            ));
+        }
         let same = |a: &Path| match (a.canonicalize(), path.canonicalize()) {
             (Ok(a), Ok(b)) => a == b,
             _ => false,

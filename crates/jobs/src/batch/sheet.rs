@@ -158,6 +158,17 @@ impl Sheet {
                     "empty: give a file, a folder or a manifest".into(),
                 ));
             }
+            // The batch's records stat and hash local files to tell what changed.
+            if contactscope_formats::remote::is_url(Path::new(&input_text)) {
+                return Err(bad(
+                    "input",
+                    format!(
+                        "'{input_text}' is a URL: the batch reads local files (its records \
+                         hash them to redo only what changed); analyze a URL with \
+                         `contactscope analyze`, or copy the objects to a folder"
+                    ),
+                ));
+            }
             let mut options = SeriesOptions::default();
             for (i, opt, unit) in &columns.options {
                 let value = cell(*i);
@@ -488,6 +499,11 @@ mod tests {
         let e = err("id,input,pixel_size\ns1,a,200nm\ns2,b,200\n");
         assert!(
             e.contains("sheet.csv: line 3, column pixel_size") && e.contains("no unit"),
+            "{e}"
+        );
+        let e = err("id,input\ns1,s3://lab/a.tif\n");
+        assert!(
+            e.contains("line 2, column input") && e.contains("is a URL"),
             "{e}"
         );
         let e = err("id,input\ns1,a\nS1,b\n");

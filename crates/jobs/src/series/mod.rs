@@ -101,13 +101,19 @@ fn is_image_name(path: &Path) -> bool {
 
 /// Expand inputs into files: directories give their image files (.tif, .tiff, .czi, .nd2,
 /// .lif) and OME-Zarr stores in natural order, files are kept in the order given. An OME-Zarr
-/// store (a folder) is one input, as a file is.
+/// store (a folder) is one input, as a file is, and so is a URL.
 pub fn collect_files(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     if inputs.is_empty() {
         return Err(Error::InvalidArgument("no input files given".into()));
     }
     let mut files = Vec::new();
     for input in inputs {
+        // An object on a server (`s3://`, `https://`) is one input, file or store: a bucket
+        // is not walked as a folder.
+        if contactscope_formats::remote::is_url(input) {
+            files.push(input.clone());
+            continue;
+        }
         let meta = std::fs::metadata(input).map_err(|e| Error::io(input, e))?;
         if !meta.is_dir() || zarr::is_store(input) {
             files.push(input.clone());

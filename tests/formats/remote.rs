@@ -1,0 +1,236 @@
+//! Inputs by URL (`http://`; `s3://` against moto's S3 server in
+//! `python/tests/test_object_storage.py`): a small HTTP/1.1 server written here from RFC 9110
+//! (HEAD, GET, `Range: bytes=…` answered 206 with `Content-Range`, or ignored) serves a folder on
+//! loopback; a TIFF and OME-Zarr stores of both versions analyse from it with the same numbers as
+//! from disk, also when the first connections are cut in the middle of a response or the server
+//! ignores byte ranges; a missing object and a server that cuts every connection give one line
+//! naming the URL and no output.
+
+use std::io::{BufRead, BufReader, Write};
+use std::net::{Shutdown, TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+
+use super::ome_zarr::{analyze, numbers, planes, store_v2, store_v3, tiff};
+use crate::common::{run, stderr};
+
+/// How the server misbehaves.
+#[derive(Clone, Copy)]
+struct Faults {
+    /// Cut this many connections (the first ones) after `after` bytes of response.
+    cut: usize,
+    /// Cut every connection.
+    cut_all: bool,
+    after: usize,
+    /// Answer every GET with the whole file (200), ignoring `Range`.
+    ignore_range: bool,
+}
+
+const HONEST: Faults = Faults {
+    cut: 0,
+    cut_all: false,
+    after: 0,
+    ignore_range: false,
+};
+
+/// Serve `root` on a loopback port; the base URL and the number of connections cut so far.
+fn serve(root: &Path, faults: Faults) -> (String, Arc<AtomicUsize>) {
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let url = format!("http://{}", listener.local_addr().unwrap());
+    let cut = Arc::new(AtomicUsize::new(0));
+    let (root, counter) = (root.to_path_buf(), cut.clone());
+    std::thread::spawn(move || {
+        for stream in listener.incoming().flatten() {
+            let kill = faults.cut_all
+                || counter
+                    .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |c| {
+                        (c < faults.cut).then_some(c + 1)
+                    })
+                    .is_ok();
+            let root = root.clone();
+            std::thread::spawn(move || {
+                let _ = connection(stream, &root, faults, kill);
+            });
+        }
+    });
+    (url, cut)
+}
+
+/// Answer the requests of one connection (keep-alive) until the client closes it.
+fn connection(stream: TcpStream, root: &Path, faults: Faults, kill: bool) -> std::io::Result<()> {
+    let mut reader = BufReader::new(stream.try_clone()?);
+    let mut out = stream;
+    let mut sent = 0usize;
+    loop {
+        let mut request = String::new();
+        loop {
+            let mut line = String::new();
+            if reader.read_line(&mut line)? == 0 {
+                return Ok(());
+            }
+            if line == "\r\n" {
+                break;
+            }
+            request.push_str(&line);
+        }
+        let mut words = request.split_whitespace();
+        let (method, target) = (words.next().unwrap_or(""), words.next().unwrap_or("/"));
+        let range = request.lines().find_map(|l| {
+            let (name, value) = l.split_once(':')?;
+            name.eq_ignore_ascii_case("range")
+                .then(|| value.trim().trim_start_matches("bytes=").to_string())
+        });
+        let path: PathBuf = root.join(target.split('?').next().unwrap().trim_start_matches('/'));
+        let Ok(body) = std::fs::read(&path)
+            .map_err(|_| ())
+            .and_then(|b| match path.is_file() {
+                true => Ok(b),
+                false => Err(()),
+            })
+        else {
+            out.write_all(b"HTTP/1.1 404 Not Found\r\nContent-Length: 0\r\n\r\n")?;
+            continue;
+        };
+        let n = body.len();
+        let (status, part, extra) = match (range, faults.ignore_range || method == "HEAD") {
+            (Some(r), false) => {
+                let (a, b) = r.split_once('-').unwrap();
+                let (start, end) = match (a.parse::<usize>(), b.parse::<usize>()) {
+                    (Ok(a), Ok(b)) => (a, (b + 1).min(n)),
+                    (Ok(a), Err(_)) => (a, n),
+                    (Err(_), Ok(suffix)) => (n.saturating_sub(suffix), n),
+                    _ => (0, n),
+                };
+                let extra = format!("Content-Range: bytes {start}-{}/{n}\r\n", end - 1);
+                ("206 Partial Content", &body[start..end], extra)
+            }
+            _ => ("200 OK", &body[..], String::new()),
+        };
+        let head = format!(
+            "HTTP/1.1 {status}\r\nContent-Length: {}\r\n{extra}\r\n",
+            part.len()
+        );
+        out.write_all(head.as_bytes())?;
+        if method == "HEAD" {
+            continue;
+        }
+        if kill && sent + part.len() > faults.after {
+            let keep = faults.after.saturating_sub(sent);
+            out.write_all(&part[..keep])?;
+            return out.shutdown(Shutdown::Both);
+        }
+        out.write_all(part)?;
+        sent += part.len();
+    }
+}
+
+/// The URL of `file` below the served folder `root`.
+fn url_of(base: &str, root: &Path, file: &Path) -> PathBuf {
+    let rel = file.strip_prefix(root).unwrap().to_str().unwrap();
+    PathBuf::from(format!("{base}/{rel}"))
+}
+
+#[test]
+fn files_and_stores_by_url_analyse_as_on_disk_through_cut_connections() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().join("served");
+    std::fs::create_dir_all(&root).unwrap();
+    let planes = planes();
+    let inputs = [
+        tiff(&root, &planes),
+        store_v2(&root, &planes),
+        store_v3(&root, &planes),
+    ];
+    for (k, input) in inputs.iter().enumerate() {
+        let reference = numbers(&analyze(input, &dir.path().join(format!("disk{k}")), &[]));
+        let cuts = Faults {
+            cut: 3,
+            after: 700,
+            ..HONEST
+        };
+        let no_ranges = Faults {
+            ignore_range: true,
+            ..HONEST
+        };
+        for (j, faults) in [HONEST, cuts, no_ranges].into_iter().enumerate() {
+            let (base, cut) = serve(&root, faults);
+            let url = url_of(&base, &root, input);
+            let out = dir.path().join(format!("url{k}-{j}"));
+            assert_eq!(
+                numbers(&analyze(&url, &out, &[])),
+                reference,
+                "{}",
+                url.display()
+            );
+            if j == 1 {
+                assert_eq!(cut.load(Ordering::SeqCst), 3, "{}", url.display());
+            }
+        }
+    }
+    // A reader fed by URL gives the same planes (Python and napari read through it).
+    let (base, _) = serve(&root, HONEST);
+    let mut local = contactscope_formats::microscopy::MicroscopyFile::open(&inputs[0]).unwrap();
+    let mut remote =
+        contactscope_formats::microscopy::MicroscopyFile::open(&url_of(&base, &root, &inputs[0]))
+            .unwrap();
+    let index = contactscope_formats::microscopy::PlaneIndex::tzc(0, 2, 0);
+    let (a, b) = (
+        local.read_plane(0, &index).unwrap(),
+        remote.read_plane(0, &index).unwrap(),
+    );
+    assert_eq!(format!("{:?}", a.samples), format!("{:?}", b.samples));
+}
+
+#[test]
+fn a_missing_object_or_a_dead_server_is_one_line_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().join("served");
+    std::fs::create_dir_all(&root).unwrap();
+    let input = tiff(&root, &planes());
+    let (base, _) = serve(&root, HONEST);
+    let dead = Faults {
+        cut_all: true,
+        after: 100,
+        ..HONEST
+    };
+    let (dead_base, _) = serve(&root, dead);
+    let missing = format!("{base}/nothing-here.tif");
+    let cut = url_of(&dead_base, &root, &input);
+    let cases = [
+        (missing.as_str(), "no such object (HTTP 404)"),
+        (cut.to_str().unwrap(), "(5 tries)"),
+        ("http://127.0.0.1:1/ramp.tif", "(5 tries)"),
+    ];
+    for (url, what) in cases {
+        let out = dir.path().join("out");
+        let o = run(&[
+            "analyze",
+            url,
+            "--forces",
+            "4mN..400mN:4",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{url}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(url) && err.contains(what), "{err}");
+        assert!(!out.exists());
+    }
+    // Outputs are local: a URL as --out is refused before any work.
+    let o = run(&[
+        "analyze",
+        url_of(&base, &root, &input).to_str().unwrap(),
+        "--forces",
+        "4mN..400mN:4",
+        "--out",
+        "s3://bucket/results",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("not to object storage"),
+        "{}",
+        stderr(&o)
+    );
+}
