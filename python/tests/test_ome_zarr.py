@@ -242,3 +242,34 @@ def test_python_analyze_writes_the_same_store_as_the_command_line(cli, tmp_path,
     cli_masks = cs.read_series(tmp_path / "cli.ome.zarr" / "labels" / "contact", load_axis="t",
                                forces=[1e-3] * 3).images
     np.testing.assert_array_equal(np.asarray(py), np.asarray(cli_masks))
+
+
+@pytest.mark.parametrize("version", ["0.4", "0.5"])
+def test_a_path_to_one_level_reads_that_level(cli, tmp_path, series_tif, version):
+    """``image.ome.zarr/1`` reads the second resolution level: its planes (as zarr-python reads
+    them), its scale as the pixel size; the masks are not written into a level."""
+    zarr = pytest.importorskip("zarr")
+    tif, _ = series_tif
+    data = np.asarray(cs.read_image(tif).images)
+    store = tmp_path / "ramp.ome.zarr"
+    _write_ome_zarr_py(store, data, (0.2, 0.2), version)
+    attrs = json.loads((store / (".zattrs" if version == "0.4" else "zarr.json")).read_text())
+    ms = (attrs if version == "0.4" else attrs["attributes"]["ome"])["multiscales"][0]
+    level = ms["datasets"][1]
+    scale = level["coordinateTransformations"][0]["scale"]
+    lower = np.asarray(zarr.open_array(str(store / level["path"]), mode="r"))
+    assert lower.shape[1] < data.shape[1]
+    reference = tmp_path / "level1.tif"
+    cs.write_tiff(reference, lower, scale[-1] * 1e-6)
+    forces = "2mN,4mN,8mN"
+    cli("analyze", reference, "--forces", forces, "--out", tmp_path / "tif")
+    cli("analyze", store / level["path"], "--load-axis", "t", "--forces", forces,
+        "--out", tmp_path / "level")
+    _same_numbers(_areas(tmp_path / "level"), _areas(tmp_path / "tif"))
+    px = _pixel_um(tmp_path / "level" / "summary.json")
+    assert px["x_um"] == pytest.approx(scale[-1], rel=1e-12)
+    np.testing.assert_array_equal(
+        np.asarray(cs.read_image(store / level["path"], load_axis="t").images), lower)
+    with pytest.raises(AssertionError, match="resolution level"):
+        cli("analyze", store / level["path"], "--load-axis", "t", "--forces", forces,
+            "--out", tmp_path / "z", "--zarr-out", store / level["path"])

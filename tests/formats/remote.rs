@@ -218,6 +218,26 @@ fn a_missing_object_or_a_dead_server_is_one_line_and_no_output() {
         assert!(err.contains(url) && err.contains(what), "{err}");
         assert!(!out.exists());
     }
+    // A plane none of whose chunks the server has is refused, as on disk (never written, or an
+    // incomplete upload), not read as the fill value.
+    let store = super::ome_zarr::store_v3(&root, &planes());
+    std::fs::remove_dir_all(store.join("0/c/1")).unwrap();
+    let url = url_of(&base, &root, &store);
+    let out = dir.path().join("out");
+    let o = run(&[
+        "analyze",
+        url.to_str().unwrap(),
+        "--load-axis",
+        "t",
+        "--forces",
+        "4mN..400mN:4",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("none of its chunks"), "{err}");
+    assert!(!out.exists());
     // Outputs are local: a URL as --out is refused before any work.
     let o = run(&[
         "analyze",

@@ -169,7 +169,7 @@ impl PixelSizeSource {
             PixelSizeSource::LifDimensions => {
                 "LIF DimensionDescription DimID 1/2 Length/(NumberOfElements-1)"
             }
-            PixelSizeSource::OmeZarrScale => "OME-Zarr level-0 scale × axis unit",
+            PixelSizeSource::OmeZarrScale => "OME-Zarr scale of the level read × axis unit",
             PixelSizeSource::DefaultForUncalibrated => match crate::param::front_end() {
                 crate::param::FrontEnd::Python => {
                     "given for files without one (pixel_size_default=)"

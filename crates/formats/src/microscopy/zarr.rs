@@ -24,24 +24,25 @@ use std::sync::Arc;
 use serde::Deserialize;
 use zarrs::array::{data_type, Array, ArraySubset};
 use zarrs::group::Group;
-use zarrs::storage::{ReadableStorage, ReadableStorageTraits};
+use zarrs::storage::{ReadableStorage, ReadableStorageTraits, StorageError};
 
 use super::{Axes, ChannelInfo, PlaneIndex, Rows, SeriesInfo, VoxelSize};
 use crate::binary::{bad, checked_bytes, unsupported};
 use crate::error::Result;
 use crate::image::{Plane, SampleType, Samples};
+use crate::remote::RemoteStore;
 
 /// At most this many bioformats2raw images are looked for.
 const MAX_IMAGES: usize = 100_000;
 
-/// Whether `path` is a Zarr store (a folder with `zarr.json`, `.zgroup` or `.zattrs` at its
-/// root, or a URL below which the server has one of them).
+/// Whether `path` is a Zarr store (a folder with `zarr.json`, `.zgroup`, `.zattrs` or, for one
+/// level of an image, `.zarray` at its root, or a URL below which the server has one of them).
 pub fn is_store(path: &Path) -> bool {
     if crate::remote::is_url(path) {
         return crate::remote::is_zarr_store(path);
     }
     path.is_dir()
-        && ["zarr.json", ".zgroup", ".zattrs"]
+        && ["zarr.json", ".zgroup", ".zattrs", ".zarray"]
             .iter()
             .any(|f| path.join(f).is_file())
 }
@@ -178,9 +179,9 @@ pub struct ImageLayout {
     /// Its axes as (name, type, unit), as the store gives them (type `space` when absent for
     /// x, y and z).
     pub axes: Vec<(String, String, Option<String>)>,
-    /// The level-0 scale per axis (1 where none is given).
+    /// The scale per axis of the level read (1 where none is given).
     pub scale: Vec<f64>,
-    /// The level-0 array's shape.
+    /// The shape of the level read (level 0 unless the path named another).
     pub shape: Vec<u64>,
     /// Every level (resolution) as (path below the image group, shape, scale per axis with
     /// the image's own scale folded in), the full resolution first.
@@ -235,25 +236,76 @@ pub struct ZarrReader {
     pub version: String,
     /// The store is an HCS plate (its series are the wells' fields).
     pub plate: bool,
+    /// The resolution level read (0: full resolution; another when the path named a level).
+    pub level: usize,
+    /// The store, when it is on a server.
+    remote: Option<Arc<RemoteStore>>,
+}
+
+/// The store at `path` (a folder, or an `s3://` or `http(s)://` URL, which is also returned as
+/// such).
+fn store_at(path: &Path) -> Result<(ReadableStorage, Option<Arc<RemoteStore>>)> {
+    if crate::remote::is_url(path) {
+        let remote = Arc::new(RemoteStore::new(path)?);
+        return Ok((remote.clone(), Some(remote)));
+    }
+    crate::inputs::note_input(path);
+    let fs = zarrs::filesystem::FilesystemStore::new(path)
+        .map_err(|e| bad(path, format!("not a readable Zarr store: {e}")))?;
+    Ok((Arc::new(fs), None))
 }
 
 impl ZarrReader {
     /// Open the store at `path` (a folder, or an `s3://` or `http(s)://` URL) and read the
     /// metadata of every image in it.
+    ///
+    /// A path to one resolution level of an image (`image.ome.zarr/1`, an array its parent's
+    /// `multiscales` lists) reads that level: its shape, and its scale as the pixel size.
     pub fn open(path: &Path) -> Result<Self> {
-        if crate::remote::is_url(path) {
-            let store: ReadableStorage = Arc::new(crate::remote::RemoteStore::new(path)?);
-            return Self::open_store(path, store);
+        let (store, remote) = store_at(path)?;
+        match Self::open_images(path, store, 0) {
+            Ok(r) => Ok(ZarrReader { remote, ..r }),
+            Err(e) => Self::open_level(path)?.ok_or(e),
         }
-        crate::inputs::note_input(path);
-        let fs = zarrs::filesystem::FilesystemStore::new(path)
-            .map_err(|e| bad(path, format!("not a readable Zarr store: {e}")))?;
-        let store: ReadableStorage = Arc::new(fs);
-        Self::open_store(path, store)
+    }
+
+    /// The image at `path`'s parent, read at the level `path` names; `None` when `path` is no
+    /// level of an image.
+    fn open_level(path: &Path) -> Result<Option<Self>> {
+        let (Some(parent), Some(name)) = (path.parent(), path.file_name()) else {
+            return Ok(None);
+        };
+        let name = name.to_string_lossy();
+        if parent.as_os_str().is_empty() || !is_store(parent) {
+            return Ok(None);
+        }
+        let (store, remote) = store_at(parent)?;
+        let Ok(root) = group_fields(parent, &store, "/") else {
+            return Ok(None);
+        };
+        let found = root.multiscales(parent, "/")?.iter().find_map(|ms| {
+            ms.datasets
+                .iter()
+                .position(|d| d.path.trim_matches('/') == name)
+        });
+        let Some(level) = found else {
+            return Ok(None);
+        };
+        let reader = Self::open_images(path, store, level)?;
+        Ok(Some(ZarrReader {
+            level,
+            remote,
+            ..reader
+        }))
     }
 
     /// Read the images of a store opened elsewhere; `path` names it in messages.
     pub fn open_store(path: &Path, store: ReadableStorage) -> Result<Self> {
+        Self::open_images(path, store, 0)
+    }
+
+    /// Read the images of a store, each at resolution level `level` (0: full resolution).
+    fn open_images(path: &Path, store: ReadableStorage, level: usize) -> Result<Self> {
         let root = group_fields(path, &store, "/")?;
         // (group node, series name, group fields) of every image.
         let mut groups: Vec<(String, String, GroupFields)> = Vec::new();
@@ -295,7 +347,8 @@ impl ZarrReader {
                     (true, None) if k > 0 => k.to_string(),
                     _ => name.clone(),
                 };
-                images.push(open_image(path, &store, node, ms, &labels, (index, name))?);
+                let at = (index, name, level);
+                images.push(open_image(path, &store, node, ms, &labels, at)?);
             }
         }
         if images.is_empty() {
@@ -312,6 +365,8 @@ impl ZarrReader {
             compressed,
             version,
             plate: plate.is_some(),
+            level,
+            remote: None,
         })
     }
 
@@ -366,7 +421,13 @@ impl ZarrReader {
                 format!("array '{}': plane {index:?}: {e}", image.array_path),
             )
         };
-        self.check_written(image, &subset, index)?;
+        // On a server, whether the chunks were there is known from reading them (below), which
+        // saves a request per plane.
+        if self.remote.is_none() {
+            self.check_written(image, &subset, index, |key| {
+                image.array.storage().size_key(key).map(|s| s.is_some())
+            })?;
+        }
         let array = &image.array;
         let samples = match info.dtype {
             SampleType::U8 => Samples::Int {
@@ -407,6 +468,9 @@ impl ZarrReader {
                     .collect(),
             ),
         };
+        if let Some(remote) = &self.remote {
+            self.check_written(image, &subset, index, |key| Ok(!remote.was_missing(key)))?;
+        }
         Ok(Plane {
             width: w,
             height: h,
@@ -426,21 +490,21 @@ impl ZarrReader {
         image: &ZarrImage,
         subset: &ArraySubset,
         index: &PlaneIndex,
+        present: impl Fn(&zarrs::storage::StoreKey) -> std::result::Result<bool, StorageError>,
     ) -> Result<()> {
         let array = &image.array;
         let Ok(Some(chunks)) = array.chunks_in_array_subset(subset) else {
             return Ok(());
         };
-        let store = array.storage();
         for chunk in &chunks.indices() {
             let key = array.chunk_key(&chunk);
-            let size = store.size_key(&key).map_err(|e| {
+            let there = present(&key).map_err(|e| {
                 bad(
                     &self.path,
                     format!("array '{}': chunk {key}: {e}", image.array_path),
                 )
             })?;
-            if size.is_some() {
+            if there {
                 return Ok(());
             }
         }
@@ -583,19 +647,25 @@ fn metres_per_unit(unit: Option<&str>) -> Option<f64> {
     Some(m)
 }
 
-/// Open the level-0 array of one multiscale image and describe it as a series.
+/// Open the array of level `at` (0: full resolution) of one multiscale image and describe it as
+/// a series (index and name given).
 fn open_image(
     path: &Path,
     store: &ReadableStorage,
     node: &str,
     ms: &Multiscale,
     labels: &[Option<String>],
-    (index, name): (usize, String),
+    (index, name, at): (usize, String, usize),
 ) -> Result<ZarrImage> {
-    let level = ms
-        .datasets
-        .first()
-        .ok_or_else(|| bad(path, format!("image '{node}' lists no datasets")))?;
+    let level = ms.datasets.get(at).ok_or_else(|| {
+        bad(
+            path,
+            format!(
+                "image '{node}' lists {} datasets, not level {at}",
+                ms.datasets.len()
+            ),
+        )
+    })?;
     let base = node.trim_end_matches('/');
     let array_path = format!("{base}/{}", level.path.trim_matches('/'));
     let array = Array::open(store.clone(), &array_path)
@@ -647,7 +717,7 @@ fn open_image(
     )?;
     // Level scale × image scale, in the axis unit.
     let transforms = |d: usize| &ms.raw["datasets"][d]["coordinateTransformations"];
-    let level_scale = scale_of(transforms(0));
+    let level_scale = scale_of(transforms(at));
     let global = scale_of(&ms.raw["coordinateTransformations"]);
     let scale_at = |i: usize| -> Option<f64> {
         let s = level_scale.as_ref()?.get(i)?

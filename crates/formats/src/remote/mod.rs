@@ -61,14 +61,14 @@ pub fn set_endpoint_url(url: Option<&str>) -> Result<(), String> {
     Ok(())
 }
 
-/// Whether the object store at `path` is a Zarr store (its root holds `zarr.json`, `.zgroup`
-/// or `.zattrs`). Asks the server; any failure counts as "no" (opening it as a file then says
+/// Whether the object store at `path` is a Zarr store (its root holds `zarr.json`, `.zgroup`,
+/// `.zattrs` or `.zarray`). Asks the server; any failure counts as "no" (opening it as a file then says
 /// what is wrong).
 pub fn is_zarr_store(path: &Path) -> bool {
     let Ok(object) = client::Object::parse(path) else {
         return false;
     };
-    ["zarr.json", ".zgroup", ".zattrs"]
+    ["zarr.json", ".zgroup", ".zattrs", ".zarray"]
         .iter()
         .any(|key| matches!(client::client().size(&object, Some(key)), Ok(Some(_))))
 }

@@ -2,7 +2,9 @@
 //! URL (`s3://bucket/ramp.ome.zarr/0/c/0/0/0`), each read one ranged GET. A key the server does
 //! not have is a missing key (Zarr: a chunk never written holds the fill value).
 
+use std::collections::HashSet;
 use std::path::Path;
+use std::sync::Mutex;
 
 use zarrs::storage::byte_range::{ByteRange, ByteRangeIterator};
 use zarrs::storage::{Bytes, MaybeBytesIterator, ReadableStorageTraits, StorageError, StoreKey};
@@ -13,13 +15,23 @@ use crate::error::{Error, Result};
 /// The store at a URL.
 pub(crate) struct RemoteStore {
     root: Object,
+    /// Keys asked for that the server does not have.
+    missing: Mutex<HashSet<String>>,
 }
 
 impl RemoteStore {
     /// The store whose root is `path` (`s3://…`, `https://…`).
     pub(crate) fn new(path: &Path) -> Result<RemoteStore> {
         let root = Object::parse(path).map_err(|e| Error::io(path, e))?;
-        Ok(RemoteStore { root })
+        Ok(RemoteStore {
+            root,
+            missing: Mutex::default(),
+        })
+    }
+
+    /// Whether `key` was asked for and found missing.
+    pub(crate) fn was_missing(&self, key: &StoreKey) -> bool {
+        self.missing.lock().is_ok_and(|m| m.contains(key.as_str()))
     }
 }
 
@@ -39,7 +51,12 @@ impl ReadableStorageTraits for RemoteStore {
             };
             match client().get(&self.root, Some(key.as_str()), range)? {
                 Some(bytes) => parts.push(Ok(Bytes::from(bytes))),
-                None => return Ok(None),
+                None => {
+                    if let Ok(mut m) = self.missing.lock() {
+                        m.insert(key.as_str().to_string());
+                    }
+                    return Ok(None);
+                }
             }
         }
         Ok(Some(Box::new(parts.into_iter())))

@@ -222,6 +222,13 @@ impl ZarrOut {
 
     fn into_input(path: &Path, open: &OpenSeries) -> Result<Self> {
         let reader = ZarrReader::open(path)?;
+        if reader.level != 0 {
+            return Err(output_error(
+                path,
+                "is one resolution level of an image: the masks go into the image's store \
+                 (its parent folder) or a new one",
+            ));
+        }
         let version = NgffVersion::of(&reader.version);
         let store = ZarrStore::open(path, version)?;
         let mut nodes: Vec<String> = Vec::new();

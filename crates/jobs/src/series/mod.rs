@@ -289,7 +289,9 @@ pub fn from_files_selected(
         Some(axis) => format!("planes along {}", axis.name()),
         None => "planes in order".to_string(),
     };
-    let order = match (inputs.iter().any(|p| p.is_dir()), files.len()) {
+    // A store is one input, as a file is: its planes are in the store's order.
+    let folder = |p: &PathBuf| p.is_dir() && !zarr::is_store(p);
+    let order = match (inputs.iter().any(folder), files.len()) {
         (true, _) => format!(
             "file names in natural order (numbers compared as numbers: load_1.25mN, \
              load_1.5mN, load_10mN), each file's {planes}"
@@ -563,12 +565,15 @@ pub struct SeriesPlanes<'a> {
 }
 
 impl<'a> SeriesPlanes<'a> {
-    /// The planes of `series`, keeping up to `budget` bytes of decoded compressed planes.
+    /// The planes of `series`, keeping up to `budget` bytes of decoded planes that cost more
+    /// than a read from disk: compressed ones, and those fetched from a server (`s3://`,
+    /// `https://`), which a second pass would download again.
     pub fn new(series: &'a Series, budget: usize) -> Self {
         let compressed = |path: &Path| {
-            series
-                .info_of(path)
-                .is_some_and(|info| info.compression != "none")
+            contactscope_formats::remote::is_url(path)
+                || series
+                    .info_of(path)
+                    .is_some_and(|info| info.compression != "none")
         };
         SeriesPlanes {
             series,
