@@ -26,6 +26,7 @@ mod clx;
 pub mod czi;
 pub mod lif;
 pub mod nd2;
+mod ngff;
 pub mod select;
 pub mod summary;
 mod tiff;
