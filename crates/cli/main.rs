@@ -168,7 +168,7 @@ fn main() -> ExitCode {
     };
     let (command, verbose) = (cli.command, cli.verbose);
     if let Err(e) = contactscope_formats::remote::set_endpoint_url(cli.endpoint_url.as_deref()) {
-        eprintln!("error: --endpoint-url: {e}");
+        eprintln!("contactscope: error: --endpoint-url: {e} (see --help)");
         return ExitCode::from(2);
     }
     // Messages name parameters as flags (`--pixel-size`).

@@ -253,4 +253,14 @@ fn a_missing_object_or_a_dead_server_is_one_line_and_no_output() {
         "{}",
         stderr(&o)
     );
+    // An endpoint that is no http(s) URL is a usage error (exit 2), before anything is read.
+    let o = run(&[
+        "info",
+        "s3://lab/ramp.tif",
+        "--endpoint-url",
+        "ftp://h:9000",
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.starts_with("contactscope: error: --endpoint-url") && err.lines().count() == 1);
 }
