@@ -222,16 +222,16 @@ def test_connections_killed_mid_response_are_retried_to_the_same_numbers(s3, tmp
     args = ["--load-axis", "t", "--forces", FORCES]
     rc, _, err = _run("analyze", store, *args, "--out", tmp_path / "disk")
     assert rc in (0, 4), err
+    # The store holds the TIFF's planes: both give the same rows.
     for url in (f"s3://lab/2026/{store.name}", "s3://lab/2026/series.tif"):
         proxy = KillingProxy(s3["endpoint"], kills=3)
         extra = args if "zarr" in url else ["--forces", FORCES]
-        rc, _, err = _run("analyze", url, *extra, "--out", tmp_path / "flaky",
-                          endpoint=proxy.endpoint)
+        out = tmp_path / url.rsplit("/", 1)[-1]
+        rc, _, err = _run("analyze", url, *extra, "--out", out, endpoint=proxy.endpoint)
         proxy.close()
         assert rc in (0, 4), err
         assert proxy.cut == 3
-        if "zarr" in url:
-            assert _areas(tmp_path / "flaky") == _areas(tmp_path / "disk")
+        assert _areas(out) == _areas(tmp_path / "disk")
 
 
 def test_a_connection_killed_on_every_try_is_one_line_and_nothing_written(s3, tmp_path):

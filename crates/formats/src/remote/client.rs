@@ -410,22 +410,18 @@ fn content_length<B>(response: &ureq::http::Response<B>) -> Option<u64> {
         .ok()
 }
 
-/// A transport failure (no HTTP status): worth another try, except a malformed URL or a TLS
-/// certificate refused.
+/// A transport failure (no HTTP status): the network (a refused, dropped or stalled connection,
+/// a timeout, a response cut in its headers) is worth another try; anything else (a malformed
+/// URL, a TLS handshake or certificate refused, a response too large) is final.
 fn transport<T>(e: ureq::Error) -> Try<T> {
     match e {
         ureq::Error::Io(io) => Try::Again(io),
-        ureq::Error::Timeout(_) | ureq::Error::ConnectionFailed | ureq::Error::HostNotFound => {
-            Try::Again(io::Error::other(e.to_string()))
-        }
-        other => {
-            let text = other.to_string();
-            if text.contains("certificate") || text.contains("Url") || text.contains("url") {
-                Try::Fail(io::Error::other(text))
-            } else {
-                Try::Again(io::Error::other(text))
-            }
-        }
+        ureq::Error::Timeout(_)
+        | ureq::Error::ConnectionFailed
+        | ureq::Error::HostNotFound
+        | ureq::Error::Protocol(_)
+        | ureq::Error::BodyStalled => Try::Again(io::Error::other(e.to_string())),
+        other => Try::Fail(io::Error::other(other.to_string())),
     }
 }
 

@@ -87,6 +87,26 @@ struct Cache {
     bytes: usize,
 }
 
+impl Cache {
+    /// Keep `block`, dropping the least recently used ones beyond `capacity` bytes. Another
+    /// reader may have fetched the same block meanwhile: one copy is kept.
+    fn insert(&mut self, key: (String, u64), block: Arc<Vec<u8>>, capacity: usize) {
+        self.bytes += block.len();
+        match self.blocks.insert(key.clone(), block) {
+            Some(old) => self.bytes -= old.len(),
+            None => self.order.push_back(key),
+        }
+        while self.bytes > capacity {
+            let Some(old) = self.order.pop_front() else {
+                break;
+            };
+            if let Some(b) = self.blocks.remove(&old) {
+                self.bytes -= b.len();
+            }
+        }
+    }
+}
+
 fn cache() -> &'static Mutex<Cache> {
     static CACHE: OnceLock<Mutex<Cache>> = OnceLock::new();
     CACHE.get_or_init(Mutex::default)
@@ -121,17 +141,7 @@ impl RemoteFile {
         }
         let block = Arc::new(bytes);
         if let Ok(mut c) = cache().lock() {
-            c.bytes += block.len();
-            c.blocks.insert(key.clone(), block.clone());
-            c.order.push_back(key);
-            while c.bytes > CACHE_BYTES {
-                let Some(old) = c.order.pop_front() else {
-                    break;
-                };
-                if let Some(b) = c.blocks.remove(&old) {
-                    c.bytes -= b.len();
-                }
-            }
+            c.insert(key, block.clone(), CACHE_BYTES);
         }
         Ok(block)
     }
@@ -161,5 +171,25 @@ impl Seek for RemoteFile {
         self.pos = target
             .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "seek before the start"))?;
         Ok(self.pos)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cache_counts_each_block_once_and_keeps_to_its_capacity() {
+        let mut c = Cache::default();
+        let block = |n: usize| Arc::new(vec![0u8; n]);
+        c.insert(("a".into(), 0), block(10), 25);
+        c.insert(("a".into(), 0), block(10), 25);
+        assert_eq!((c.bytes, c.blocks.len(), c.order.len()), (10, 1, 1));
+        c.insert(("a".into(), 1), block(10), 25);
+        c.insert(("b".into(), 0), block(10), 25);
+        // Over 25 bytes: the oldest block goes.
+        assert_eq!(c.bytes, 20);
+        assert!(!c.blocks.contains_key(&("a".into(), 0)));
+        assert_eq!(c.order.len(), c.blocks.len());
     }
 }
