@@ -159,6 +159,27 @@ def test_bad_files_give_no_reader_and_one_line(tmp_path, monkeypatch):
     assert readers.get_topography_reader(str(bad)) is None
 
 
+@needs_napari
+def test_dat_files_by_their_first_bytes_and_sflz(tmp_path):
+    """A `.dat` is a height map only when it starts as a Createc or MetroPro image does; the
+    committed Createc and surfalize fixtures open as heights in µm."""
+    from contactscope.napari import readers
+
+    createc = ROOT / "fixtures" / "createc" / "A250407.141806.dat"
+    [(data, kwargs, _)] = readers.get_topography_reader(str(createc))(str(createc))
+    t = cs.read_topography(createc)
+    assert data.shape == (9, 255)
+    np.testing.assert_allclose(data, t.heights * 1e6)
+    assert kwargs["scale"] == pytest.approx([t.pixel_size_m[1] * 1e6, t.pixel_size_m[0] * 1e6])
+    other = tmp_path / "spectrum.dat"
+    other.write_text("Experiment\tbias spectroscopy\n1 2 3\n")
+    assert readers.get_topography_reader(str(other)) is None
+    sflz = ROOT / "fixtures" / "sflz" / "none_i2.sflz"
+    [(data, _, _)] = readers.get_topography_reader(str(sflz))(str(sflz))
+    np.testing.assert_allclose(data, cs.read_topography(sflz).heights * 1e6)
+    assert data.shape == (36, 48)
+
+
 # Readers on the real files beside the checkout ---------------------------------------------
 
 @needs_napari

@@ -179,6 +179,52 @@ def test_jpk_tiff_reads_its_default_calibration_slot(cli):
         cs.read_topography(path, channel="vDeflection")
 
 
+def test_createc_image_reads_its_dac_counts_in_metres(cli):
+    """The committed Createc image (fixtures/createc, ProbeFlow's sample): decoded here with zlib
+    and NumPy from the header's own numbers — float32 planes after the DATA line, the first
+    column dropped, the 9 lines scanned of 256 kept, counts × Dacto[A]z (nm) × GainZ/10."""
+    import zlib
+    path = ROOT / "fixtures" / "createc" / "A250407.141806.dat"
+    raw = path.read_bytes()
+    at = raw.index(b"\nDATA")
+    header = dict(line.split("=", 1) for line in raw[:at].decode("latin-1").splitlines()
+                  if "=" in line)
+    assert header["Num.X / Num.X"] == "256" and header["Dacto[A]z"] == "0.00037"
+    planes = np.frombuffer(zlib.decompress(raw[at + 5:]), "<f4")[:4 * 256 * 256]
+    z_forward = planes.reshape(4, 256, 256)[0, :9, 1:].astype(np.float64) * 0.00037e-9
+    t = cs.read_topography(path, detrend="none")
+    np.testing.assert_allclose(t.heights, z_forward, rtol=1e-12)
+    assert t.pixel_size_m == pytest.approx((998.468e-10 / 256,) * 2, rel=1e-12)
+    summary = json.loads(cli("topography", path, "--json"))
+    assert (summary["format"], summary["channel"], summary["nx"], summary["ny"]) == \
+        ("createc", "Z (forward)", 255, 9)
+    with pytest.raises(cs.InputError, match="'A', not a length"):
+        cs.read_topography(path, channel="Current (forward)")
+
+
+def test_sflz_files_read_as_surfalize_wrote_them(cli):
+    """The committed surfalize files (tests/data/sflz_fixture.py): the formula's heights back,
+    to the quantisation step of each file, with surfalize's unit and step."""
+    ny, nx = 36, 48
+    y, x = np.mgrid[0:ny, 0:nx].astype(np.float64)
+    um = 0.8 + 0.01 * x - 0.02 * y + 0.35 * np.sin(x / 4.0) * np.cos(y / 5.0)
+    spread = um.max() - um.min()
+    for name, step in [("none_i2.sflz", spread / 65535), ("lzma_f8.sflz", 0.0),
+                       ("zlib_u4.sflz", spread / (2**32 - 2))]:
+        t = cs.read_topography(ROOT / "fixtures" / "sflz" / name, detrend="none",
+                               fill_invalid="nearest")
+        assert t.pixel_size_m == pytest.approx((0.625e-6, 0.5e-6), rel=1e-12)
+        measured = np.ones_like(um, dtype=bool)
+        if name != "none_i2.sflz":
+            measured[3, 5] = False
+            measured[20, 40:44] = False
+        error = np.abs(t.heights[measured] - um[measured] * 1e-6)
+        assert error.max() <= 0.5 * step * 1e-6 * (1 + 1e-6) + 1e-21, name
+        summary = json.loads(cli("topography", ROOT / "fixtures" / "sflz" / name, "--json"))
+        assert summary["format"] == "sflz"
+        assert summary["valid_points"] == measured.sum()
+
+
 def test_a_tiny_map_is_levelled_as_asked_and_says_what_it_cannot_compute(tmp_path):
     """A 2 × 2 map has no interior point for the slope: its summary leaves the slope null with a
     note, and its heights are still levelled as asked (plane: they sum to zero)."""

@@ -14,6 +14,19 @@
 //! * JPK TIFF `.jpk`, `.jpk-qi-image`: the two files of `AFM-SPM/AFMReader`
 //!   (`CONTACTSCOPE_AFMREADER_DIR`); reference `tests/data/jpk_reference.csv`
 //!   (`jpk_reference.py`, AFMReader 0.0.7).
+//! * JPK HDF5 export `.h5-jpk`: `sample_0.h5-jpk` of `AFM-SPM/AFMReader`
+//!   (`CONTACTSCOPE_AFMREADER_DIR`); reference `tests/data/h5jpk_reference.csv`
+//!   (`h5jpk_reference.py`, AFMReader 0.0.7). CI reads `fixtures/jpk/tiny.h5-jpk`
+//!   (`h5jpk_fixture.py`, h5py) against its formula.
+//! * Createc `.dat`: the eleven `[Paramco32]` images of
+//!   `SPMQT-Lab/Createc-to-Nanonis-file-conversion` (`CONTACTSCOPE_CREATEC_DIR`); reference
+//!   `tests/data/createc_reference.csv` (`createc_reference.py`, ProbeFlow's decoder). Its
+//!   smallest image is committed (`fixtures/createc`, MIT) and compared always.
+//!
+//! And, always (the files are our own, written by the reference package itself): surfalize
+//! `.sflz`, the three files of `fixtures/sflz` (`sflz_fixture.py`: zlib, LZMA and no
+//! compression; uint32, float64 and int16 heights; um, nm and mm); reference
+//! `tests/data/sflz_reference.csv` (`sflz_reference.py`, surfalize 0.19.2).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -31,9 +44,18 @@ fn rel(a: f64, b: f64) -> f64 {
 /// Compare every row of `table` (under `tests/data`) with the files in `dir`; the number of
 /// rows compared.
 fn compare(dir: &Path, table: &str) -> usize {
+    compare_files(dir, table, |_| true)
+}
+
+/// Compare the rows of `table` whose file `keep` accepts; the number of rows compared.
+fn compare_files(dir: &Path, table: &str, keep: impl Fn(&str) -> bool) -> usize {
     let table = crate::common::root().join("tests/data").join(table);
     let mut reader = csv::Reader::from_path(table).unwrap();
-    let rows: Vec<HashMap<String, String>> = reader.deserialize().map(Result::unwrap).collect();
+    let rows: Vec<HashMap<String, String>> = reader
+        .deserialize()
+        .map(Result::unwrap)
+        .filter(|row: &HashMap<String, String>| keep(row.get("file").map_or("", String::as_str)))
+        .collect();
     for row in &rows {
         let get = |k: &str| row.get(k).map_or("", String::as_str);
         let num = |k: &str| get(k).parse::<f64>().unwrap();
@@ -150,4 +172,157 @@ fn jpk_tiffs_read_as_afmreader_reads_them() {
     };
     let err = read_height_map(&qi, &options).unwrap_err().to_string();
     assert!(err.contains("'N', not a length"), "{err}");
+}
+
+#[test]
+fn sflz_files_read_as_surfalize_reads_them() {
+    let dir = crate::common::root().join("fixtures/sflz");
+    assert_eq!(compare(&dir, "sflz_reference.csv"), 3);
+    // The camera image beside the heights is listed, not read as heights.
+    let map = read_height_map(&dir.join("lzma_f8.sflz"), &ReadOptions::default()).unwrap();
+    assert_eq!(map.channels, ["topography", "Camera"]);
+    assert_eq!(map.invalid_points, 5);
+    let options = ReadOptions {
+        channel: Some("camera".into()),
+        ..ReadOptions::default()
+    };
+    let err = read_height_map(&dir.join("lzma_f8.sflz"), &options)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("'Camera' is a camera image"), "{err}");
+}
+
+#[test]
+fn the_committed_createc_image_reads_as_probeflow_reads_it() {
+    let dir = crate::common::root().join("fixtures/createc");
+    let compared = compare_files(&dir, "createc_reference.csv", |f| f == "A250407.141806.dat");
+    assert_eq!(compared, 2);
+    // Without a channel: Z forward; the current is listed and refused as heights.
+    let path = dir.join("A250407.141806.dat");
+    let map = read_height_map(&path, &ReadOptions::default()).unwrap();
+    assert_eq!(map.channel, "Z (forward)");
+    assert_eq!(
+        map.channels,
+        [
+            "Z (forward)",
+            "Current (forward)",
+            "Z (backward)",
+            "Current (backward)"
+        ]
+    );
+    let options = ReadOptions {
+        channel: Some("current (backward)".into()),
+        ..ReadOptions::default()
+    };
+    let err = read_height_map(&path, &options).unwrap_err().to_string();
+    assert!(err.contains("'A', not a length"), "{err}");
+}
+
+#[test]
+fn createc_images_read_as_probeflow_reads_them() {
+    let Some(dir) = folder(
+        "CONTACTSCOPE_CREATEC_DIR",
+        "the Createc .dat images of SPMQT-Lab/Createc-to-Nanonis-file-conversion's test_data",
+    ) else {
+        return;
+    };
+    assert_eq!(compare(&dir, "createc_reference.csv"), 25);
+    // A qPlus scan's planes named by the channels it selected (Channelselectval=899).
+    let map = read_height_map(
+        &dir.join("createc_scan_qplus_10ch_afm.dat"),
+        &ReadOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(map.channels.len(), 10);
+    assert_eq!(map.channels[2], "Aux6 (forward)");
+}
+
+#[test]
+fn jpk_hdf5_exports_read_as_afmreader_reads_them() {
+    let Some(dir) = folder(
+        "CONTACTSCOPE_AFMREADER_DIR",
+        "AFMReader's tests/resources/sample_0.h5-jpk",
+    ) else {
+        return;
+    };
+    assert_eq!(compare(&dir, "h5jpk_reference.csv"), 8);
+    // Without a channel: the first height frame; the phase (degrees) is refused.
+    let path = dir.join("sample_0.h5-jpk");
+    let map = read_height_map(&path, &ReadOptions::default()).unwrap();
+    assert_eq!(map.channel, "height (trace, frame 1)");
+    assert_eq!(map.channels.len(), 36, "{:?}", map.channels);
+    let options = ReadOptions {
+        channel: Some("phase (retrace, frame 2)".into()),
+        ..ReadOptions::default()
+    };
+    let err = read_height_map(&path, &options).unwrap_err().to_string();
+    assert!(err.contains("'deg', not a length"), "{err}");
+}
+
+#[test]
+fn the_committed_jpk_hdf5_export_reads_its_counts_in_metres() {
+    let path = crate::common::root().join("fixtures/jpk/tiny.h5-jpk");
+    let read = |channel: &str| {
+        let options = ReadOptions {
+            channel: Some(channel.into()),
+            ..ReadOptions::default()
+        };
+        read_height_map(&path, &options).unwrap()
+    };
+    let map = read_height_map(&path, &ReadOptions::default()).unwrap();
+    assert_eq!(
+        map.channels,
+        [
+            "height (trace, frame 1)",
+            "height (trace, frame 2)",
+            "height (retrace, frame 1)",
+            "height (retrace, frame 2)",
+            "phase (trace, frame 1)",
+            "phase (trace, frame 2)"
+        ]
+    );
+    assert_eq!(
+        (map.channel.as_str(), map.nx(), map.ny()),
+        ("height (trace, frame 1)", 5, 4)
+    );
+    assert!(rel(map.dx_m, 4e-9) < 1e-12 && rel(map.dy_m, 3e-9) < 1e-12);
+    // Counts 1000·line + 10·column + 100000·frame (+ 7 retrace), lines stored bottom first.
+    for (channel, frame, extra) in [
+        ("height (trace, frame 1)", 0.0, 0.0),
+        ("height (retrace, frame 2)", 1.0, 7.0),
+    ] {
+        let m = read(channel);
+        for row in 0..4 {
+            for column in 0..5 {
+                let line = (3 - row) as f64;
+                let raw = 1000.0 * line + 10.0 * column as f64 + 100000.0 * frame + extra;
+                let want = raw * -2e-15 + 3e-7;
+                let got = m.heights[[row, column]];
+                assert!(
+                    rel(got, want) < 1e-12,
+                    "{channel} {row} {column}: {got:e} vs {want:e}"
+                );
+            }
+        }
+    }
+    let options = ReadOptions {
+        channel: Some("phase".into()),
+        ..ReadOptions::default()
+    };
+    let err = read_height_map(&path, &options).unwrap_err().to_string();
+    assert!(err.contains("'deg', not a length"), "{err}");
+    // Its unit is stated, as a TopoStats file's is: a second one is refused, not applied.
+    for file in [
+        "fixtures/jpk/tiny.h5-jpk",
+        "fixtures/topostats/tiny.topostats",
+    ] {
+        let options = ReadOptions {
+            height_unit_m: Some(1e-9),
+            ..ReadOptions::default()
+        };
+        let err = read_height_map(&crate::common::root().join(file), &options)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("states its height unit"), "{file}: {err}");
+    }
 }

@@ -151,6 +151,36 @@ pub const TEMPLATES: &[Template] = &[
         ["topography", "tc", "--json"]
     ),
     t!(
+        "topography-sflz",
+        ["t.sflz"],
+        ["t.sflz"],
+        ["topography", "t.sflz", "--json"]
+    ),
+    t!(
+        "topography-sflz-lzma",
+        ["t-lzma.sflz"],
+        ["t-lzma.sflz"],
+        ["topography", "t-lzma.sflz", "--json"]
+    ),
+    t!(
+        "topography-h5-jpk",
+        ["t.h5-jpk"],
+        ["t.h5-jpk"],
+        [
+            "topography",
+            "t.h5-jpk",
+            "--channel",
+            "height (retrace, frame 2)",
+            "--json"
+        ]
+    ),
+    t!(
+        "topography-createc",
+        ["t-createc.dat"],
+        ["t-createc.dat"],
+        ["topography", "t-createc.dat", "--json"]
+    ),
+    t!(
         "topography-topostats",
         ["t.topostats"],
         ["t.topostats"],

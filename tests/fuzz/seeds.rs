@@ -214,6 +214,27 @@ pub fn build(dir: &Path) {
         dir.join("t.jpk"),
     )
     .unwrap();
+    // surfalize: the committed fixtures (fixtures/sflz, written by surfalize), one per
+    // compression.
+    for (name, seed) in [("zlib_u4", "t.sflz"), ("lzma_f8", "t-lzma.sflz")] {
+        fs::copy(
+            crate::common::root().join(format!("fixtures/sflz/{name}.sflz")),
+            dir.join(seed),
+        )
+        .unwrap();
+    }
+    // JPK HDF5 export: the committed fixture (fixtures/jpk, h5py).
+    fs::copy(
+        crate::common::root().join("fixtures/jpk/tiny.h5-jpk"),
+        dir.join("t.h5-jpk"),
+    )
+    .unwrap();
+    // Createc: the committed image (fixtures/createc, ProbeFlow's sample, MIT).
+    fs::copy(
+        crate::common::root().join("fixtures/createc/A250407.141806.dat"),
+        dir.join("t-createc.dat"),
+    )
+    .unwrap();
     // A simulation folder and an analysis of the series (areas.csv for fits and friction).
     cli(
         dir,

@@ -1,8 +1,8 @@
 //! Which reader a height-map file goes to, decided from its content: magic bytes and headers
 //! first ([`super::detect_file`], NumPy, TIFF, Gwyddion Simple Field, gzip), then text; the
 //! extension only names what the file was expected to be in an error. A file in a format
-//! contactscope knows but does not read (Keyence, old Gwyddion, Nanoscope force
-//! curves, images, …) is refused
+//! contactscope knows but does not read (Keyence, old Gwyddion, Createc's older layouts,
+//! pictures, …) is refused
 //! saying what it is.
 
 use std::io::Read;
@@ -21,14 +21,22 @@ const HEAD_BYTES: usize = 4096;
 /// Formats recognised by their first bytes that no reader here reads, with what to say.
 fn known_unread(head: &[u8]) -> Option<&'static str> {
     let starts = |m: &[u8]| head.starts_with(m);
-    Some(if starts(b"\\*Force file list") {
-        "a Nanoscope force-curve file, not a height map"
-    } else if starts(b"GWYO") {
+    Some(if starts(b"GWYO") {
         "an old-format Gwyddion file (GWYO, before Gwyddion 2): open it in Gwyddion and save it \
          again (.gwy) to read it"
     } else if starts(b"VK4_") || starts(b"VK3_") {
         "a Keyence VK3/VK4 file: not read by contactscope (no sample file to test a reader on); \
          export the map as .gsf or a text matrix"
+    } else if starts(b"KPK") {
+        "a Keyence ZON file: not read by contactscope (no sample file to test a reader on); \
+         export the map as .gsf or a text matrix"
+    } else if starts(b"[Parameter]") || starts(b"[Paramet32]") {
+        "a Createc image of the older uncompressed layout ([Parameter], [Paramet32]): not read \
+         by contactscope (no sample file to test a reader on; the compressed [Paramco32] layout \
+         is read)"
+    } else if starts(b"Experiment\t") {
+        "a Nanonis spectroscopy or sweep file (a .dat of curves), not a height map; Nanonis \
+         images are .sxm files"
     } else if starts(b"MATLAB 5.0 MAT-file") {
         "a MATLAB .mat file: not read by contactscope; save the array with numpy.save (.npy)"
     } else if starts(b"OLYMPUSRAWFORMAT") {
@@ -44,8 +52,11 @@ fn known_unread(head: &[u8]) -> Option<&'static str> {
 
 /// Read a height map of any format (the module docs of [`super`]).
 pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> {
-    if let Some(format) = detect_file(path)? {
+    if detect_file(path)?.is_some() {
         let mut map = read(path, options.channel.as_deref())?;
+        // The format read, which may be more specific than the one detected (an HDF5 file that
+        // is a TopoStats file or a JPK export states its unit).
+        let format = map.format;
         if !format.states_height_unit() {
             let convert = super::to_metres(super::unitless_scale(options.height_unit_m)?);
             map.heights.mapv_inplace(&convert);
@@ -151,7 +162,7 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
 /// The formats read, for messages.
 pub const READ_FORMATS: &str = "Igor .ibw, Nanosurf .nid, Agilent .mi, Park TIFF, Gwyddion .gwy \
      and .gsf, ISO 25178 .x3p and .sdf, Wyko .opd, Sensofar .plu, Digital Surf .sur, FRT .frt, \
-     Nanoscope .di/.spm, WSxM .top/.stp, Nanonis .sxm, TopoStats .topostats, JPK .jpk, Alicona .al3d, TrueMap .tmd, NanoFocus .nms, Image \
+     Nanoscope .di/.spm, WSxM .top/.stp, Nanonis .sxm, TopoStats .topostats, JPK .jpk and .h5-jpk, Alicona .al3d, TrueMap .tmd, NanoFocus .nms, surfalize .sflz, Createc .dat, Image \
      Metrology .bcr/.bcrf, Zygo MetroPro .dat, NetCDF .nc, HDF5 .h5, NumPy .npy, float TIFF, text matrices and x y z grids \
      (also gzip-compressed)";
 
@@ -209,8 +220,18 @@ mod tests {
     fn known_formats_that_are_not_read_say_what_they_are() {
         for (head, needle) in [
             (&b"GWYOxxxx"[..], "old-format Gwyddion"),
-            (b"\\*Force file list\r\n", "force-curve"),
+            (
+                b"\\*Force file list\r\n\\*Ciao force image list\r\n\\@4:Image Data: S \
+                  [DeflectionError] \"Deflection Error\"\r\n\\*File list end\r\n",
+                "force-curve file without an image",
+            ),
             (b"VK4_\0\0\0\0", "Keyence"),
+            (b"KPK\0\0\0\0\0BM", "Keyence ZON"),
+            (b"[Paramet32]\r\nNum.X=4\r\n", "Createc image of the older"),
+            (
+                b"Experiment\tbias spectroscopy\t\r\n",
+                "Nanonis spectroscopy",
+            ),
             (b"\x89PNG\r\n\x1a\n", "picture"),
         ] {
             let (_d, path) = write("a.dat", head);

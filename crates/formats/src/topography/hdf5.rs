@@ -16,6 +16,9 @@
 //! `pixel_to_nm_scaling` (nm per pixel, both axes): it is read with that calibration, its
 //! channels being those two images.
 //!
+//! A JPK Instruments HDF5 export (`.h5-jpk`, root attribute `file-format-info` = `JPK SCAN`)
+//! is read with its own calibration by [`super::jpk_h5`].
+//!
 //! A NetCDF-4 file is an HDF5 file too: one that holds a `heights` dataset beside the `x` and
 //! `y` coordinate datasets SurfaceTopography writes is read as NetCDF ([`super::netcdf`]), with
 //! the sizes and units its attributes state.
@@ -63,14 +66,12 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
             ),
         ));
     }
+    let root = file.root_group().map_err(h5(path))?;
+    if super::jpk_h5::is_jpk_h5(&root) {
+        return super::jpk_h5::read(path, &root, channel, &h5(path));
+    }
     let mut datasets = Vec::new();
-    collect(
-        path,
-        &file.root_group().map_err(h5(path))?,
-        "",
-        0,
-        &mut datasets,
-    )?;
+    collect(path, &root, "", 0, &mut datasets)?;
     if let Some(map) = netcdf4(path, &datasets, channel)? {
         return Ok(map);
     }
@@ -168,7 +169,9 @@ fn shape2(path: &Path, shape: &[u64]) -> Result<(usize, usize)> {
 }
 
 /// Every value of a numeric dataset as f64, in row-major order.
-fn values(d: &hdf5_reader::Dataset) -> std::result::Result<Vec<f64>, hdf5_reader::error::Error> {
+pub(super) fn values(
+    d: &hdf5_reader::Dataset,
+) -> std::result::Result<Vec<f64>, hdf5_reader::error::Error> {
     macro_rules! as_f64 {
         ($t:ty) => {
             d.read_array::<$t>()?.iter().map(|&v| v as f64).collect()

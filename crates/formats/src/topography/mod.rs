@@ -51,11 +51,14 @@
 //! | NetCDF `.nc` (classic, 64-bit offset) | [`netcdf`] | `CDF\x01`, `CDF\x02`, `CDF\x05` | variable `heights` in its `unit` | `length` of the `x`/`y` variables / points | `mask`, `_FillValue` |
 //! | HDF5 `.h5` | [`hdf5`] | `\x89HDF\r\n\x1a\n` | 2-D datasets as stored, m (or the height unit given) | none: the argument is required | NaN |
 //! | JPK Instruments TIFF `.jpk`, `.jpk-qi-image` | [`jpk`] | TIFF + tags 32768, 32834, 32838 | `raw·multiplier + offset` of the default slot, in its unit; lines flipped | grid lengths / points | none |
+//! | JPK HDF5 export `.h5-jpk` | [`jpk_h5`] | HDF5 with root attribute `file-format-info` = `JPK SCAN` | `raw·multiplier + offset` of `net-encoder.scaling`, in its unit; lines flipped; one channel per frame | `ulength/ilength`, `vlength/jlength` | none |
 //! | TopoStats `.topostats` | [`hdf5`] | HDF5 with `image` and `pixel_to_nm_scaling` | `image` or `image_original`, nm | `pixel_to_nm_scaling` (nm) | NaN |
 //! | Digital Surf MountainsMap `.mnt` | [`mnt`] | OLE2 (`D0 CF 11 E0`) with a `ScopedContents` stream | `count·step + origin` of the z axis | x and y axis steps | mask value ≠ 9 |
 //! | Bruker/Veeco Vision64 `.opdx` | [`opdx`] | `VCA DATA\x01\x00\x00\x55` | float32 · `DataScale` (a 1-D profile is refused) | `Dimension2Extent`/(columns − 1), `Dimension1Extent`/(rows − 1) | NaN |
 //! | Bruker/Veeco Nanoscope `.di`, `.spm`, `.001`… | `nanoscope` | `\*File list` | `raw·(V_z/65536)·S` | scan size / samples | none |
 //! | WSxM images `.top`, `.stp`, … | `wsxm` | `WSxM file copyright` | integers: `raw·Z amplitude/(max − min)`; floats as stored | X/Y amplitude / points | none |
+//! | surfalize `.sflz` | [`sflz`] | `SFLZ` | the height layer in the file's unit; integer layers mapped onto their stated range | `step_x`, `step_y` | NaN; the integer sentinel |
+//! | Createc `.dat` | [`createc`] | `[Paramco32]` | float32 DAC counts × `Dacto[A]z` (nm) × `GainZ`/10; first column dropped | `Length x[A]`/`Num.X` | lines not scanned dropped |
 //! | Nanonis `.sxm` | [`sxm`] | `:NANONIS_VERSION:` | float32 as stored, in the `DATA_INFO` unit; backward lines mirrored, scans `up` flipped | `SCAN_RANGE` / `SCAN_PIXELS` | NaN (not scanned) |
 //!
 //! A file that states no pixel size (HDF5; a MetroPro file with a camera resolution of 0; a
@@ -79,11 +82,13 @@ pub mod al3d;
 pub mod bcr;
 pub mod container;
 pub mod container_write;
+pub mod createc;
 pub mod frt;
 pub mod gwy;
 pub mod hdf5;
 pub mod ibw;
 pub mod jpk;
+pub mod jpk_h5;
 pub mod metropro;
 pub mod mi;
 pub mod mnt;
@@ -96,6 +101,7 @@ pub mod opdx;
 pub mod park;
 pub mod plu;
 pub mod sdf;
+pub mod sflz;
 pub mod sur;
 pub mod sxm;
 pub mod tmd;

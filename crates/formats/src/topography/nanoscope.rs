@@ -3,6 +3,11 @@
 //! `\*File list end`, one `\*Ciao image list` section per channel, and int16 (or int32) data
 //! at each channel's `Data offset`.
 //!
+//! A force-volume file (`\*Force file list`) has the same header with `\*Ciao force image list`
+//! sections for its force curves (`@4:Image Data`): its image channels are read as above, its
+//! force channels listed as `DeflectionError (force curves)` and refused as heights; a file of
+//! force curves alone is refused naming them.
+//!
 //! The height of a channel is `raw · (V_z / 65536) · S` (int32: a further `/65536`), where
 //! `V_z` is the last number of `\@2:Z scale: V [Sens. X] (… V/LSB) V_z V` and `S` the soft
 //! scale `\@Sens. X: V S nm/V` from the scanner sections. The default channel is the first one
@@ -24,10 +29,12 @@ struct Channel {
     fields: HashMap<String, String>,
 }
 
-/// The header: scanner fields (every section but the image lists) and the channels.
+/// The header: scanner fields (every section but the image and force lists), the image
+/// channels and, in a force-volume file, the force-curve channels.
 struct Header {
     scanner: HashMap<String, String>,
     channels: Vec<Channel>,
+    force: Vec<Channel>,
 }
 
 /// A channel resolved to numbers.
@@ -55,6 +62,26 @@ pub fn read(path: &Path, bytes: &[u8], channel: Option<&str>) -> Result<HeightMa
         resolved.push(r);
     }
     let names = distinct_names(&entries);
+    let force: Vec<String> = header
+        .force
+        .iter()
+        .map(|c| format!("{} (force curves)", channel_name(c)))
+        .collect();
+    if header.channels.is_empty() {
+        return Err(Error::Unsupported {
+            at: Location::file(path),
+            reason: format!(
+                "a Nanoscope force-curve file without an image: its channels hold force curves \
+                 ({}), not a height map",
+                if force.is_empty() {
+                    "none named".to_string()
+                } else {
+                    force.join(", ")
+                }
+            ),
+        });
+    }
+    // Force curves are listed after the images (so that they can be named), never read.
     let list: Vec<ChannelEntry> = names
         .iter()
         .zip(&entries)
@@ -62,6 +89,10 @@ pub fn read(path: &Path, bytes: &[u8], channel: Option<&str>) -> Result<HeightMa
             name: name.clone(),
             height: *length,
         })
+        .chain(force.iter().map(|name| ChannelEntry {
+            name: name.clone(),
+            height: false,
+        }))
         .collect();
     if list.iter().all(|c| !c.height) && channel.is_none() {
         return Err(Error::Unsupported {
@@ -77,6 +108,20 @@ pub fn read(path: &Path, bytes: &[u8], channel: Option<&str>) -> Result<HeightMa
         });
     }
     let index = choose(path, &list, channel)?;
+    if index >= resolved.len() {
+        return Err(bad(
+            path,
+            format!(
+                "channel '{}' holds force curves, not an image; the file's images are {}",
+                list[index].name,
+                names
+                    .iter()
+                    .map(|n| format!("'{n}'"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
+    }
     let Some(chosen) = resolved.swap_remove(index)? else {
         return Err(bad(
             path,
@@ -144,7 +189,7 @@ fn raw_value(c: &[u8]) -> f64 {
 }
 
 fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
-    if !bytes.starts_with(b"\\*File list") {
+    if !bytes.starts_with(b"\\*File list") && !bytes.starts_with(b"\\*Force file list") {
         return Err(bad(
             path,
             "not a Nanoscope file (it does not start with '\\*File list')",
@@ -153,8 +198,10 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
     let mut header = Header {
         scanner: HashMap::new(),
         channels: Vec::new(),
+        force: Vec::new(),
     };
     let mut in_image = false;
+    let mut in_force = false;
     let mut rest = bytes;
     loop {
         let end = rest.iter().position(|&b| b == b'\n').ok_or_else(|| {
@@ -171,14 +218,22 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
         }
         if let Some(section) = line.strip_prefix("\\*") {
             in_image = section.eq_ignore_ascii_case("Ciao image list");
+            in_force = section.eq_ignore_ascii_case("Ciao force image list");
             if in_image {
                 header.channels.push(Channel::default());
+            } else if in_force {
+                header.force.push(Channel::default());
             }
         } else if let Some((key, value)) = line.strip_prefix('\\').and_then(split_entry) {
             let (key, value) = (key.trim().to_ascii_lowercase(), value.trim().to_string());
-            match header.channels.last_mut() {
-                Some(channel) if in_image => channel.fields.insert(key, value),
-                _ => header.scanner.insert(key, value),
+            let list = match (in_image, in_force) {
+                (true, _) => header.channels.last_mut(),
+                (_, true) => header.force.last_mut(),
+                _ => None,
+            };
+            match list {
+                Some(channel) => channel.fields.insert(key, value),
+                None => header.scanner.insert(key, value),
             };
         }
     }
@@ -190,11 +245,13 @@ fn split_entry(line: &str) -> Option<(&str, &str)> {
         .or_else(|| line.strip_suffix(':').map(|key| (key, "")))
 }
 
-/// `S [ZSensor] "Height Sensor"` → `ZSensor`.
+/// `S [ZSensor] "Height Sensor"` → `ZSensor` (`@2:Image Data` of an image, `@4:Image Data` of
+/// force curves).
 fn channel_name(channel: &Channel) -> String {
     let text = channel
         .fields
         .get("@2:image data")
+        .or_else(|| channel.fields.get("@4:image data"))
         .map_or("", String::as_str);
     match (text.find('['), text.find(']')) {
         (Some(a), Some(b)) if a < b => text[a + 1..b].to_string(),
@@ -402,6 +459,74 @@ mod tests {
                 "Height (4)",
                 "Phase (5)"
             ]
+        );
+    }
+
+    /// `sample` as a force-volume file: its header starts `\*Force file list` and holds force
+    /// curves (`\*Ciao force image list`, before and after the images).
+    fn force_volume(data: &[i16], images: bool) -> Vec<u8> {
+        let force = "\\*Ciao force image list\r\n\\Data offset: 40960\r\n\\Bytes/pixel: 2\r\n\
+                     \\Samps/line: 512\r\n\\@4:Image Data: S [DeflectionError] \"Deflection \
+                     Error\"\r\n\\@4:Z scale: V [Sens. DeflSens] (0.000375 V/LSB) 24.5 V\r\n";
+        let text = String::from_utf8_lossy(&sample(data)).into_owned();
+        let text = text
+            .replacen("\\*File list\r\n", "\\*Force file list\r\n", 1)
+            .replacen(
+                "\\*Ciao image list",
+                &format!("{force}\\*Ciao image list"),
+                1,
+            )
+            .replacen("\\*File list end", &format!("{force}\\*File list end"), 1);
+        let text = match images {
+            true => text,
+            false => text.replace("\\*Ciao image list", "\\*Ciao scan list"),
+        };
+        text.into_bytes()
+    }
+
+    #[test]
+    fn a_force_volume_file_reads_its_images_and_names_its_curves() {
+        // The header grew by the force sections: the data offsets of `sample` move with it.
+        let bytes = force_volume(&[1, 2, 3, 4], true);
+        let at = bytes.len() - 8;
+        let mut text = String::from_utf8_lossy(&bytes[..at]).into_owned();
+        text = text
+            .replace("Data offset: 1024", &format!("Data offset: {}", at - 8))
+            .replace("Data offset: 1032", &format!("Data offset: {at}"));
+        let mut fixed = text.into_bytes();
+        fixed.extend(&bytes[at..]);
+        let (_dir, path) = file(&fixed);
+        let m = read_nanoscope(&path, None).unwrap();
+        assert_eq!(m.channel, "Height");
+        assert_eq!(
+            m.channels,
+            [
+                "Phase",
+                "Height",
+                "DeflectionError (force curves)",
+                "DeflectionError (force curves)"
+            ]
+        );
+        let plain = file(&sample(&[1, 2, 3, 4]));
+        let image = read_nanoscope(&plain.1, None).unwrap();
+        assert_eq!(
+            m.heights, image.heights,
+            "the image reads as in an image file"
+        );
+        assert_eq!((m.dx_m, m.dy_m), (image.dx_m, image.dy_m));
+        let err = read_nanoscope(&path, Some("deflection"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("holds force curves, not an image") && err.contains("'Height'"),
+            "{err}"
+        );
+        let (_dir, path) = file(&force_volume(&[1, 2, 3, 4], false));
+        let err = read_nanoscope(&path, None).unwrap_err().to_string();
+        assert!(
+            err.contains("force-curve file without an image")
+                && err.contains("DeflectionError (force curves)"),
+            "{err}"
         );
     }
 

@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use super::{
-    al3d, bcr, frt, gwy, hdf5, ibw, jpk, metropro, mi, mnt, nanoscope, netcdf, nid, nms, opd, opdx,
-    park, plu, sdf, sur, sxm, tmd, wsxm, x3p,
+    al3d, bcr, createc, frt, gwy, hdf5, ibw, jpk, metropro, mi, mnt, nanoscope, netcdf, nid, nms,
+    opd, opdx, park, plu, sdf, sflz, sur, sxm, tmd, wsxm, x3p,
 };
 
 use ndarray::Array2;
@@ -85,6 +85,13 @@ pub enum TopographyFormat {
     /// TopoStats HDF5 (`.topostats`).
     #[serde(rename = "topostats")]
     TopoStats,
+    /// surfalize's own `.sflz`.
+    Sflz,
+    /// Createc STM/AFM image (`.dat`, `[Paramco32]`).
+    Createc,
+    /// JPK Instruments HDF5 export (`.h5-jpk`).
+    #[serde(rename = "jpk-h5")]
+    JpkHdf5,
 }
 
 impl TopographyFormat {
@@ -121,6 +128,9 @@ impl TopographyFormat {
             TopographyFormat::Sxm => "sxm",
             TopographyFormat::TopoStats => "topostats",
             TopographyFormat::Jpk => "jpk",
+            TopographyFormat::Sflz => "sflz",
+            TopographyFormat::Createc => "createc",
+            TopographyFormat::JpkHdf5 => "jpk-h5",
         }
     }
 
@@ -221,7 +231,7 @@ pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
         Some(TopographyFormat::Mi)
     } else if head.get(2..11) == Some(b"Directory") {
         Some(TopographyFormat::Opd)
-    } else if starts(b"\\*File list") {
+    } else if starts(b"\\*File list") || starts(b"\\*Force file list") {
         Some(TopographyFormat::Nanoscope)
     } else if starts(b"WSxM file copyright") {
         Some(TopographyFormat::Wsxm)
@@ -231,6 +241,10 @@ pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
         Some(TopographyFormat::Al3d)
     } else if starts(tmd::MAGIC) {
         Some(TopographyFormat::Tmd)
+    } else if starts(sflz::MAGIC) {
+        Some(TopographyFormat::Sflz)
+    } else if starts(createc::MAGIC) {
+        Some(TopographyFormat::Createc)
     } else if head.get(nms::VERSION_AT..nms::VERSION_AT + nms::VERSION.len()) == Some(nms::VERSION)
     {
         Some(TopographyFormat::Nms)
@@ -286,7 +300,7 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
             path,
             "not a height-map format contactscope recognises from its content (ibw, nid, mi, \
              Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf, metropro, netcdf, hdf5, mnt, opdx, \
-             nanoscope, wsxm, sxm, jpk)",
+             nanoscope, wsxm, sxm, jpk, sflz, createc)",
         )
     })?;
     match format {
@@ -311,6 +325,8 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 TopographyFormat::Jpk => jpk::read(path, &bytes, channel),
                 TopographyFormat::Al3d => al3d::read(path, &bytes, channel),
                 TopographyFormat::Tmd => tmd::read(path, &bytes, channel),
+                TopographyFormat::Sflz => sflz::read(path, &bytes, channel),
+                TopographyFormat::Createc => createc::read(path, &bytes, channel),
                 TopographyFormat::Nms => nms::read(path, &bytes, channel),
                 TopographyFormat::Bcr => bcr::read(path, &bytes, channel),
                 TopographyFormat::MetroPro => metropro::read(path, &bytes, channel),
@@ -324,7 +340,8 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 | TopographyFormat::Gsf
                 | TopographyFormat::Text
                 | TopographyFormat::Xyz
-                | TopographyFormat::TopoStats => unreachable!("not detected by content"),
+                | TopographyFormat::TopoStats
+                | TopographyFormat::JpkHdf5 => unreachable!("not detected by content"),
             }
         }
     }

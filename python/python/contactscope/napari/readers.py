@@ -10,7 +10,8 @@ file's pixel size (1 where the file does not state it) and the file's name and s
 
 Height maps: AFM and profilometer files (Igor ibw, Nanosurf nid, PicoView mi, Gwyddion gwy,
 X3P, SDF, Wyko opd, Sensofar plu, Digital Surf sur and mnt, FRT, GSF, WSxM top/stp, Nanoscope
-di/spm/001, Nanonis sxm, TopoStats, JPK TIFF, Alicona al3d, TrueMap tmd, NanoFocus nms, Image Metrology bcr/bcrf, Vision64 opdx,
+di/spm/001, Nanonis sxm, TopoStats, JPK TIFF and HDF5, surfalize sflz, Createc and Zygo MetroPro dat
+(recognised by their first bytes: .dat is a common name), Alicona al3d, TrueMap tmd, NanoFocus nms, Image Metrology bcr/bcrf, Vision64 opdx,
 NetCDF nc, HDF5 h5, Park TIFF) through :func:`contactscope.read_topography`, as the command line's ``topography``
 reads them (plane-levelled, its default): one image layer of heights in µm, scale in µm.
 
@@ -40,7 +41,7 @@ TIFF_EXTENSIONS = (".tif", ".tiff")
 TOPOGRAPHY_EXTENSIONS = (".ibw", ".nid", ".mi", ".gwy", ".x3p", ".sdf", ".opd", ".plu", ".sur",
                          ".frt", ".gsf", ".top", ".stp", ".di", ".spm", ".001", ".al3d", ".tmd",
                          ".nms", ".bcr", ".bcrf", ".mnt", ".opdx", ".nc", ".h5", ".sxm", ".topostats", ".jpk",
-                         ".jpk-qi-image")
+                         ".jpk-qi-image", ".sflz", ".h5-jpk")
 
 
 CHANNEL_COLOURS = ("green", "magenta", "cyan", "yellow", "red", "blue", "gray")
@@ -92,9 +93,28 @@ def get_topography_reader(path: PathOrPaths) -> Optional[Callable[[PathOrPaths],
     if isinstance(path, (list, tuple)):
         return None
     path = os.fspath(path)
-    if os.path.isdir(path) or _ext(path) not in TOPOGRAPHY_EXTENSIONS:
+    if os.path.isdir(path):
+        return None
+    if _ext(path) == ".dat":
+        return read_topography_layers if _height_map_dat(path) else None
+    if _ext(path) not in TOPOGRAPHY_EXTENSIONS:
         return None
     return read_topography_layers
+
+
+# The first bytes of the `.dat` files that hold height maps: Zygo MetroPro (three header
+# formats) and Createc images. Other `.dat` files are left to other readers.
+DAT_HEIGHT_MAP_MAGIC = (b"\x88\x1b\x03\x6f", b"\x88\x1b\x03\x70", b"\x88\x1b\x03\x71",
+                        b"[Paramco32]")
+
+
+def _height_map_dat(path: str) -> bool:
+    try:
+        with open(path, "rb") as f:
+            head = f.read(16)
+    except OSError:
+        return False
+    return head.startswith(DAT_HEIGHT_MAP_MAGIC)
 
 
 def read_micrographs(path: PathOrPaths) -> Optional[List[LayerData]]:
