@@ -112,16 +112,18 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
     }
 
     let plane_bytes = grid_bytes(path, nx, ny, 4)?;
+    // All planes are inflated (a short stream is a truncated file), within the size limit of a
+    // whole height-map file; the buffer grows with the data, not with the header's claim.
     let needed = plane_bytes
         .checked_mul(planes)
-        .filter(|&n| n <= crate::binary::MAX_PLANE_BYTES.saturating_mul(64))
+        .filter(|&n| n as u64 <= super::MAX_FILE_BYTES)
         .ok_or_else(|| {
             unsupported(
                 path,
                 format!("{planes} Createc planes of {nx}×{ny} values exceed the size limit"),
             )
         })?;
-    let mut raw = Vec::with_capacity(needed);
+    let mut raw = Vec::new();
     flate2::read::ZlibDecoder::new(&data[marker + 5..])
         .take(needed as u64)
         .read_to_end(&mut raw)

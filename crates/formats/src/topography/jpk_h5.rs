@@ -162,6 +162,17 @@ pub(super) fn read(
         ));
     }
     let raw = super::hdf5::values(&e.dataset).map_err(h5)?;
+    if raw.len() != points.saturating_mul(e.frames) {
+        return Err(bad(
+            path,
+            format!(
+                "JPK channel '{}' holds {} values for {points} points × {} frames",
+                e.name,
+                raw.len(),
+                e.frames
+            ),
+        ));
+    }
     let (multiplier, offset) = e.scaling;
     let mut heights = Vec::with_capacity(nx * ny);
     for line in (0..ny).rev() {

@@ -294,7 +294,8 @@ fn decode(path: &Path, layer: &Layer, compression: u8) -> Result<Vec<f64>> {
 /// A zlib stream's bytes, at most `limit + 1` of them (more says the layer is not what its
 /// header states).
 fn inflate(path: &Path, decoder: impl Read, limit: usize) -> Result<Vec<u8>> {
-    let mut out = Vec::with_capacity(limit);
+    // The buffer grows with the data, not with the header's claim.
+    let mut out = Vec::new();
     decoder
         .take(limit as u64 + 1)
         .read_to_end(&mut out)
@@ -305,7 +306,7 @@ fn inflate(path: &Path, decoder: impl Read, limit: usize) -> Result<Vec<u8>> {
 /// An `.xz` stream's bytes (Python's `lzma.compress`), at most `limit + 1` of them.
 fn unxz(path: &Path, payload: &[u8], limit: usize) -> Result<Vec<u8>> {
     let mut out = Capped {
-        bytes: Vec::with_capacity(limit),
+        bytes: Vec::new(),
         limit: limit + 1,
     };
     let mut input = payload;
