@@ -225,6 +225,19 @@ def test_sflz_files_read_as_surfalize_wrote_them(cli):
         assert summary["valid_points"] == measured.sum()
 
 
+def test_a_zygo_datx_file_is_refused_by_name(tmp_path):
+    """An HDF5 file laid out as Zygo's DATX (a root MetaData table, Measurement/Surface) is
+    refused naming the format, not read as plain datasets in an unknown unit."""
+    h5py = pytest.importorskip("h5py")
+    path = tmp_path / "scan.datx"
+    with h5py.File(path, "w") as f:
+        row = np.dtype([("Source", "S16"), ("Link", "S16"), ("Destination", "S16")])
+        f.create_dataset("MetaData", data=np.array([(b"Root", b"Path", b"x")], dtype=row))
+        f.create_dataset("Measurement/Surface", data=np.zeros((4, 5), np.float32))
+    with pytest.raises(cs.InputError, match="Zygo DATX"):
+        cs.read_topography(path, pixel_size=1e-6)
+
+
 def test_a_tiny_map_is_levelled_as_asked_and_says_what_it_cannot_compute(tmp_path):
     """A 2 × 2 map has no interior point for the slope: its summary leaves the slope null with a
     note, and its heights are still levelled as asked (plane: they sum to zero)."""

@@ -72,6 +72,18 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
     }
     let mut datasets = Vec::new();
     collect(path, &root, "", 0, &mut datasets)?;
+    // Zygo DATX: the instrument's calibration lives in its `MetaData` table and in converter
+    // attributes of `Measurement/Surface`; read as plain datasets its heights would be in an
+    // unknown unit.
+    let has = |name: &str| datasets.iter().any(|(n, _)| n == name);
+    if has("MetaData") && datasets.iter().any(|(n, _)| n.starts_with("Measurement/")) {
+        return Err(unsupported(
+            path,
+            "a Zygo DATX file (HDF5 with a MetaData table and a Measurement group): not read by \
+             contactscope (no sample file to test a reader on); export the map as .gsf or a \
+             text matrix",
+        ));
+    }
     if let Some(map) = netcdf4(path, &datasets, channel)? {
         return Ok(map);
     }
