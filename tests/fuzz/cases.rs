@@ -127,6 +127,12 @@ pub const TEMPLATES: &[Template] = &[
         ["topography", "t.di", "--json"]
     ),
     t!(
+        "topography-force-volume",
+        ["t-force.spm"],
+        ["t-force.spm"],
+        ["topography", "t-force.spm", "--json"]
+    ),
+    t!(
         "topography-sxm",
         ["t.sxm"],
         ["t.sxm"],

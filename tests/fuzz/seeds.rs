@@ -114,7 +114,7 @@ fn wsxm(dir: &Path) {
 fn nanoscope(dir: &Path) {
     let n = 16usize;
     let offset = 2048usize;
-    let mut header = format!(
+    let header = format!(
         "\\*File list\r\n\\Data length: {offset}\r\n\\*Ciao scan list\r\n\
          \\Scan Size: 2 2 um\r\n\\@Sens. Zsens: V 20 nm/V\r\n\
          \\*Ciao image list\r\n\\Data offset: {offset}\r\n\\Data length: {}\r\n\
@@ -125,14 +125,26 @@ fn nanoscope(dir: &Path) {
          \\*File list end\r\n",
         2 * n * n
     );
-    assert!(header.len() < offset);
-    header.push_str(&"\0".repeat(offset - header.len()));
-    let mut bytes = header.into_bytes();
-    for k in 0..n * n {
-        let v = ((k as f64 * 0.21).cos() * 8000.0) as i16;
-        bytes.extend_from_slice(&v.to_le_bytes());
+    // The same image in a force-volume file: `\*Force file list` and a force-curve channel
+    // (whose curves are named, never read) beside the image.
+    let force = header
+        .replacen("\\*File list\r\n", "\\*Force file list\r\n", 1)
+        .replacen(
+            "\\*File list end",
+            "\\*Ciao force image list\r\n\\Data offset: 4096\r\n\\Samps/line: 64\r\n\
+             \\@4:Image Data: S [DeflectionError] \"Deflection Error\"\r\n\\*File list end",
+            1,
+        );
+    for (name, mut header) in [("t.di", header), ("t-force.spm", force)] {
+        assert!(header.len() < offset);
+        header.push_str(&"\0".repeat(offset - header.len()));
+        let mut bytes = header.into_bytes();
+        for k in 0..n * n {
+            let v = ((k as f64 * 0.21).cos() * 8000.0) as i16;
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        fs::write(dir.join(name), bytes).unwrap();
     }
-    fs::write(dir.join("t.di"), bytes).unwrap();
 }
 
 /// A Hertzian squeeze test: 2δ from F for R = 290 µm, E* = 3.7 MPa (soft sphere).
