@@ -214,39 +214,21 @@ pub fn build(dir: &Path) {
     wsxm(dir);
     nanoscope(dir);
     sxm(dir);
-    // TopoStats: the committed fixture (fixtures/topostats, h5py).
-    fs::copy(
-        crate::common::root().join("fixtures/topostats/tiny.topostats"),
-        dir.join("t.topostats"),
-    )
-    .unwrap();
-    // JPK: the committed fixture (fixtures/jpk, tifffile).
-    fs::copy(
-        crate::common::root().join("fixtures/jpk/tiny.jpk"),
-        dir.join("t.jpk"),
-    )
-    .unwrap();
-    // surfalize: the committed fixtures (fixtures/sflz, written by surfalize), one per
-    // compression.
-    for (name, seed) in [("zlib_u4", "t.sflz"), ("lzma_f8", "t-lzma.sflz")] {
+    // Committed fixtures of the vendor formats (fixtures/README.md says how each was made).
+    for (fixture, seed) in [
+        ("topostats/tiny.topostats", "t.topostats"),
+        ("jpk/tiny.jpk", "t.jpk"),
+        ("jpk/tiny.h5-jpk", "t.h5-jpk"),
+        ("sflz/zlib_u4.sflz", "t.sflz"),
+        ("sflz/lzma_f8.sflz", "t-lzma.sflz"),
+        ("createc/A250407.141806.dat", "t-createc.dat"),
+    ] {
         fs::copy(
-            crate::common::root().join(format!("fixtures/sflz/{name}.sflz")),
+            crate::common::root().join("fixtures").join(fixture),
             dir.join(seed),
         )
         .unwrap();
     }
-    // JPK HDF5 export: the committed fixture (fixtures/jpk, h5py).
-    fs::copy(
-        crate::common::root().join("fixtures/jpk/tiny.h5-jpk"),
-        dir.join("t.h5-jpk"),
-    )
-    .unwrap();
-    // Createc: the committed image (fixtures/createc, ProbeFlow's sample, MIT).
-    fs::copy(
-        crate::common::root().join("fixtures/createc/A250407.141806.dat"),
-        dir.join("t-createc.dat"),
-    )
-    .unwrap();
     // A simulation folder and an analysis of the series (areas.csv for fits and friction).
     cli(
         dir,
