@@ -67,17 +67,13 @@ pub fn read(path: &Path, bytes: &[u8], channel: Option<&str>) -> Result<HeightMa
         .iter()
         .map(|c| format!("{} (force curves)", channel_name(c)))
         .collect();
-    if header.channels.is_empty() {
+    if header.channels.is_empty() && !header.force.is_empty() {
         return Err(Error::Unsupported {
             at: Location::file(path),
             reason: format!(
                 "a Nanoscope force-curve file without an image: its channels hold force curves \
                  ({}), not a height map",
-                if force.is_empty() {
-                    "none named".to_string()
-                } else {
-                    force.join(", ")
-                }
+                force.join(", ")
             ),
         });
     }

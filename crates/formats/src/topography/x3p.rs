@@ -155,7 +155,12 @@ fn main_folder<R: std::io::Read + std::io::Seek>(
     if let [one] = nested.as_slice() {
         return Ok(one.trim_end_matches("main.xml").to_string());
     }
-    let what = if names.contains(&"[Content_Types].xml") {
+    // Sensofar's PLUX (as surfalize documents it): `index.xml` with the layers `LAYER_0.raw`, ….
+    let what = if names.contains(&"index.xml") && names.contains(&"LAYER_0.raw") {
+        "a Sensofar PLUX file: not read by contactscope (no sample file to test a reader on); \
+         export the map from SensoView as .plu, .gsf or a text matrix"
+            .to_string()
+    } else if names.contains(&"[Content_Types].xml") {
         let kind = if names.iter().any(|n| n.starts_with("xl/")) {
             "an Excel workbook (.xlsx)"
         } else if names.iter().any(|n| n.starts_with("word/")) {
@@ -267,7 +272,12 @@ mod tests {
         );
         let err = other("b.zip", &["index.xml", "LAYER_0.raw"]);
         assert!(
-            err.contains("no main.xml") && err.contains("'LAYER_0.raw'"),
+            err.contains("Sensofar PLUX") && err.contains("b.zip"),
+            "{err}"
+        );
+        let err = other("c.zip", &["index.xml", "data.bin"]);
+        assert!(
+            err.contains("no main.xml") && err.contains("'data.bin'"),
             "{err}"
         );
     }
