@@ -21,7 +21,9 @@
 //! * Createc `.dat`: the eleven `[Paramco32]` images of
 //!   `SPMQT-Lab/Createc-to-Nanonis-file-conversion` (`CONTACTSCOPE_CREATEC_DIR`); reference
 //!   `tests/data/createc_reference.csv` (`createc_reference.py`, ProbeFlow's decoder). Its
-//!   smallest image is committed (`fixtures/createc`, MIT) and compared always.
+//!   smallest image is committed (`fixtures/createc`, MIT) and compared always. The same folder's
+//!   Nanonis scan `sxm_moire_10nm.sxm` against nanonispy 1.1.0
+//!   (`tests/data/nanonis_sxm_probeflow_reference.csv`, `nanonis_sxm_reference.py`).
 //!
 //! And, always (the files are our own, written by the reference package itself): surfalize
 //! `.sflz`, the three files of `fixtures/sflz` (`sflz_fixture.py`: zlib, LZMA and no
@@ -227,6 +229,8 @@ fn createc_images_read_as_probeflow_reads_them() {
         return;
     };
     assert_eq!(compare(&dir, "createc_reference.csv"), 25);
+    // A Nanonis scan of a fifth project, as nanonispy reads it.
+    assert_eq!(compare(&dir, "nanonis_sxm_probeflow_reference.csv"), 2);
     // A qPlus scan's planes named by the channels it selected (Channelselectval=899).
     let map = read_height_map(
         &dir.join("createc_scan_qplus_10ch_afm.dat"),
