@@ -203,23 +203,27 @@ def test_createc_image_reads_its_dac_counts_in_metres(cli):
 
 
 def test_sflz_files_read_as_surfalize_wrote_them(cli):
-    """The committed surfalize files (tests/data/sflz_fixture.py): the formula's heights back,
-    to the quantisation step of each file, with surfalize's unit and step."""
+    """The committed surfalize files (tests/data/sflz_fixture.py, sflz_earlier_fixture.py): the
+    formula's heights back, to the quantisation step of each file, with surfalize's unit and
+    step, in both layouts."""
     ny, nx = 36, 48
     y, x = np.mgrid[0:ny, 0:nx].astype(np.float64)
     um = 0.8 + 0.01 * x - 0.02 * y + 0.35 * np.sin(x / 4.0) * np.cos(y / 5.0)
     spread = um.max() - um.min()
-    for name, step in [("none_i2.sflz", spread / 65535), ("lzma_f8.sflz", 0.0),
-                       ("zlib_u4.sflz", spread / (2**32 - 2))]:
+    # Within half a step where surfalize rounds (0.19), within a step where it truncates (0.17).
+    for name, step in [("none_i2.sflz", 0.5 * spread / 65535), ("lzma_f8.sflz", 0.0),
+                       ("zlib_u4.sflz", 0.5 * spread / (2**32 - 2)),
+                       ("earlier_lzma_f8.sflz", 0.0),
+                       ("earlier_zlib_u4.sflz", spread / (2**32 - 1))]:
         t = cs.read_topography(ROOT / "fixtures" / "sflz" / name, detrend="none",
                                fill_invalid="nearest")
         assert t.pixel_size_m == pytest.approx((0.625e-6, 0.5e-6), rel=1e-12)
         measured = np.ones_like(um, dtype=bool)
-        if name != "none_i2.sflz":
+        if name in ("lzma_f8.sflz", "zlib_u4.sflz"):
             measured[3, 5] = False
             measured[20, 40:44] = False
         error = np.abs(t.heights[measured] - um[measured] * 1e-6)
-        assert error.max() <= 0.5 * step * 1e-6 * (1 + 1e-6) + 1e-21, name
+        assert error.max() <= step * 1e-6 * (1 + 1e-6) + 1e-21, name
         summary = json.loads(cli("topography", ROOT / "fixtures" / "sflz" / name, "--json"))
         assert summary["format"] == "sflz"
         assert summary["valid_points"] == measured.sum()

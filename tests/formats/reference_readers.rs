@@ -28,7 +28,9 @@
 //! And, always (the files are our own, written by the reference package itself): surfalize
 //! `.sflz`, the three files of `fixtures/sflz` (`sflz_fixture.py`: zlib, LZMA and no
 //! compression; uint32, float64 and int16 heights; um, nm and mm); reference
-//! `tests/data/sflz_reference.csv` (`sflz_reference.py`, surfalize 0.19.2).
+//! `tests/data/sflz_reference.csv` (`sflz_reference.py`, surfalize 0.19.2); and two files of
+//! the earlier layout (`sflz_earlier_fixture.py`, surfalize 0.17.1), reference
+//! `tests/data/sflz_earlier_reference.csv` (the same script run with surfalize 0.17.1).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -180,6 +182,10 @@ fn jpk_tiffs_read_as_afmreader_reads_them() {
 fn sflz_files_read_as_surfalize_reads_them() {
     let dir = crate::common::root().join("fixtures/sflz");
     assert_eq!(compare(&dir, "sflz_reference.csv"), 3);
+    // The earlier layout (surfalize 0.17.1), as that version reads it.
+    assert_eq!(compare(&dir, "sflz_earlier_reference.csv"), 2);
+    let map = read_height_map(&dir.join("earlier_zlib_u4.sflz"), &ReadOptions::default()).unwrap();
+    assert_eq!(map.channels, ["topography", "Camera"]);
     // The camera image beside the heights is listed, not read as heights.
     let map = read_height_map(&dir.join("lzma_f8.sflz"), &ReadOptions::default()).unwrap();
     assert_eq!(map.channels, ["topography", "Camera"]);

@@ -163,6 +163,12 @@ pub const TEMPLATES: &[Template] = &[
         ["topography", "t.sflz", "--json"]
     ),
     t!(
+        "topography-sflz-earlier",
+        ["t-earlier.sflz"],
+        ["t-earlier.sflz"],
+        ["topography", "t-earlier.sflz", "--json"]
+    ),
+    t!(
         "topography-sflz-lzma",
         ["t-lzma.sflz"],
         ["t-lzma.sflz"],

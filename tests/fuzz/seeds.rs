@@ -221,6 +221,7 @@ pub fn build(dir: &Path) {
         ("jpk/tiny.h5-jpk", "t.h5-jpk"),
         ("sflz/zlib_u4.sflz", "t.sflz"),
         ("sflz/lzma_f8.sflz", "t-lzma.sflz"),
+        ("sflz/earlier_zlib_u4.sflz", "t-earlier.sflz"),
         ("createc/A250407.141806.dat", "t-createc.dat"),
     ] {
         fs::copy(

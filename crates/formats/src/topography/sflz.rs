@@ -1,5 +1,5 @@
 //! surfalize `.sflz`, the native format of the surfalize Python package (version 1.0 of the
-//! layout, as its `surfalize.file.sflz` module writes it since 0.19): little-endian throughout.
+//! layout, as its `surfalize.file.sflz` module writes it in 0.19.2): little-endian throughout.
 //!
 //! | bytes | field |
 //! |---|---|
@@ -18,6 +18,15 @@
 //! linearly onto [minimum, maximum]; with `has_nan` the dtype's largest value marks an invalid
 //! point and the one below it is the maximum. The height layer (`topography`) is in the file's
 //! unit; other layers are camera images and are listed as channels but not read as heights.
+//!
+//! The earlier layout (as surfalize 0.17.1 writes it, also version `1.0`) is told apart by what
+//! follows the steps: a scaling flag (a byte 0 or 1, where a unit starts with a letter) and the
+//! height range (f64 minimum, maximum) instead of a unit, then
+//! the counts and the compression, no metadata; its layers have no height flag (the first,
+//! named `topography`, is the heights), a 3-byte dtype, and are in µm. Its integer heights map
+//! the dtype's range onto [minimum, maximum] as its writer maps them (surfalize's reader of that
+//! layout adds the dtype's minimum instead of subtracting it: the same for unsigned types, its
+//! default, and wrong for signed ones).
 
 use std::io::Read;
 use std::path::Path;
@@ -113,7 +122,20 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
     let mut r = Reader::new(path, data, MAGIC.len() + 10);
     let step_x = r.f64()?;
     let step_y = r.f64()?;
-    let unit = padded_text(r.take(8)?);
+    // The layout of 0.19 has the unit here; the earlier one (also "1.0") a scaling flag and
+    // the height range, in µm.
+    // A unit is text; the earlier layout's scaling flag is a byte 0 or 1.
+    let unit_field = slice(path, data, r.pos, 8, "the SFLZ header")?;
+    let earlier = unit_field[0] <= 1;
+    let unit_field = padded_text(unit_field);
+    let (unit, scaling) = if earlier {
+        let scaled = r.u8()? != 0;
+        let (min, max) = (r.f64()?, r.f64()?);
+        ("um".to_string(), Some((scaled, min, max)))
+    } else {
+        r.take(8)?;
+        (unit_field, None)
+    };
     let layers = usize::from(r.u16()?);
     let _entries = r.u16()?;
     let compression = r.u8()?;
@@ -123,14 +145,19 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
             format!("SFLZ compression {compression} is none of 0 (none), 1 (zlib), 2 (LZMA)"),
         ));
     }
-    let metadata = r.usize_u32()?;
-    r.take(metadata)?;
+    if !earlier {
+        let metadata = r.usize_u32()?;
+        r.take(metadata)?;
+    }
     if layers == 0 {
         return Err(bad(path, "the SFLZ file holds no layer"));
     }
     let mut found = Vec::new();
-    for _ in 0..layers.min(MAX_LAYERS) {
-        found.push(layer(path, &mut r)?);
+    for k in 0..layers.min(MAX_LAYERS) {
+        found.push(match scaling {
+            None => layer(path, &mut r)?,
+            Some(scaling) => earlier_layer(path, &mut r, k, scaling)?,
+        });
     }
     let channels: Vec<ChannelEntry> = found
         .iter()
@@ -225,6 +252,41 @@ fn layer<'a>(path: &Path, r: &mut Reader<'a>) -> Result<Layer<'a>> {
         dtype,
         scaled,
         has_nan,
+        min,
+        max,
+        payload,
+    })
+}
+
+/// The next layer of the earlier layout: no height flag (the first layer, when it is named
+/// `topography`, holds the heights), a 3-byte dtype, and the file header's scaling.
+fn earlier_layer<'a>(
+    path: &Path,
+    r: &mut Reader<'a>,
+    k: usize,
+    (scaled, min, max): (bool, f64, f64),
+) -> Result<Layer<'a>> {
+    let name_len = usize::from(r.u16()?);
+    let name = String::from_utf8_lossy(r.take(name_len)?).into_owned();
+    let width = count(path, "SFLZ layer width", f64::from(r.u32()?))?;
+    let height = count(path, "SFLZ layer height", f64::from(r.u32()?))?;
+    let channels = usize::from(r.u8()?);
+    if channels == 0 {
+        return Err(bad(path, format!("SFLZ layer '{name}' has 0 channels")));
+    }
+    let dtype = Dtype::parse(path, r.take(3)?)?;
+    let size = r.usize_u32()?;
+    let payload = r.take(size)?;
+    let is_height = k == 0 && name == "topography";
+    Ok(Layer {
+        is_height,
+        scaled: is_height && scaled,
+        name,
+        width,
+        height,
+        channels,
+        dtype,
+        has_nan: false,
         min,
         max,
         payload,
