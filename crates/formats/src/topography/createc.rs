@@ -40,6 +40,9 @@ pub(crate) const MAGIC: &[u8] = b"[Paramco32]";
 /// Longest header looked through for the `DATA` line (bytes; Createc's is 16 kB).
 const MAX_HEADER: usize = 1 << 20;
 
+/// Most planes read (Createc's software saves tens), checked before they are named.
+const MAX_PLANES: usize = 4096;
+
 /// What a plane holds.
 #[derive(Clone, Copy, PartialEq, Debug)]
 enum Signal {
@@ -76,6 +79,12 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
     let nx = count(path, "Createc Num.X", number("Num.X")?)?;
     let ny = count(path, "Createc Num.Y", number("Num.Y")?)?;
     let planes = count(path, "Createc Channels", number("Channels")?)?;
+    if planes > MAX_PLANES {
+        return Err(unsupported(
+            path,
+            format!("Createc Channels is {planes}; at most {MAX_PLANES} planes are read"),
+        ));
+    }
     if nx < 2 {
         return Err(bad(
             path,
@@ -387,6 +396,7 @@ mod tests {
                 "sine mode",
             ),
             ("Channels=2", "Channels=9", "truncated"),
+            ("Channels=2", "Channels=99999999", "at most 4096 planes"),
         ] {
             let mut edited = text.replace(from, to).into_bytes();
             edited.resize(512, 0);
