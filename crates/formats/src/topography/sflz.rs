@@ -154,10 +154,7 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
     }
     let mut found = Vec::new();
     for k in 0..layers.min(MAX_LAYERS) {
-        found.push(match scaling {
-            None => layer(path, &mut r)?,
-            Some(scaling) => earlier_layer(path, &mut r, k, scaling)?,
-        });
+        found.push(layer(path, &mut r, k, scaling)?);
     }
     let channels: Vec<ChannelEntry> = found
         .iter()
@@ -225,68 +222,43 @@ fn padded_text(field: &[u8]) -> String {
         .to_string()
 }
 
-/// The next layer's header and its payload's bytes.
-fn layer<'a>(path: &Path, r: &mut Reader<'a>) -> Result<Layer<'a>> {
+/// The next layer's header and its payload's bytes. `earlier` is the file header's scaling of
+/// the earlier layout (module docs), whose layers have no height flag (the first, when it is
+/// named `topography`, holds the heights), a 3-byte dtype and no scaling of their own.
+fn layer<'a>(
+    path: &Path,
+    r: &mut Reader<'a>,
+    k: usize,
+    earlier: Option<(bool, f64, f64)>,
+) -> Result<Layer<'a>> {
     let name_len = usize::from(r.u16()?);
     let name = String::from_utf8_lossy(r.take(name_len)?).into_owned();
-    let is_height = r.u8()? != 0;
+    let flag = match earlier {
+        None => r.u8()? != 0,
+        Some(_) => k == 0 && name == "topography",
+    };
     let width = count(path, "SFLZ layer width", f64::from(r.u32()?))?;
     let height = count(path, "SFLZ layer height", f64::from(r.u32()?))?;
     let channels = usize::from(r.u8()?);
     if channels == 0 {
         return Err(bad(path, format!("SFLZ layer '{name}' has 0 channels")));
     }
-    let dtype = Dtype::parse(path, r.take(4)?)?;
-    let scaled = r.u8()? != 0;
-    let has_nan = r.u8()? != 0;
-    let min = r.f64()?;
-    let max = r.f64()?;
+    let dtype = Dtype::parse(path, r.take(if earlier.is_some() { 3 } else { 4 })?)?;
+    let (scaled, has_nan, min, max) = match earlier {
+        None => (r.u8()? != 0, r.u8()? != 0, r.f64()?, r.f64()?),
+        Some((scaled, min, max)) => (flag && scaled, false, min, max),
+    };
     let size = r.usize_u32()?;
     let payload = r.take(size)?;
     Ok(Layer {
         name,
-        is_height,
+        is_height: flag,
         width,
         height,
         channels,
         dtype,
         scaled,
         has_nan,
-        min,
-        max,
-        payload,
-    })
-}
-
-/// The next layer of the earlier layout: no height flag (the first layer, when it is named
-/// `topography`, holds the heights), a 3-byte dtype, and the file header's scaling.
-fn earlier_layer<'a>(
-    path: &Path,
-    r: &mut Reader<'a>,
-    k: usize,
-    (scaled, min, max): (bool, f64, f64),
-) -> Result<Layer<'a>> {
-    let name_len = usize::from(r.u16()?);
-    let name = String::from_utf8_lossy(r.take(name_len)?).into_owned();
-    let width = count(path, "SFLZ layer width", f64::from(r.u32()?))?;
-    let height = count(path, "SFLZ layer height", f64::from(r.u32()?))?;
-    let channels = usize::from(r.u8()?);
-    if channels == 0 {
-        return Err(bad(path, format!("SFLZ layer '{name}' has 0 channels")));
-    }
-    let dtype = Dtype::parse(path, r.take(3)?)?;
-    let size = r.usize_u32()?;
-    let payload = r.take(size)?;
-    let is_height = k == 0 && name == "topography";
-    Ok(Layer {
-        is_height,
-        scaled: is_height && scaled,
-        name,
-        width,
-        height,
-        channels,
-        dtype,
-        has_nan: false,
         min,
         max,
         payload,
