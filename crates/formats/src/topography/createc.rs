@@ -30,7 +30,9 @@ use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
-use super::{choose, count, grid_bytes, height_map, ChannelEntry, HeightMap, TopographyFormat};
+use super::{
+    choose, count, grid_bytes, height_map, positive, ChannelEntry, HeightMap, TopographyFormat,
+};
 use crate::binary::{bad, unsupported};
 use crate::error::Result;
 
@@ -97,8 +99,8 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
             "a Createc scan in sine mode (its lines are not evenly spaced): not read",
         ));
     }
-    let lx = positive_length(path, "Length x[A]", number("Length x[A]")?)?;
-    let ly = positive_length(path, "Length y[A]", number("Length y[A]")?)?;
+    let lx = positive(path, "Createc 'Length x[A]'", number("Length x[A]")?)?;
+    let ly = positive(path, "Createc 'Length y[A]'", number("Length y[A]")?)?;
     let names = plane_names(planes, optional("Channelselectval"));
     let channels: Vec<ChannelEntry> = names
         .iter()
@@ -160,7 +162,7 @@ pub fn read(path: &Path, data: &[u8], channel: Option<&str>) -> Result<HeightMap
             "no line of the Createc scan was recorded (the first plane is all zeros)",
         ));
     }
-    let scale = z_metres_per_count(&optional);
+    let scale = z_metres_per_count(path, &header, &optional)?;
     let values = plane(index);
     let heights: Vec<f64> = values
         .chunks_exact(nx)
@@ -190,30 +192,39 @@ fn parse_header(text: &[u8]) -> HashMap<String, String> {
         .collect()
 }
 
-/// A length from the header (Å), positive and finite.
-fn positive_length(path: &Path, key: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(bad(
-            path,
-            format!("Createc header '{key}' is {v}; it must be positive"),
-        ))
-    }
-}
-
-/// Metres per DAC count of a Z plane (module docs).
-fn z_metres_per_count(optional: &dyn Fn(&str) -> Option<f64>) -> f64 {
+/// Metres per DAC count of a Z plane (module docs); a calibration that is not positive (a gain
+/// or `Dacto[A]z` of 0) is an error, not a flat map.
+fn z_metres_per_count(
+    path: &Path,
+    header: &HashMap<String, String>,
+    optional: &dyn Fn(&str) -> Option<f64>,
+) -> Result<f64> {
     let gain = optional("GainZ").unwrap_or(10.0) / 10.0;
-    match optional("Dacto[A]z") {
+    let scale = match optional("Dacto[A]z") {
         Some(nm_per_count) => nm_per_count * gain * 1e-9,
         None => {
-            let bits = optional("DAC-Type").unwrap_or(20.0);
+            // `DAC-Type=20bit`: the number of bits leads the value.
+            let bits: f64 = header
+                .get("DAC-Type")
+                .map(|t| {
+                    t.trim()
+                        .chars()
+                        .take_while(char::is_ascii_digit)
+                        .collect::<String>()
+                })
+                .and_then(|d| d.parse().ok())
+                .filter(|b| (8.0..=32.0).contains(b))
+                .unwrap_or(20.0);
             let volts_per_count = 10.0 / 2f64.powf(bits);
             let nm_per_volt = optional("ZPiezoconst").unwrap_or(19.2);
             2.0 * volts_per_count * nm_per_volt * gain * 1e-9
         }
-    }
+    };
+    positive(
+        path,
+        "Createc Z calibration (Dacto[A]z × GainZ/10, m per count)",
+        scale,
+    )
 }
 
 /// The lines of a plane that were scanned: up to the last line with a recorded (non-zero,
@@ -396,6 +407,7 @@ mod tests {
                 "sine mode",
             ),
             ("Channels=2", "Channels=9", "truncated"),
+            ("GainZ=5", "GainZ=0", "Z calibration"),
             ("Channels=2", "Channels=99999999", "at most 4096 planes"),
         ] {
             let mut edited = text.replace(from, to).into_bytes();

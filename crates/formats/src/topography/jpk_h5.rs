@@ -9,7 +9,7 @@
 //! A channel's values are `raw · multiplier + offset` of its `net-encoder.scaling` attributes,
 //! in `net-encoder.scaling.unit.unit`: the product of its calibration chain up to its default
 //! slot (for a height: encoder volts → nominal → calibrated metres, the numbers JPK's own
-//! software shows, and the scaling AFMReader applies). Channels are named as the JPK TIFF
+//! software shows, and the scaling AFMReader applies); a channel without it is listed, not read. Channels are named as the JPK TIFF
 //! reader names them, with their direction and, for a video, the frame: `height (trace)`,
 //! `height (retrace, frame 3)`. Lines are flipped so that row 0 is the top of the image. The
 //! pixel size is `ulength/ilength` by `vlength/jlength`. A phase in degrees or a signal in volts
@@ -21,7 +21,7 @@ use hdf5_reader::group::Group;
 use hdf5_reader::Attribute;
 
 use super::{choose, grid_bytes, height_map, length_factor, ChannelEntry, HeightMap};
-use super::{count, TopographyFormat};
+use super::{count, positive, TopographyFormat};
 use crate::binary::{bad, unsupported};
 use crate::error::Result;
 
@@ -36,7 +36,7 @@ struct Entry {
     dataset: hdf5_reader::Dataset,
     frame: usize,
     frames: usize,
-    scaling: (f64, f64),
+    scaling: Option<(f64, f64)>,
 }
 
 /// A measurement's scan grid.
@@ -63,26 +63,13 @@ pub(super) fn read(
     channel: Option<&str>,
     h5: &dyn Fn(hdf5_reader::error::Error) -> crate::error::Error,
 ) -> Result<HeightMap> {
-    let mut measurements: Vec<Group> = root
-        .groups()
-        .map_err(h5)?
-        .into_iter()
-        .filter(|g| g.name().starts_with("Measurement_"))
-        .collect();
-    measurements.sort_by(|a, b| a.name().cmp(b.name()));
+    let measurements = children(root, "Measurement_", h5)?;
     let several = measurements.len() > 1;
     let mut entries = Vec::new();
     for m in &measurements {
         let attrs = m.attributes().map_err(h5)?;
         let grid = grid(path, &attrs)?;
-        let mut groups: Vec<Group> = m
-            .groups()
-            .map_err(h5)?
-            .into_iter()
-            .filter(|g| g.name().starts_with("Channel_"))
-            .collect();
-        groups.sort_by(|a, b| a.name().cmp(b.name()));
-        for g in groups {
+        for g in children(m, "Channel_", h5)? {
             let attrs = g.attributes().map_err(h5)?;
             let Some(name) = text(&attrs, "channel.name") else {
                 continue;
@@ -108,10 +95,11 @@ pub(super) fn read(
                     ),
                 ));
             }
-            let scaling = (
-                number(&attrs, "net-encoder.scaling.multiplier").unwrap_or(1.0),
-                number(&attrs, "net-encoder.scaling.offset").unwrap_or(0.0),
-            );
+            // Without its scaling a channel's counts have no unit (it is listed, not read).
+            let scaling = number(&attrs, "net-encoder.scaling.multiplier").map(|multiplier| {
+                let offset = number(&attrs, "net-encoder.scaling.offset").unwrap_or(0.0);
+                (multiplier, offset)
+            });
             let unit = text(&attrs, "net-encoder.scaling.unit.unit").unwrap_or_default();
             for frame in 0..frames {
                 let mut label = format!("{name} ({direction}");
@@ -138,7 +126,7 @@ pub(super) fn read(
         .iter()
         .map(|e| ChannelEntry {
             name: e.name.clone(),
-            height: length_factor(&e.unit).is_some(),
+            height: e.scaling.is_some() && length_factor(&e.unit).is_some(),
         })
         .collect();
     let index = choose(path, &channels, channel)?;
@@ -173,7 +161,12 @@ pub(super) fn read(
             ),
         ));
     }
-    let (multiplier, offset) = e.scaling;
+    let (multiplier, offset) = e.scaling.ok_or_else(|| {
+        bad(
+            path,
+            format!("JPK channel '{}' states no net-encoder scaling", e.name),
+        )
+    })?;
     let mut heights = Vec::with_capacity(nx * ny);
     for line in (0..ny).rev() {
         for column in 0..nx {
@@ -189,6 +182,22 @@ pub(super) fn read(
         heights,
         (dx_m, dy_m),
     )
+}
+
+/// The groups below `group` whose names start with `prefix`, in name order.
+fn children(
+    group: &Group,
+    prefix: &str,
+    h5: &dyn Fn(hdf5_reader::error::Error) -> crate::error::Error,
+) -> Result<Vec<Group>> {
+    let mut found: Vec<Group> = group
+        .groups()
+        .map_err(h5)?
+        .into_iter()
+        .filter(|g| g.name().starts_with(prefix))
+        .collect();
+    found.sort_by(|a, b| a.name().cmp(b.name()));
+    Ok(found)
 }
 
 /// The scan grid a measurement group states.
@@ -210,14 +219,7 @@ fn grid(path: &Path, attrs: &[Attribute]) -> Result<Grid> {
     let factor = length_factor(&unit)
         .ok_or_else(|| bad(path, format!("JPK scan grid in '{unit}', not a length")))?;
     let length = |key: &str| -> Result<f64> {
-        let v = need(key)?;
-        match v.is_finite() && v > 0.0 {
-            true => Ok(v * factor),
-            false => Err(bad(
-                path,
-                format!("JPK '{key}' is {v}; it must be positive"),
-            )),
-        }
+        Ok(positive(path, &format!("JPK '{key}'"), need(key)?)? * factor)
     };
     Ok(Grid {
         nx,

@@ -307,6 +307,16 @@ fn decode(path: &Path, layer: &Layer, compression: u8) -> Result<Vec<f64>> {
             ),
         ));
     }
+    // A range that is not one (max below min, NaN) would map every point onto the minimum.
+    if !(layer.min.is_finite() && layer.max.is_finite() && layer.max >= layer.min) {
+        return Err(bad(
+            path,
+            format!(
+                "SFLZ layer '{}' states the height range {} … {}",
+                layer.name, layer.min, layer.max
+            ),
+        ));
+    }
     let (lo, hi) = d.int_range();
     let top = if layer.has_nan { hi - 1.0 } else { hi };
     let levels = top - lo;
@@ -513,5 +523,10 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("holds 12 bytes"), "{err}");
+        let reversed = body((2, 2), "<u4", (true, false), (1.0, 0.0), &zlib(&q[..16]));
+        let err = read(p, &sflz("um", 1, &[("topography", true, reversed)]), None)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("height range 1 … 0"), "{err}");
     }
 }
