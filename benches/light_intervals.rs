@@ -27,6 +27,9 @@
 //! cargo bench --bench light_intervals                    # 20 series per cell, both generators
 //! cargo bench --bench light_intervals -- --seeds 40 --only series
 //! cargo bench --bench light_intervals -- --only solved --seeds 20
+//! # a part of the table: scales by name (series: sub-PSF, PSF-sized, coarse; solved: sub_psf,
+//! # psf_sized, coarse, cloud), PSF FWHMs in nm, and seeds from 20 on (held out)
+//! cargo bench --bench light_intervals -- --only solved --scales sub_psf --psfs 600,750 --first-seed 20
 //! ```
 
 #[path = "support.rs"]
@@ -37,7 +40,7 @@ use contactscope::analysis::bootstrap::joint_fit_intervals;
 use contactscope::analysis::corrected::{correct_series, Assumptions};
 use contactscope::analysis::fit::fit_power_law;
 use contactscope::analysis::{analyze, AnalysisOptions};
-use contactscope::image::Plane;
+use contactscope::image::{PixelSize, PixelSizeSource, Plane};
 use contactscope::optics::blur::FWHM_PER_SIGMA;
 use contactscope::synth::solved::{
     image_ramp, solve_ramp, Camera, ContactRamp, PatchScale, RampSpec,
@@ -109,7 +112,7 @@ fn rank(k: usize, n: usize) -> usize {
 }
 
 /// Analyse one series as `analyze` does and score it against its truth.
-fn score(s: &Series, sigma_px: f64) -> Tally {
+fn score(s: &Series, sigma_px: f64, pixel_m: f64) -> Tally {
     let planes: Vec<Plane> = s
         .codes
         .iter()
@@ -117,6 +120,11 @@ fn score(s: &Series, sigma_px: f64) -> Tally {
         .collect();
     let options = AnalysisOptions {
         psf_sigma_px: Some(sigma_px),
+        pixel_size: Some(PixelSize {
+            x_m: pixel_m,
+            y_m: pixel_m,
+            source: PixelSizeSource::CommandLine,
+        }),
         light_budgets: true,
         ..AnalysisOptions::default()
     };
@@ -220,18 +228,23 @@ fn header(title: &str) {
 /// Score every cell of one scale; `make(psf, px, photons, seed)` gives a series.
 fn table(
     title: &str,
-    seeds: u64,
+    seeds: std::ops::Range<u64>,
     make: &(dyn Fn(f64, f64, f64, u64) -> Series + Sync),
 ) -> Vec<(String, Tally)> {
     header(title);
     let mut all = Vec::new();
     let mut pooled = Tally::default();
-    for psf in PSFS_NM {
+    let psfs = list("--psfs", &PSFS_NM);
+    for psf in psfs {
         for px in PIXELS_NM {
             for photons in PHOTONS {
-                let tallies: Vec<Tally> = (0..seeds)
+                let tallies: Vec<Tally> = seeds
+                    .clone()
                     .into_par_iter()
-                    .map(|seed| score(&make(psf, px, photons, seed), psf / FWHM_PER_SIGMA / px))
+                    .map(|seed| {
+                        let s = make(psf, px, photons, seed);
+                        score(&s, psf / FWHM_PER_SIGMA / px, px * 1e-9)
+                    })
                     .collect();
                 let mut t = Tally::default();
                 for x in tallies {
@@ -306,20 +319,45 @@ fn solved_generator(r: &ContactRamp, psf: f64, px: f64, photons: f64) -> Series 
     }
 }
 
+/// The numbers after `name` (`--psfs 600,750`), else `all`.
+fn list(name: &str, all: &[f64]) -> Vec<f64> {
+    let given: String = arg(name, String::new());
+    let v: Vec<f64> = given
+        .split(',')
+        .filter_map(|x| x.trim().parse().ok())
+        .collect();
+    if v.is_empty() {
+        all.to_vec()
+    } else {
+        v
+    }
+}
+
+/// Whether the scale named `name` was asked for (`--scales sub_psf,coarse`; all by default).
+fn wanted(name: &str) -> bool {
+    let given: String = arg("--scales", String::new());
+    given.is_empty() || given.split(',').any(|x| x.trim() == name)
+}
+
 fn main() {
-    let seeds: u64 = arg("--seeds", 20);
+    let count: u64 = arg("--seeds", 20);
+    let first: u64 = arg("--first-seed", 0);
+    let seeds = first..first + count;
     let only: String = arg("--only", String::from("both"));
     let cache: PathBuf = arg("--cache", PathBuf::from("target/solved-ramps"));
     let started = std::time::Instant::now();
     println!(
-        "area and exponent intervals on two generators: {seeds} series per cell, assumptions {:?}",
+        "area and exponent intervals on two generators: seeds {seeds:?} per cell, assumptions {:?}",
         Assumptions::default()
     );
     let mut cells = Vec::new();
     if only != "solved" {
         for (scale, name) in [(0.25, "sub-PSF"), (0.6, "PSF-sized"), (2.0, "coarse")] {
+            if !wanted(name) {
+                continue;
+            }
             let title = format!("series generator, {name} patches (scale {scale})");
-            cells.extend(table(&title, seeds, &|psf, px, ph, seed| {
+            cells.extend(table(&title, seeds.clone(), &|psf, px, ph, seed| {
                 series_generator(scale, psf, px, ph, seed)
             }));
         }
@@ -331,7 +369,11 @@ fn main() {
             Some(PatchScale::Coarse),
             None,
         ] {
-            let ramps: Vec<ContactRamp> = (0..seeds)
+            if !wanted(scale.map_or("cloud", |s| s.name())) {
+                continue;
+            }
+            let ramps: Vec<ContactRamp> = seeds
+                .clone()
                 .into_par_iter()
                 .map(|seed| ramp(&cache, scale, seed))
                 .collect();
@@ -339,8 +381,8 @@ fn main() {
                 Some(s) => format!("solved generator, paper preset, {} patches", s.name()),
                 None => "solved generator, cloud preset (stress case, not carried)".to_string(),
             };
-            let found = table(&title, seeds, &|psf, px, ph, seed| {
-                solved_generator(&ramps[seed as usize], psf, px, ph)
+            let found = table(&title, seeds.clone(), &|psf, px, ph, seed| {
+                solved_generator(&ramps[(seed - first) as usize], psf, px, ph)
             });
             if scale.is_some() {
                 cells.extend(found);

@@ -167,6 +167,9 @@ pub struct AreaIntervalFacts {
     /// How far above the top reading of an interior the signal may lie, in units of the gap
     /// between its top and mean readings; `None` for the edge band.
     pub porosity: Option<f64>,
+    /// The smallest correlation area of a contact interior's holes the signal's range allows
+    /// for (the porosity a wide PSF hides), µm²; `None` for the edge band.
+    pub hole_area_um2: Option<f64>,
     /// Joint draws behind each interval; `None` for the edge band.
     pub draws: Option<usize>,
     /// Half-width w of the edge band's levels, as a fraction of the contact signal; `None` for
@@ -221,6 +224,7 @@ impl AreaIntervalFacts {
             psf_source: psf.source,
             signal_trend_exponent: light.map(|l| l.gamma_range()),
             porosity: light.map(|l| l.assumptions().porosity),
+            hole_area_um2: light.map(|l| l.assumptions().hole_area_um2),
             draws: light.map(|_| contactscope::analysis::corrected::DRAWS),
             band_half_width: light.is_none().then_some(EDGE_BAND_HALF_WIDTH),
             noise_sd_multiple: light.is_none().then_some(NOISE_WIDENING),
@@ -235,11 +239,13 @@ impl AreaIntervalFacts {
             not_included: match (light.is_some(), u > 0.0) {
                 (true, true) => {
                     "the forces' calibration; a contact signal that varies over a contact by \
-                     more than the illumination's 1 %"
+                     more than the illumination's 1 %; holes in a contact's interior finer than \
+                     hole_area_um2"
                 }
                 (true, false) => {
                     "the pixel size's calibration; the forces' calibration; a contact signal \
-                     that varies over a contact by more than the illumination's 1 %"
+                     that varies over a contact by more than the illumination's 1 %; holes in a \
+                     contact's interior finer than hole_area_um2"
                 }
                 (false, true) => {
                     "the forces' calibration; what the PSF does to patches near its size \
