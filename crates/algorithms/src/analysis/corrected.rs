@@ -81,10 +81,12 @@ pub struct Assumptions {
     /// texture.
     pub porosity: f64,
     /// The smallest correlation area of an interior's holes, µm² (module docs: the hidden
-    /// porosity). A hole much narrower than about 100 nm in a rough elastic contact is only a
-    /// few nanometres deep, within the rigidochromic detection gap (9 nm, Weber et al. 2018):
-    /// it fluoresces as contact. Without a pixel size it is taken as
-    /// [`HOLE_SHARE_OF_PSF`] of the PSF's area 4πσ².
+    /// porosity). The reasoning: a hole much narrower than about 100 nm opens by roughly the
+    /// surface's slope times its width, a few nanometres, within the rigidochromic detection gap
+    /// (9 nm, Weber et al. 2018), and fluoresces as contact (an estimate, not measured). The
+    /// value sits below the 0.011 µm² the solver-made sub-PSF contacts of seeds 0–19 needed
+    /// (`docs/validation.md` B25) and was checked on seeds 20–39. Without a pixel size it is
+    /// taken as [`HOLE_SHARE_OF_PSF`] of the PSF's area 4πσ².
     pub hole_area_um2: f64,
 }
 
