@@ -30,6 +30,8 @@
 //! # a part of the table: scales by name (series: sub-PSF, PSF-sized, coarse; solved: sub_psf,
 //! # psf_sized, coarse, cloud), PSF FWHMs in nm, and seeds from 20 on (held out)
 //! cargo bench --bench light_intervals -- --only solved --scales sub_psf --psfs 600,750 --first-seed 20
+//! # one cell, every image whose interval misses its truth printed
+//! cargo bench --bench light_intervals -- --only solved --scales sub_psf --psfs 600 --pixels 100 --photons 20 --misses
 //! ```
 
 #[path = "support.rs"]
@@ -112,7 +114,7 @@ fn rank(k: usize, n: usize) -> usize {
 }
 
 /// Analyse one series as `analyze` does and score it against its truth.
-fn score(s: &Series, sigma_px: f64, pixel_m: f64) -> Tally {
+fn score(s: &Series, sigma_px: f64, pixel_m: f64, label: &str) -> Tally {
     let planes: Vec<Plane> = s
         .codes
         .iter()
@@ -153,7 +155,14 @@ fn score(s: &Series, sigma_px: f64, pixel_m: f64) -> Tally {
         t.pixel_err[r].push(pixels / truth - 1.0);
         match correction.areas[k] {
             Some(c) => {
-                t.covered[r] += usize::from(c.lo_px <= truth && truth <= c.hi_px);
+                let held = c.lo_px <= truth && truth <= c.hi_px;
+                if !held && show_misses() {
+                    eprintln!(
+                        "miss {label} image {k}: truth {truth:.0} px, interval [{:.0}, {:.0}], corrected {:.0} ({:?}, signal {:.0}), pixel count {pixels:.0}",
+                        c.lo_px, c.hi_px, c.area_px, c.source, c.signal
+                    );
+                }
+                t.covered[r] += usize::from(held);
                 t.widths[r].push((c.hi_px - c.lo_px) / truth);
                 t.corrected_err[r].push(c.area_px / truth - 1.0);
             }
@@ -236,14 +245,16 @@ fn table(
     let mut pooled = Tally::default();
     let psfs = list("--psfs", &PSFS_NM);
     for psf in psfs {
-        for px in PIXELS_NM {
-            for photons in PHOTONS {
+        for px in list("--pixels", &PIXELS_NM) {
+            for photons in list("--photons", &PHOTONS) {
                 let tallies: Vec<Tally> = seeds
                     .clone()
                     .into_par_iter()
                     .map(|seed| {
                         let s = make(psf, px, photons, seed);
-                        score(&s, psf / FWHM_PER_SIGMA / px, px * 1e-9)
+                        let label =
+                            format!("{title} ({psf:.0}, {px:.0}, {photons:.0}) seed {seed}");
+                        score(&s, psf / FWHM_PER_SIGMA / px, px * 1e-9, &label)
                     })
                     .collect();
                 let mut t = Tally::default();
@@ -331,6 +342,11 @@ fn list(name: &str, all: &[f64]) -> Vec<f64> {
     } else {
         v
     }
+}
+
+/// Whether `--misses` was given: every image whose interval misses its truth is printed.
+fn show_misses() -> bool {
+    std::env::args().any(|a| a == "--misses")
 }
 
 /// Whether the scale named `name` was asked for (`--scales sub_psf,coarse`; all by default).
