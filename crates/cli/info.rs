@@ -134,7 +134,7 @@ fn tiff_axes(a: &contactscope_formats::tiff::TiffAxes) -> String {
     s.push_str(loads);
     if !a.other_files.is_empty() {
         s.push_str(&format!(
-            "; planes in other files of the OME set: {}",
+            "; planes read from other files of its OME set: {}",
             a.other_files.join(", ")
         ));
     }

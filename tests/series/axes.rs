@@ -1,6 +1,7 @@
 //! A TIFF's pages read by the axes its metadata states (issue: "no wrong number from a file's
 //! axes"): an OME-TIFF's channels are not pooled into one series, an ImageJ hyperstack's focal
-//! planes are not taken for loads, a z stack is not a load series unless told so.
+//! planes are not taken for loads, a z stack is not a load series unless told so, a multi-file
+//! OME set is read whole (once) from any of its files.
 //!
 //! The files are written here page by page with the ImageDescription each writer would give
 //! (OME-XML as tifffile writes it for axes TCYX; ImageJ's `channels/slices/frames`), and each
@@ -263,4 +264,79 @@ fn decimal_names_load_in_numeric_order_and_the_order_is_said() {
         .starts_with("file names in natural order"));
     // The areas grow with the load: no physics warning.
     assert!(!String::from_utf8_lossy(&o.stderr).contains("wrong order"));
+}
+
+/// The OME-XML of a set of two files, `names[0]` holding time points 0–1 and `names[1]` time
+/// points 2–3 (OME-TIFF specification, multi-file datasets: every file carries the same XML).
+fn set_xml(names: [&str; 2]) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?><OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06" UUID="urn:uuid:00000000-0000-0000-0000-00000000000a"><Image ID="Image:0"><Pixels ID="Pixels:0" DimensionOrder="XYCZT" Type="uint16" SizeX="{W}" SizeY="{W}" SizeC="1" SizeZ="1" SizeT="4" PhysicalSizeX="0.2" PhysicalSizeXUnit="um" PhysicalSizeY="0.2" PhysicalSizeYUnit="um"><Channel ID="Channel:0:0" SamplesPerPixel="1"/><TiffData FirstT="0" IFD="0" PlaneCount="2"><UUID FileName="{}">urn:uuid:00000000-0000-0000-0000-00000000000a</UUID></TiffData><TiffData FirstT="2" IFD="0" PlaneCount="2"><UUID FileName="{}">urn:uuid:00000000-0000-0000-0000-00000000000b</UUID></TiffData></Pixels></Image></OME>"#,
+        names[0], names[1]
+    )
+}
+
+#[test]
+fn a_multi_file_ome_set_is_read_whole_from_any_of_its_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let radii = [4.0, 7.0, 10.0, 13.0];
+    let planes: Vec<Vec<u16>> = radii.iter().map(|&r| disk(r, 2000, 0)).collect();
+    let set = tmp.path().join("set");
+    std::fs::create_dir(&set).unwrap();
+    let names = ["load_0.ome.tif", "load_1.ome.tif"];
+    let xml = set_xml(names);
+    write_tiff(&set.join(names[0]), &planes[..2], &xml);
+    write_tiff(&set.join(names[1]), &planes[2..], &xml);
+    let plain = tmp.path().join("plain.tif");
+    write_tiff(&plain, &planes, "plain pages");
+    let forces = "4,10,20,40mN";
+    let alone = tmp.path().join("alone");
+    analyze(&plain, &alone, &["--forces", forces]);
+
+    // Either file gives the four time points; the folder of both gives them once.
+    for (k, input) in [set.join(names[0]), set.join(names[1]), set.clone()]
+        .iter()
+        .enumerate()
+    {
+        let out = tmp.path().join(format!("set-{k}"));
+        analyze(input, &out, &["--forces", forces]);
+        assert_eq!(areas(&out), areas(&alone), "{}", input.display());
+        assert_eq!(threshold(&out), threshold(&alone));
+    }
+    // The images read from the other file say so.
+    let (header, rows) = crate::common::read_csv(&tmp.path().join("set-0").join("areas.csv"));
+    let image = header.iter().position(|h| h == "image").unwrap();
+    assert!(rows[0][image].contains(names[0]), "{:?}", rows[0]);
+    assert!(rows[3][image].contains(names[1]), "{:?}", rows[3]);
+
+    // A file of the set without the other: one line naming the missing file.
+    let lone = tmp.path().join("lone");
+    std::fs::create_dir(&lone).unwrap();
+    std::fs::copy(set.join(names[0]), lone.join(names[0])).unwrap();
+    let e = refused(&["analyze", s(&lone.join(names[0])), "--forces", forces]);
+    assert!(e.contains(names[1]) && e.contains("not in"), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+    // A set that names a file outside its folder is refused.
+    let escape = tmp.path().join("escape");
+    std::fs::create_dir(&escape).unwrap();
+    write_tiff(
+        &escape.join("a.ome.tif"),
+        &planes[..2],
+        &set_xml(["a.ome.tif", "../plain.tif"]),
+    );
+    let e = refused(&["analyze", s(&escape.join("a.ome.tif")), "--forces", forces]);
+    assert!(e.contains("leaves the file's folder"), "{e}");
+    // A file of the set whose pages are another size.
+    let odd = tmp.path().join("odd");
+    std::fs::create_dir(&odd).unwrap();
+    write_tiff(&odd.join(names[0]), &planes[..2], &xml);
+    {
+        let file = std::fs::File::create(odd.join(names[1])).unwrap();
+        let mut enc = TiffEncoder::new(file).unwrap();
+        for _ in 0..2 {
+            enc.write_image::<colortype::Gray16>(8, 8, &[300u16; 64])
+                .unwrap();
+        }
+    }
+    let e = refused(&["analyze", s(&odd.join(names[0])), "--forces", forces]);
+    assert!(e.contains(names[1]) && e.contains("8×8"), "{e}");
 }

@@ -561,11 +561,21 @@ fn read_tiff_planes(
     let info = reader.info().clone();
     let pixel_size = pixel_size_or(info.pixel_size, pixel_size_m);
     let planes = selection.tiff_planes(&info, along, default)?;
+    // The other file of a multi-file OME set last read from.
+    let mut member: Option<crate::tiff::TiffReader> = None;
     planes
         .into_iter()
-        .map(|(_, (page, sample))| {
-            let plane = reader.read_page(page, sample)?;
-            Ok(Image::of_plane(&plane, pixel_size, path, page))
+        .map(|(_, at)| {
+            let plane = if at.path == info.path {
+                reader.read_page(at.ifd, at.sample)?
+            } else {
+                if member.as_ref().is_none_or(|m| m.info().path != at.path) {
+                    member = Some(super::tiff::open_member(&info, &at.path)?);
+                }
+                let m = member.as_mut().expect("just opened");
+                m.read_page(at.ifd, at.sample)?
+            };
+            Ok(Image::of_plane(&plane, pixel_size, &at.path, at.ifd))
         })
         .collect()
 }

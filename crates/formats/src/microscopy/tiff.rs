@@ -5,7 +5,7 @@
 //! ([`super::select::Selection::tiff_planes`]).
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Component, Path, PathBuf};
 
 use super::select::{LoadAxis, SelectedPlane, Selection};
 use super::{Axes, ChannelInfo, PlaneIndex, SeriesInfo, VoxelSize};
@@ -13,11 +13,111 @@ use crate::binary::bad;
 use crate::error::Result;
 use crate::image::Plane;
 use crate::param::Param;
-use crate::tiff::{AxesSource, TiffAxes, TiffInfo, TiffReader};
+use crate::tiff::{AxesSource, Place, TiffInfo, TiffReader};
 
 /// An open TIFF.
 pub(crate) struct TiffBackend {
     reader: TiffReader,
+    /// The other file of its OME set last read from.
+    member: Option<TiffReader>,
+}
+
+/// Where a selected plane of a TIFF is read: the file (the TIFF itself, or another file of its
+/// OME set) and the page's IFD and sample there.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TiffPage {
+    /// The file holding the page.
+    pub path: PathBuf,
+    /// Its IFD in that file.
+    pub ifd: usize,
+    /// The sample of a pixel (a channel stored as samples).
+    pub sample: usize,
+}
+
+/// The path of [`TiffAxes::other_files`]`[file]`: a multi-file OME set names its files by
+/// `UUID FileName`, relative to the folder of the file whose OME-XML names them (OME-TIFF
+/// specification, "multi-file datasets"). A name that is absolute or leaves the folder (`..`)
+/// is refused, as is one no file answers to.
+pub fn set_member(info: &TiffInfo, file: usize) -> Result<PathBuf> {
+    let name = info
+        .axes
+        .other_files
+        .get(file)
+        .ok_or_else(|| bad(&info.path, format!("no file {file} in this OME-TIFF set")))?;
+    let relative = Path::new(name);
+    let plain = relative
+        .components()
+        .all(|c| matches!(c, Component::Normal(_) | Component::CurDir));
+    if name.is_empty() || !plain {
+        return Err(bad(
+            &info.path,
+            format!(
+                "its OME-XML names the file {name:?} of its set by a path that leaves the                  file's folder; a set's files are named relative to it"
+            ),
+        ));
+    }
+    let folder = info.path.parent().unwrap_or(Path::new(""));
+    let path = folder.join(relative);
+    if !path.is_file() {
+        return Err(bad(
+            &info.path,
+            format!(
+                "planes of this OME-TIFF set are stored in {name}, which is not in {}; copy                  the set's files together",
+                if folder.as_os_str().is_empty() {
+                    "this folder".to_string()
+                } else {
+                    folder.display().to_string()
+                }
+            ),
+        ));
+    }
+    Ok(path)
+}
+
+/// Open `path`, another file of `info`'s OME set, and check that its pages are planes of the
+/// same size and type.
+pub fn open_member(info: &TiffInfo, path: &Path) -> Result<TiffReader> {
+    let reader = TiffReader::open(path)?;
+    let other = reader.info();
+    if (other.width, other.height, other.sample_type) != (info.width, info.height, info.sample_type)
+    {
+        return Err(bad(
+            path,
+            format!(
+                "a file of the OME-TIFF set of {} holds {}×{} {} pages, the set {}×{} {}",
+                info.path.display(),
+                other.width,
+                other.height,
+                other.sample_type.name(),
+                info.width,
+                info.height,
+                info.sample_type.name()
+            ),
+        ));
+    }
+    Ok(reader)
+}
+
+/// Where plane (t, z, c) of a TIFF is read (module docs); an error when no page holds it.
+pub fn page_at(info: &TiffInfo, t: usize, z: usize, c: usize) -> Result<TiffPage> {
+    let (place, sample) = info.axes.place_of(t, z, c).ok_or_else(|| {
+        bad(
+            &info.path,
+            format!("no page holds plane t {t}, z {z}, c {c}"),
+        )
+    })?;
+    Ok(match place {
+        Place::Here(ifd) => TiffPage {
+            path: info.path.clone(),
+            ifd,
+            sample,
+        },
+        Place::There { file, ifd } => TiffPage {
+            path: set_member(info, file)?,
+            ifd,
+            sample,
+        },
+    })
 }
 
 /// The one series of a TIFF, with the axes its metadata states.
@@ -65,6 +165,7 @@ impl TiffBackend {
     pub(crate) fn open(path: &Path) -> Result<Self> {
         Ok(TiffBackend {
             reader: TiffReader::open(path)?,
+            member: None,
         })
     }
 
@@ -84,11 +185,21 @@ impl TiffBackend {
             AxesSource::Pages => (index.t + index.z, 0),
             _ => (index.t, index.z),
         };
-        let (page, sample) = info
-            .axes
-            .page_of(t, z, index.c)
-            .ok_or_else(|| bad(&info.path, elsewhere(&info.axes, t, z, index.c)))?;
-        self.reader.read_page(page, sample)
+        let at = page_at(info, t, z, index.c)?;
+        if at.path == info.path {
+            return self.reader.read_page(at.ifd, at.sample);
+        }
+        if self
+            .member
+            .as_ref()
+            .is_none_or(|m| m.info().path != at.path)
+        {
+            self.member = Some(open_member(info, &at.path)?);
+        }
+        self.member
+            .as_mut()
+            .expect("just opened")
+            .read_page(at.ifd, at.sample)
     }
 }
 
@@ -106,15 +217,16 @@ pub enum LoadDefault {
 }
 
 impl Selection {
-    /// The planes of a TIFF this selection names, each with its IFD and sample, in load order:
-    /// along `along`, or the axis [`LoadDefault`] gives when none is named. Pages without axis
-    /// metadata are the load axis whichever is named.
+    /// The planes of a TIFF this selection names, each with the file, IFD and sample it is read
+    /// from (another file of a multi-file OME set, [`set_member`], for a plane stored there), in
+    /// load order: along `along`, or the axis [`LoadDefault`] gives when none is named. Pages
+    /// without axis metadata are the load axis whichever is named.
     pub fn tiff_planes(
         &self,
         info: &TiffInfo,
         along: Option<LoadAxis>,
         default: LoadDefault,
-    ) -> Result<Vec<(SelectedPlane, (usize, usize))>> {
+    ) -> Result<Vec<(SelectedPlane, TiffPage)>> {
         let (path, axes) = (&info.path, &info.axes);
         let along = match along {
             Some(a) => Some(a),
@@ -133,10 +245,7 @@ impl Selection {
                     AxesSource::Pages => (t + z, 0),
                     _ => (t, z),
                 };
-                let at = axes
-                    .page_of(t, z, c)
-                    .ok_or_else(|| bad(path, elsewhere(axes, t, z, c)))?;
-                Ok((p, at))
+                Ok((p, page_at(info, t, z, c)?))
             })
             .collect()
     }
@@ -179,18 +288,5 @@ impl Selection {
             return Ok(Some(LoadAxis::Z));
         }
         Ok(None)
-    }
-}
-
-/// Why plane (t, z, c) has no page: an OME set keeps it in another file.
-pub(crate) fn elsewhere(axes: &TiffAxes, t: usize, z: usize, c: usize) -> String {
-    if axes.other_files.is_empty() {
-        format!("no page holds plane t {t}, z {z}, c {c}")
-    } else {
-        format!(
-            "plane t {t}, z {z}, c {c} is stored in another file of this OME-TIFF set ({}); \
-             select planes of this file, or open the file that holds them",
-            axes.other_files.join(", ")
-        )
     }
 }

@@ -68,12 +68,26 @@ pub struct TiffAxes {
     pub z_step_m: Option<f64>,
     /// Time between time points, s (OME `TimeIncrement`, ImageJ `finterval`).
     pub time_increment_s: Option<f64>,
-    /// The IFD of every (t, z, page channel), t slowest; `None` for a plane an OME set stores in
-    /// another file.
+    /// Where every (t, z, page channel) is, t slowest.
     #[serde(skip)]
-    table: Vec<Option<usize>>,
-    /// Files of an OME set that hold the planes this file does not.
+    table: Vec<Place>,
+    /// Files of an OME set that hold the planes this file does not, as its `UUID FileName`s
+    /// name them (relative to this file's folder).
     pub other_files: Vec<String>,
+}
+
+/// Where a plane of a TIFF's axes is stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Place {
+    /// Page (IFD) `0` of this file.
+    Here(usize),
+    /// IFD `ifd` of [`TiffAxes::other_files`]`[file]` (a multi-file OME set).
+    There {
+        /// Index into `other_files`.
+        file: usize,
+        /// The IFD in that file.
+        ifd: usize,
+    },
 }
 
 impl TiffAxes {
@@ -88,7 +102,7 @@ impl TiffAxes {
             channel_names: vec![None; samples],
             z_step_m: None,
             time_increment_s: None,
-            table: pages.iter().map(|&p| Some(p)).collect(),
+            table: pages.iter().map(|&p| Place::Here(p)).collect(),
             other_files: Vec::new(),
         }
     }
@@ -101,12 +115,20 @@ impl TiffAxes {
     /// The IFD and the sample of plane (t, z, c); `None` outside the axes or for a plane stored
     /// in another file of an OME set.
     pub fn page_of(&self, t: usize, z: usize, c: usize) -> Option<(usize, usize)> {
+        match self.place_of(t, z, c)? {
+            (Place::Here(ifd), sample) => Some((ifd, sample)),
+            (Place::There { .. }, _) => None,
+        }
+    }
+
+    /// Where plane (t, z, c) is stored, and its sample; `None` outside the axes.
+    pub fn place_of(&self, t: usize, z: usize, c: usize) -> Option<(Place, usize)> {
         if t >= self.t || z >= self.z || c >= self.c {
             return None;
         }
         let pc = self.page_channels();
-        let ifd = self.table[(t * self.z + z) * pc + c / self.samples]?;
-        Some((ifd, c % self.samples))
+        let place = *self.table.get((t * self.z + z) * pc + c / self.samples)?;
+        Some((place, c % self.samples))
     }
 
     /// The IFDs of channel `c`, time points slowest, then focal planes (planes stored in other
@@ -214,7 +236,7 @@ fn imagej_axes(
             .finterval
             .filter(|f| t > 1 && f.is_finite() && *f > 0.0),
         // ImageJ's order: channel fastest, then slice, then frame: the pages as they come.
-        table: pages.iter().map(|&p| Some(p)).collect(),
+        table: pages.iter().map(|&p| Place::Here(p)).collect(),
         other_files: Vec::new(),
     }))
 }
@@ -337,14 +359,14 @@ fn ome_axes(path: &Path, xml: &str, pages: &[usize], samples: usize) -> Result<T
         linear
     };
     let own_name = path.file_name().map(|n| n.to_string_lossy().into_owned());
-    let mut table: Vec<Option<usize>> = vec![None; planes];
+    let mut table: Vec<Place> = vec![Place::Here(0); planes];
     let mut assigned = vec![false; planes];
     let mut other_files: Vec<String> = Vec::new();
     let blocks: Vec<roxmltree::Node> = pixels.children().filter(|n| is(n, "TiffData")).collect();
     if blocks.is_empty() {
         // No TiffData: the planes fill the pages in DimensionOrder.
         for (linear, slot) in table.iter_mut().enumerate() {
-            *slot = Some(linear);
+            *slot = Place::Here(linear);
         }
         assigned.iter_mut().for_each(|a| *a = true);
     }
@@ -378,17 +400,25 @@ fn ome_axes(path: &Path, xml: &str, pages: &[usize], samples: usize) -> Result<T
             }
             _ => false,
         };
+        let foreign = match (elsewhere, file) {
+            (true, Some(f)) => Some(match other_files.iter().position(|o| *o == f) {
+                Some(i) => i,
+                None => {
+                    other_files.push(f);
+                    other_files.len() - 1
+                }
+            }),
+            _ => None,
+        };
         let start = linear_of(first);
         for k in 0..n.min(planes.saturating_sub(start)) {
             let slot = start + k;
             assigned[slot] = true;
-            table[slot] = if elsewhere { None } else { Some(ifd + k) };
-        }
-        if elsewhere {
-            let f = file.expect("elsewhere has a file");
-            if !other_files.contains(&f) {
-                other_files.push(f);
-            }
+            let ifd = ifd.checked_add(k).ok_or("an IFD overflows")?;
+            table[slot] = match foreign {
+                Some(file) => Place::There { file, ifd },
+                None => Place::Here(ifd),
+            };
         }
     }
     if let Some(missing) = assigned.iter().position(|a| !a) {
@@ -398,7 +428,8 @@ fn ome_axes(path: &Path, xml: &str, pages: &[usize], samples: usize) -> Result<T
         ));
     }
     // Every IFD named must be a full-resolution page of this file.
-    for ifd in table.iter().flatten() {
+    for place in &table {
+        let Place::Here(ifd) = place else { continue };
         if !pages.contains(ifd) {
             return Err(format!(
                 "SizeC {c} × SizeZ {z} × SizeT {t} planes need page {ifd}; the file has {} pages",
@@ -407,10 +438,10 @@ fn ome_axes(path: &Path, xml: &str, pages: &[usize], samples: usize) -> Result<T
         }
     }
     // Reorder from DimensionOrder to (t, z, c) with t slowest.
-    let mut ordered = vec![None; planes];
-    for (linear, ifd) in table.into_iter().enumerate() {
+    let mut ordered = vec![Place::Here(0); planes];
+    for (linear, place) in table.into_iter().enumerate() {
         let (pt, pz, pc) = position(linear);
-        ordered[(pt * z + pz) * page_channels + pc] = ifd;
+        ordered[(pt * z + pz) * page_channels + pc] = place;
     }
     let mut channel_names: Vec<Option<String>> = pixels
         .children()
@@ -500,6 +531,10 @@ mod tests {
         assert!(notes.is_empty(), "{notes:?}");
         assert_eq!(a.page_of(1, 0, 0), Some((1, 0)));
         assert_eq!(a.page_of(2, 0, 0), None);
+        assert_eq!(
+            a.place_of(3, 0, 0),
+            Some((Place::There { file: 0, ifd: 1 }, 0))
+        );
         assert_eq!(a.other_files, vec!["b.ome.tif".to_string()]);
         // A plane no block places: the XML is not trusted.
         let inner = r#"<TiffData IFD="0" PlaneCount="1"/>"#;

@@ -8,6 +8,7 @@ use contactscope::image::{PixelSize, SampleType};
 use contactscope_formats::microscopy::select::{
     series_pixel_size, LoadAxis, SelectedPlane, Selection,
 };
+use contactscope_formats::microscopy::TiffPage;
 use contactscope_formats::microscopy::{MicroscopyFile, MicroscopyFormat, SeriesInfo};
 use contactscope_formats::tiff::TiffInfo;
 
@@ -37,13 +38,14 @@ pub struct SeriesFile {
     pub tiff: Option<TiffInfo>,
     /// The selected planes, in load order.
     pub planes: Vec<SelectedPlane>,
-    /// The IFD of each selected plane (TIFF files only).
-    pub tiff_pages: Vec<usize>,
+    /// The file and IFD of each selected plane (TIFF files only; another file of a multi-file
+    /// OME set for a plane stored there).
+    pub tiff_pages: Vec<TiffPage>,
 }
 
 impl SeriesFile {
-    pub(super) fn from_tiff(info: TiffInfo, planes: Vec<(SelectedPlane, (usize, usize))>) -> Self {
-        let (planes, tiff_pages) = planes.into_iter().map(|(p, (page, _))| (p, page)).unzip();
+    pub(super) fn from_tiff(info: TiffInfo, planes: Vec<(SelectedPlane, TiffPage)>) -> Self {
+        let (planes, tiff_pages) = planes.into_iter().unzip();
         SeriesFile {
             path: info.path.clone(),
             format: MicroscopyFormat::Tiff,
@@ -123,16 +125,32 @@ impl SeriesFile {
         )
     }
 
-    /// (page, plane) of every image this file gives to a series built from files: the IFD of
-    /// each selected plane of a TIFF, the selected planes otherwise.
-    pub(super) fn images(&self) -> Vec<(usize, Option<SelectedPlane>)> {
+    /// (file, page, plane) of every image this file gives to a series built from files: the
+    /// file and IFD of each selected plane of a TIFF (another file of its OME set for a plane
+    /// stored there), this file and the selected planes otherwise.
+    pub(super) fn images(&self) -> Vec<(PathBuf, usize, Option<SelectedPlane>)> {
         match &self.tiff {
-            Some(_) => self.tiff_pages.iter().map(|&p| (p, None)).collect(),
+            Some(_) => self
+                .tiff_pages
+                .iter()
+                .map(|p| (p.path.clone(), p.ifd, None))
+                .collect(),
             None => self
                 .planes
                 .iter()
-                .map(|p| (p.load_index, Some(p.clone())))
+                .map(|p| (self.path.clone(), p.load_index, Some(p.clone())))
                 .collect(),
         }
+    }
+
+    /// The other files of a multi-file OME set this file reads planes from.
+    pub(super) fn set_members(&self) -> Vec<&Path> {
+        let mut members: Vec<&Path> = Vec::new();
+        for p in &self.tiff_pages {
+            if p.path != self.path && !members.contains(&p.path.as_path()) {
+                members.push(&p.path);
+            }
+        }
+        members
     }
 }

@@ -91,6 +91,14 @@ impl Series {
     }
 }
 
+/// Whether two paths name one file (compared as given when either cannot be resolved).
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    }
+}
+
 fn is_image_name(path: &Path) -> bool {
     path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
         ["tif", "tiff", "czi", "nd2", "lif"]
@@ -299,10 +307,18 @@ pub fn from_files_selected(
         (false, 1) => format!("the file's {planes}"),
         (false, _) => format!("the files in the order given, each file's {planes}"),
     };
+    // The files of a multi-file OME set given beside the one read: their planes are read once,
+    // through it.
+    let mut in_a_set: Vec<PathBuf> = Vec::new();
     for path in files {
-        let planes = table.get(&path)?.images();
-        images.extend(planes.into_iter().map(|(page, plane)| ImageRef {
-            path: path.clone(),
+        if in_a_set.iter().any(|m| same_file(m, &path)) {
+            continue;
+        }
+        let file = table.get(&path)?;
+        in_a_set.extend(file.set_members().into_iter().map(Path::to_path_buf));
+        let planes = file.images();
+        images.extend(planes.into_iter().map(|(path, page, plane)| ImageRef {
+            path,
             page,
             plane,
             force_n: None,
@@ -492,7 +508,14 @@ fn resolve_page(
     at: &Location,
 ) -> Result<(usize, Option<SelectedPlane>)> {
     let channel = table.channel();
-    let images = table.get(path)?.images();
+    // A manifest names pages of the file it names (not of another file of its OME set).
+    let images: Vec<(usize, Option<SelectedPlane>)> = table
+        .get(path)?
+        .images()
+        .into_iter()
+        .filter(|(file, _, _)| file == path)
+        .map(|(_, page, plane)| (page, plane))
+        .collect();
     let pages: Vec<usize> = images.iter().map(|(p, _)| *p).collect();
     let text = page_col.and_then(|c| row.get(c)).unwrap_or("").trim();
     if text.is_empty() {
