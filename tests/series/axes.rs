@@ -339,4 +339,35 @@ fn a_multi_file_ome_set_is_read_whole_from_any_of_its_files() {
     }
     let e = refused(&["analyze", s(&odd.join(names[0])), "--forces", forces]);
     assert!(e.contains(names[1]) && e.contains("8×8"), "{e}");
+
+    // A batch whose pattern takes both files: one series, four images, and a change to the
+    // second file alone makes it stale.
+    let archive = tmp.path().join("archive");
+    std::fs::create_dir(&archive).unwrap();
+    for n in names {
+        std::fs::copy(set.join(n), archive.join(n)).unwrap();
+    }
+    let out = tmp.path().join("batch");
+    let batch = |what: &str| {
+        let o = run_ok(&[
+            "batch",
+            s(&archive),
+            "--out",
+            s(&out),
+            "--pattern",
+            "*.ome.tif",
+            "--forces",
+            forces,
+            "--pixel-size",
+            "200nm",
+        ]);
+        let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+        assert!(said.contains(what), "{what}: {said}");
+    };
+    batch("1 series: 1 ok");
+    let (_, rows) = crate::common::read_csv(&out.join("images.csv"));
+    assert_eq!(rows.len(), 4);
+    batch("0 analysed, 1 reused");
+    write_tiff(&archive.join(names[1]), &planes[..2], &xml);
+    batch("1 analysed, 0 reused");
 }

@@ -183,9 +183,9 @@ fn stages(task: &SeriesTask, progress: &mut Progress) -> std::result::Result<(),
     let open = request.micrographs.open().map_err(at("inputs"))?;
     let mut to_hash: Vec<(PathBuf, &str)> = open
         .series
-        .files
-        .iter()
-        .map(|f| (f.path.clone(), "image"))
+        .image_files()
+        .into_iter()
+        .map(|f| (f, "image"))
         .collect();
     to_hash.extend(open.series.manifest.clone().map(|m| (m, "manifest")));
     to_hash.extend(task.topography.clone().map(|t| (t, "topography")));

@@ -89,6 +89,20 @@ impl Series {
     pub fn info_of(&self, path: &Path) -> Option<&SeriesFile> {
         self.files.iter().find(|f| f.path == path)
     }
+
+    /// Every file the series reads images from: its files, each followed by the other files
+    /// of its multi-file OME set that it reads planes from.
+    pub fn image_files(&self) -> Vec<PathBuf> {
+        let mut all: Vec<PathBuf> = Vec::new();
+        for f in &self.files {
+            for p in std::iter::once(f.path.as_path()).chain(f.set_members()) {
+                if !all.iter().any(|a| a == p) {
+                    all.push(p.to_path_buf());
+                }
+            }
+        }
+        all
+    }
 }
 
 /// Whether two paths name one file (compared as given when either cannot be resolved).
