@@ -115,3 +115,46 @@ def test_every_shared_tiff_has_tifffiles_axes():
         assert got == want, (path.name, s.axes, got)
         compared += 1
     assert compared > 20
+
+
+def _ome_set_xml(names, sizes):
+    """The OME-XML every file of a two-file set carries (OME-TIFF specification, multi-file
+    datasets): DimensionOrder XYCZT, the first half of the time points in ``names[0]``."""
+    t, c, y, x = sizes
+    half = t // 2 * c
+    uuids = [f"urn:uuid:00000000-0000-4000-8000-00000000000{k}" for k in (1, 2)]
+    blocks = "".join(
+        f'<TiffData FirstT="{k * (t // 2)}" IFD="0" PlaneCount="{half}">'
+        f'<UUID FileName="{name}">{uuid}</UUID></TiffData>'
+        for k, (name, uuid) in enumerate(zip(names, uuids))
+    )
+    channels = "".join(f'<Channel ID="Channel:0:{k}" SamplesPerPixel="1"/>' for k in range(c))
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?>'
+        '<OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06" '
+        f'UUID="{uuids[0]}"><Image ID="Image:0"><Pixels ID="Pixels:0" DimensionOrder="XYCZT" '
+        f'Type="uint16" SizeX="{x}" SizeY="{y}" SizeC="{c}" SizeZ="1" SizeT="{t}">'
+        f"{channels}{blocks}</Pixels></Image></OME>"
+    )
+
+
+def test_a_multi_file_ome_set_reads_as_tifffile_reads_it(tmp_path):
+    """A set of two files, time points split between them: read from either file, every
+    channel's planes are tifffile's ``series[0]`` of the set."""
+    t, c, y, x = 4, 2, SIZES["Y"], SIZES["X"]
+    base = (np.arange(t * c, dtype=np.uint16) * 100 + 200).reshape(t, c, 1, 1)
+    data = (base + np.arange(y * x, dtype=np.uint16).reshape(y, x) % 50).astype(np.uint16)
+    names = ["set_0.ome.tif", "set_1.ome.tif"]
+    xml = _ome_set_xml(names, data.shape)
+    for k, name in enumerate(names):
+        pages = data[k * (t // 2):(k + 1) * (t // 2)].reshape(-1, y, x)
+        with tifffile.TiffWriter(tmp_path / name) as w:
+            for j, page in enumerate(pages):
+                w.write(page, description=xml if j == 0 else None, metadata=None)
+    reference = tifffile.TiffFile(tmp_path / names[0]).series[0]
+    assert reference.axes == "TCYX" and reference.shape == data.shape
+    np.testing.assert_array_equal(reference.asarray(), data)
+    for name in names:
+        for channel in range(c):
+            got = cs.read_series(tmp_path / name, channel=channel)["images"]
+            np.testing.assert_array_equal(got, data[:, channel], err_msg=f"{name} c {channel}")

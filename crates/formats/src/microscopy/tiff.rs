@@ -52,7 +52,8 @@ pub fn set_member(info: &TiffInfo, file: usize) -> Result<PathBuf> {
         return Err(bad(
             &info.path,
             format!(
-                "its OME-XML names the file {name:?} of its set by a path that leaves the                  file's folder; a set's files are named relative to it"
+                "its OME-XML names the file {name:?} of its set by a path that leaves the \
+                 file's folder; a set's files are named relative to it"
             ),
         ));
     }
@@ -62,7 +63,8 @@ pub fn set_member(info: &TiffInfo, file: usize) -> Result<PathBuf> {
         return Err(bad(
             &info.path,
             format!(
-                "planes of this OME-TIFF set are stored in {name}, which is not in {}; copy                  the set's files together",
+                "planes of this OME-TIFF set are stored in {name}, which is not in {}; copy \
+                 the set's files together",
                 if folder.as_os_str().is_empty() {
                     "this folder".to_string()
                 } else {
