@@ -316,7 +316,7 @@ impl SeriesLight {
             .max_by(|&a, &b| forces[a].total_cmp(&forces[b]));
         // A lighter load's interior holds at least its mean: the signal cannot rise faster from
         // there to the reference than to the reference's highest reading. The largest of these
-        // rises is the cap (module docs: a trend that is not a power law rises faster over the
+        // rises is the cap (module docs: a rise that slows with load is steeper over the
         // lightest loads than between the heaviest).
         let gamma_up = reference
             .and_then(|r| {
