@@ -308,6 +308,23 @@ fn a_multi_file_ome_set_is_read_whole_from_any_of_its_files() {
     assert!(rows[0][image].contains(names[0]), "{:?}", rows[0]);
     assert!(rows[3][image].contains(names[1]), "{:?}", rows[3]);
 
+    // A set whose first file only points to the master's XML (BinaryOnly), in a folder where
+    // it sorts first: read once, through the master.
+    let pointer = tmp.path().join("pointer");
+    std::fs::create_dir(&pointer).unwrap();
+    let (a, b) = ("a.ome.tif", "b.ome.tif");
+    write_tiff(
+        &pointer.join(a),
+        &planes[..2],
+        &format!(
+            r#"<?xml version="1.0" encoding="UTF-8"?><OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06" UUID="urn:uuid:00000000-0000-0000-0000-00000000000a"><BinaryOnly MetadataFile="{b}" UUID="urn:uuid:00000000-0000-0000-0000-00000000000b"/></OME>"#
+        ),
+    );
+    write_tiff(&pointer.join(b), &planes[2..], &set_xml([a, b]));
+    let out = tmp.path().join("pointer-out");
+    analyze(&pointer, &out, &["--forces", forces]);
+    assert_eq!(areas(&out), areas(&alone));
+
     // A file of the set without the other: one line naming the missing file.
     let lone = tmp.path().join("lone");
     std::fs::create_dir(&lone).unwrap();
@@ -370,4 +387,13 @@ fn a_multi_file_ome_set_is_read_whole_from_any_of_its_files() {
     batch("0 analysed, 1 reused");
     write_tiff(&archive.join(names[1]), &planes[..2], &xml);
     batch("1 analysed, 0 reused");
+    // The pointer first: one series too.
+    std::fs::remove_dir_all(&out).unwrap();
+    for n in names {
+        std::fs::remove_file(archive.join(n)).unwrap();
+    }
+    for n in [a, b] {
+        std::fs::copy(pointer.join(n), archive.join(n)).unwrap();
+    }
+    batch("1 series: 1 ok");
 }

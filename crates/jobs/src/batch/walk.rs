@@ -8,8 +8,8 @@
 //! whole (`plate.ome.zarr` → `plate`); the walk never looks inside it. A folder holding TIFF files that no pattern takes, and no
 //! manifest, is not a series unless `tiff_folders`: it is listed in [`Sheet::skipped`] with the
 //! options that would take it (the batch prints it as a warning). The files of a multi-file
-//! OME-TIFF set that a pattern takes one by one are one series, its first file's (the set is
-//! read whole from it). The walk is in natural order (`run2` before `run10`) and
+//! OME-TIFF set that a pattern takes one by one are one series, read from the first file that
+//! holds the set's OME-XML. The walk is in natural order (`run2` before `run10`) and
 //! writes the samplesheet it used, so that the next run can be edited by hand and repeated.
 
 use std::path::{Component, Path, PathBuf};
@@ -20,10 +20,8 @@ use super::options::{Opt, SeriesOptions};
 use super::sheet::{id_from, MetaColumn, MetaKind, Row, Sheet};
 use crate::error::{Error, Location, Result};
 use crate::series::natural_cmp;
-use contactscope_formats::microscopy::select::is_tiff;
-use contactscope_formats::microscopy::set_member;
+use crate::series::one_file_per_set;
 use contactscope_formats::microscopy::zarr::{self, ZarrReader};
-use contactscope_formats::tiff::TiffReader;
 
 /// The default patterns of single-file series: the vendor formats that hold a load series in
 /// one file, and OME-Zarr stores (folders, taken whole).
@@ -275,30 +273,19 @@ fn globs(patterns: &[String]) -> Result<GlobSet> {
         .map_err(|e| Error::InvalidArgument(format!("patterns: {e}")))
 }
 
-/// The series found, each multi-file OME-TIFF set once: a TIFF file whose OME-XML reads planes
-/// from other files (read whole from any of its files) makes those files no series of their own.
+/// The series found, each multi-file OME-TIFF set once ([`one_file_per_set`]: the set is read
+/// whole from the file kept).
 fn one_file_per_ome_set(found: Vec<(PathBuf, bool)>) -> Vec<(PathBuf, bool)> {
-    let mut members: Vec<PathBuf> = Vec::new();
-    let mut kept = Vec::with_capacity(found.len());
-    for (path, folder) in found {
-        let canonical = path.canonicalize().unwrap_or_else(|_| path.clone());
-        if !folder && members.contains(&canonical) {
-            continue;
-        }
-        if !folder && is_tiff(&path) {
-            // A file that cannot be opened fails as a series later, with its own error.
-            if let Ok(reader) = TiffReader::open(&path) {
-                let info = reader.info();
-                members.extend(
-                    (0..info.axes.other_files.len())
-                        .filter_map(|k| set_member(info, k).ok())
-                        .filter_map(|m| m.canonicalize().ok()),
-                );
-            }
-        }
-        kept.push((path, folder));
-    }
-    kept
+    let files: Vec<PathBuf> = found
+        .iter()
+        .filter(|(_, folder)| !folder)
+        .map(|(p, _)| p.clone())
+        .collect();
+    let (kept, _) = one_file_per_set(files);
+    found
+        .into_iter()
+        .filter(|(p, folder)| *folder || kept.contains(p))
+        .collect()
 }
 
 /// The TIFF files of `dir` that no pattern takes as a series (`None` for none).

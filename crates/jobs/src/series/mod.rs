@@ -27,6 +27,7 @@ use serde::Serialize;
 mod file;
 mod input;
 mod manifest;
+mod ome_set;
 mod order;
 mod pixel;
 
@@ -35,6 +36,7 @@ pub use input::{
     is_manifest, load, LoadedSeries, MemorySeries, Micrographs, OpenSeries, Planes, SeriesSpec,
 };
 pub use manifest::{from_manifest, from_manifest_selected};
+pub(crate) use ome_set::one_file_per_set;
 pub use order::natural_cmp;
 pub use pixel::{
     pixel_size, pixel_size_warnings, PIXEL_SIZE_CONTRADICTION, SUB_DIFFRACTION_PIXEL_M,
@@ -103,14 +105,6 @@ impl Series {
             }
         }
         all
-    }
-}
-
-/// Whether two paths name one file (compared as given when either cannot be resolved).
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => a == b,
     }
 }
 
@@ -226,6 +220,8 @@ struct FileTable {
     load_axis: Option<LoadAxis>,
     /// The files come from a manifest (which names their pages).
     manifest: bool,
+    /// TIFF headers already read, taken by [`FileTable::get`] instead of reading them again.
+    headers: HashMap<PathBuf, TiffInfo>,
 }
 
 impl FileTable {
@@ -236,6 +232,7 @@ impl FileTable {
             selection,
             load_axis,
             manifest,
+            headers: HashMap::new(),
         }
     }
 
@@ -244,7 +241,10 @@ impl FileTable {
             return Ok(&self.files[i]);
         }
         let file = if contactscope_formats::microscopy::select::is_tiff(path) {
-            let info = TiffReader::open(path)?.info().clone();
+            let info = match self.headers.remove(path) {
+                Some(info) => info,
+                None => TiffReader::open(path)?.info().clone(),
+            };
             // A manifest names a TIFF's pages one by one: a z stack's too.
             let default = match self.manifest {
                 true => LoadDefault::AnyStack,
@@ -322,16 +322,11 @@ pub fn from_files_selected(
         (false, 1) => format!("the file's {planes}"),
         (false, _) => format!("the files in the order given, each file's {planes}"),
     };
-    // The files of a multi-file OME set given beside the one read: their planes are read once,
-    // through it.
-    let mut in_a_set: Vec<PathBuf> = Vec::new();
+    // A multi-file OME set's files given together: its planes are read once.
+    let (files, headers) = ome_set::one_file_per_set(files);
+    table.headers = headers;
     for path in files {
-        if in_a_set.iter().any(|m| same_file(m, &path)) {
-            continue;
-        }
-        let file = table.get(&path)?;
-        in_a_set.extend(file.set_members().into_iter().map(Path::to_path_buf));
-        let planes = file.images();
+        let planes = table.get(&path)?.images();
         images.extend(planes.into_iter().map(|(path, page, plane)| ImageRef {
             path,
             page,
