@@ -282,6 +282,7 @@ fn one_file_per_ome_set(found: Vec<(PathBuf, bool)>) -> Vec<(PathBuf, bool)> {
         .map(|(p, _)| p.clone())
         .collect();
     let (kept, _) = one_file_per_set(files);
+    let kept: std::collections::HashSet<PathBuf> = kept.into_iter().collect();
     found
         .into_iter()
         .filter(|(p, folder)| *folder || kept.contains(p))

@@ -3,7 +3,7 @@
 //! once — whichever of its files comes first, and whether its other files carry the set's
 //! OME-XML too or only point to it (`BinaryOnly`, read alone as plain pages).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
 
 use contactscope_formats::microscopy::select::is_tiff;
@@ -49,6 +49,7 @@ pub(crate) fn one_file_per_set(files: Vec<PathBuf>) -> (Vec<PathBuf>, HashMap<Pa
         }
     }
     let chosen: Vec<PathBuf> = kept.iter().map(|&i| files[i].clone()).collect();
-    headers.retain(|p, _| chosen.contains(p));
+    let wanted: HashSet<&PathBuf> = chosen.iter().collect();
+    headers.retain(|p, _| wanted.contains(p));
     (chosen, headers)
 }
