@@ -68,7 +68,7 @@ impl AreaBand {
 /// deviations of the pixel noise.
 pub fn area_band(plane: &Plane, mask: &Mask, w: f64, z: f64) -> AreaBand {
     let n = plane.len();
-    let measured = mask.data.iter().filter(|&&m| m != 0).count() as u64;
+    let measured = mask.contact_pixels();
     let values = |keep: &dyn Fn(usize) -> bool| -> Vec<f64> {
         let stride = n.div_ceil(MEDIAN_SAMPLES).max(1);
         (0..n)

@@ -53,9 +53,25 @@ impl Mask {
     /// touching the border of a large field stay below this; a contact wider than the field does
     /// not.
     pub fn edge_contact(&self) -> bool {
-        let contact = self.data.iter().filter(|&&m| m != 0).count() as f64;
+        self.edge_contact_of(self.contact_pixels())
+    }
+
+    /// [`Mask::edge_contact`] for a mask known to hold `contact_pixels` contact pixels (the
+    /// classification counted them): only the border is read. Counting them again was a whole
+    /// pass over the mask per image (with the slow count below, `measure_with_tiles` took
+    /// 2.17 ms per 1024² image against 0.78 ms without it; criterion `phases_1024`).
+    fn edge_contact_of(&self, contact_pixels: u64) -> bool {
         let border = self.border_contact_pixels() as f64;
-        border > 0.0 && border > EDGE_CHORD_PER_SQRT_AREA * contact.sqrt()
+        border > 0.0 && border > EDGE_CHORD_PER_SQRT_AREA * (contact_pixels as f64).sqrt()
+    }
+
+    /// Contact pixels of the mask. Counted in `u32` over blocks, a loop the compiler
+    /// vectorises (0.14 ms per 1024² mask against 0.50 ms for `filter(..).count()`).
+    pub fn contact_pixels(&self) -> u64 {
+        self.data
+            .chunks(1 << 20)
+            .map(|block| u64::from(block.iter().map(|&m| u32::from(m != 0)).sum::<u32>()))
+            .sum()
     }
 
     /// Contact flags as booleans.
@@ -157,6 +173,11 @@ fn finish(
         height: plane.height,
         data: mask,
     };
+    debug_assert_eq!(
+        contact.count,
+        mask.contact_pixels(),
+        "the classification's count"
+    );
     let (patches, largest_patch_pixels) = patch_stats(&mask);
     let measurement = Measurement {
         contact_pixels: contact.count,
@@ -166,7 +187,7 @@ fn finish(
         background_mean: background.mean(),
         patches,
         largest_patch_pixels,
-        edge_contact: mask.edge_contact(),
+        edge_contact: mask.edge_contact_of(contact.count),
     };
     (measurement, mask)
 }
@@ -345,6 +366,55 @@ mod tests {
         let mut speck = disk(100.0);
         speck.data[100 * 200] = 1;
         assert!(!speck.edge_contact());
+    }
+
+    #[test]
+    fn contact_pixels_are_counted_across_blocks_and_any_non_zero_byte() {
+        // Past one counting block (2²⁰ bytes), with bytes other than 1 counted as contact.
+        let n = (1 << 20) + 37;
+        let data: Vec<u8> = (0..n)
+            .map(|i| match (i as u64 * 2_654_435_761) % 7 {
+                0 => 1,
+                1 => 255,
+                2 => 2,
+                _ => 0,
+            })
+            .collect();
+        let naive = data.iter().filter(|&&m| m != 0).count() as u64;
+        let mask = Mask {
+            width: 1,
+            height: n,
+            data,
+        };
+        assert_eq!(mask.contact_pixels(), naive);
+        assert!(naive > 400_000, "{naive}");
+    }
+
+    #[test]
+    fn a_measurement_flags_edge_contact_as_its_mask_does() {
+        // A disk cut by the left border and one well inside: the measurement (which reuses the
+        // classification's count) agrees with the mask counting its own pixels.
+        for (cx, cut) in [(10.0, true), (60.0, false)] {
+            let (w, h) = (120, 100);
+            let codes: Vec<u16> = (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as f64, (i / w) as f64);
+                    if (x - cx).powi(2) + (y - 50.0).powi(2) <= 400.0 {
+                        3000
+                    } else {
+                        200 + (i % 13) as u16
+                    }
+                })
+                .collect();
+            let plane = Plane::from_u16(w, h, codes);
+            let mut hist = Histogram::new(Binning::Integer { offset: 0 });
+            hist.add_plane(&plane).unwrap();
+            let t = Threshold::otsu(&hist, "test").unwrap();
+            let (m, mask) = measure(&plane, &t).unwrap();
+            assert_eq!(m.edge_contact, cut, "disk at x = {cx}");
+            assert_eq!(m.edge_contact, mask.edge_contact());
+            assert_eq!(m.contact_pixels, mask.contact_pixels());
+        }
     }
 
     #[test]
