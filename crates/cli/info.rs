@@ -71,7 +71,15 @@ pub fn run(args: Args) -> Result<()> {
         if i.bigtiff { ", BigTIFF" } else { "" },
         i.byte_order
     );
-    println!("description:  {}", i.description_kind);
+    match &i.metadata_file {
+        Some(file) => println!(
+            "description:  {}, read from the set's metadata file {} (this file's only points \
+             to it)",
+            i.description_kind,
+            file.display()
+        ),
+        None => println!("description:  {}", i.description_kind),
+    }
     if let Some(q) = &i.quantity {
         let unit = i
             .value_unit

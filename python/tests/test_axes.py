@@ -158,3 +158,33 @@ def test_a_multi_file_ome_set_reads_as_tifffile_reads_it(tmp_path):
         for channel in range(c):
             got = cs.read_series(tmp_path / name, channel=channel)["images"]
             np.testing.assert_array_equal(got, data[:, channel], err_msg=f"{name} c {channel}")
+
+
+def test_a_set_whose_metadata_is_a_companion_file_reads_whole(tmp_path):
+    """The set's OME-XML in ``set.companion.ome``, each TIFF's own XML only pointing to it
+    (``BinaryOnly``, as Bio-Formats writes such a set): read from either TIFF or from the
+    companion, every channel's planes are the planes written. (tifffile reads each TIFF of such
+    a set alone, so the reference here is the array written.)"""
+    t, c, y, x = 4, 2, SIZES["Y"], SIZES["X"]
+    base = (np.arange(t * c, dtype=np.uint16) * 100 + 200).reshape(t, c, 1, 1)
+    data = (base + np.arange(y * x, dtype=np.uint16).reshape(y, x) % 50).astype(np.uint16)
+    names = ["set_0.ome.tif", "set_1.ome.tif"]
+    xml = _ome_set_xml(names, data.shape)
+    (tmp_path / "set.companion.ome").write_text(xml)
+    uuid = "urn:uuid:00000000-0000-4000-8000-000000000001"
+    pointer = (
+        '<?xml version="1.0" encoding="UTF-8"?>'
+        '<OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06" '
+        'UUID="urn:uuid:00000000-0000-4000-8000-0000000000ff">'
+        f'<BinaryOnly MetadataFile="set.companion.ome" UUID="{uuid}"/></OME>'
+    )
+    for k, name in enumerate(names):
+        pages = data[k * (t // 2):(k + 1) * (t // 2)].reshape(-1, y, x)
+        with tifffile.TiffWriter(tmp_path / name) as w:
+            for j, page in enumerate(pages):
+                w.write(page, description=pointer if j == 0 else None, metadata=None)
+    for source in [*names, "set.companion.ome"]:
+        assert cs.info(tmp_path / source)["series"][0]["axes"]["T"] == t, source
+        for channel in range(c):
+            got = cs.read_series(tmp_path / source, channel=channel)["images"]
+            np.testing.assert_array_equal(got, data[:, channel], err_msg=f"{source} c {channel}")

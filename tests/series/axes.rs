@@ -1,7 +1,8 @@
 //! A TIFF's pages read by the axes its metadata states (issue: "no wrong number from a file's
 //! axes"): an OME-TIFF's channels are not pooled into one series, an ImageJ hyperstack's focal
 //! planes are not taken for loads, a z stack is not a load series unless told so, a multi-file
-//! OME set is read whole (once) from any of its files.
+//! OME set is read whole (once) from any of its files, also when its metadata is kept in a
+//! companion file.
 //!
 //! The files are written here page by page with the ImageDescription each writer would give
 //! (OME-XML as tifffile writes it for axes TCYX; ImageJ's `channels/slices/frames`), and each
@@ -309,7 +310,7 @@ fn a_multi_file_ome_set_is_read_whole_from_any_of_its_files() {
     assert!(rows[3][image].contains(names[1]), "{:?}", rows[3]);
 
     // A set whose first file only points to the master's XML (BinaryOnly), in a folder where
-    // it sorts first: read once, through the master.
+    // it sorts first: read once (the pointer followed to the master's XML).
     let pointer = tmp.path().join("pointer");
     std::fs::create_dir(&pointer).unwrap();
     let (a, b) = ("a.ome.tif", "b.ome.tif");
@@ -396,4 +397,131 @@ fn a_multi_file_ome_set_is_read_whole_from_any_of_its_files() {
         std::fs::copy(pointer.join(n), archive.join(n)).unwrap();
     }
     batch("1 series: 1 ok");
+}
+
+/// A `BinaryOnly` OME-XML: the file's metadata are kept in `metadata_file`.
+fn binary_only(metadata_file: &str, uuid: &str) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?><OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06" UUID="urn:uuid:00000000-0000-0000-0000-0000000000f0"><BinaryOnly MetadataFile="{metadata_file}" UUID="{uuid}"/></OME>"#
+    )
+}
+
+#[test]
+fn an_ome_set_with_a_companion_file_is_read_from_any_of_its_files_and_from_the_companion() {
+    let tmp = tempfile::tempdir().unwrap();
+    let radii = [4.0, 7.0, 10.0, 13.0];
+    let planes: Vec<Vec<u16>> = radii.iter().map(|&r| disk(r, 2000, 0)).collect();
+    let plain = tmp.path().join("plain.tif");
+    write_tiff(&plain, &planes, "plain pages");
+    let forces = "4,10,20,40mN";
+    let alone = tmp.path().join("alone");
+    analyze(&plain, &alone, &["--forces", forces]);
+
+    // The set: two TIFFs whose XML points to `set.companion.ome`, which holds the set's XML
+    // (as Bio-Formats writes a companion file: the OME document, its UUID, TiffData per file).
+    let set = tmp.path().join("set");
+    std::fs::create_dir(&set).unwrap();
+    let names = ["load_0.ome.tif", "load_1.ome.tif"];
+    let companion = set.join("set.companion.ome");
+    std::fs::write(&companion, set_xml(names)).unwrap();
+    let uuid = "urn:uuid:00000000-0000-0000-0000-00000000000a";
+    write_tiff(
+        &set.join(names[0]),
+        &planes[..2],
+        &binary_only("set.companion.ome", uuid),
+    );
+    write_tiff(
+        &set.join(names[1]),
+        &planes[2..],
+        &binary_only("set.companion.ome", uuid),
+    );
+    for (k, input) in [
+        set.join(names[0]),
+        set.join(names[1]),
+        set.clone(),
+        companion.clone(),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let out = tmp.path().join(format!("set-{k}"));
+        analyze(input, &out, &["--forces", forces]);
+        assert_eq!(areas(&out), areas(&alone), "{}", input.display());
+        assert_eq!(threshold(&out), threshold(&alone));
+    }
+    // Through the companion the images name the TIFFs they came from.
+    let (header, rows) = crate::common::read_csv(&tmp.path().join("set-3").join("areas.csv"));
+    let image = header.iter().position(|h| h == "image").unwrap();
+    assert!(rows[0][image].contains(names[0]), "{:?}", rows[0]);
+    assert!(rows[3][image].contains(names[1]), "{:?}", rows[3]);
+    // `info` says where the axes came from.
+    let o = run_ok(&["info", s(&set.join(names[1]))]);
+    let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+    assert!(said.contains("set.companion.ome"), "{said}");
+    assert!(said.contains("T 4"), "{said}");
+
+    // The companion missing, or another set's: each file is read alone, in file order, and
+    // says why (not the four time points of a set it cannot see).
+    let lone = tmp.path().join("lone");
+    std::fs::create_dir(&lone).unwrap();
+    std::fs::copy(set.join(names[0]), lone.join(names[0])).unwrap();
+    let o = run_ok(&["info", s(&lone.join(names[0]))]);
+    let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+    assert!(
+        said.contains("only points to") && said.contains("not there"),
+        "{said}"
+    );
+    assert!(said.contains("T 2"), "{said}");
+    std::fs::write(
+        lone.join("set.companion.ome"),
+        set_xml(names).replace(uuid, "urn:uuid:00000000-0000-0000-0000-0000000000ee"),
+    )
+    .unwrap();
+    let o = run_ok(&["info", s(&lone.join(names[0]))]);
+    let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+    assert!(said.contains("0000000000ee"), "{said}");
+    // A companion whose TIFFs are not beside it: one line naming the file.
+    let e = refused(&[
+        "analyze",
+        s(&lone.join("set.companion.ome")),
+        "--forces",
+        forces,
+    ]);
+    assert!(e.contains("0000000000ee") || e.contains(names[1]), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+    std::fs::remove_file(lone.join(names[0])).unwrap();
+    let e = refused(&[
+        "analyze",
+        s(&lone.join("set.companion.ome")),
+        "--forces",
+        forces,
+    ]);
+    assert!(e.contains(names[0]) && e.contains("not beside"), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+
+    // A batch over the set's folder: one series of four images; a changed companion (the
+    // axes come from it) makes the series stale.
+    let out = tmp.path().join("batch");
+    let batch = |what: &str| {
+        let o = run_ok(&[
+            "batch",
+            s(&set),
+            "--out",
+            s(&out),
+            "--pattern",
+            "*.ome.tif",
+            "--forces",
+            forces,
+        ]);
+        let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+        assert!(said.contains(what), "{what}: {said}");
+    };
+    batch("1 series: 1 ok");
+    let (_, rows) = crate::common::read_csv(&out.join("images.csv"));
+    assert_eq!(rows.len(), 4);
+    batch("0 analysed, 1 reused");
+    let mut xml = set_xml(names);
+    xml = xml.replace("SizeT=\"4\"", "SizeT=\"4\" Name=\"edited\"");
+    std::fs::write(&companion, xml).unwrap();
+    batch("1 analysed, 0 reused");
 }

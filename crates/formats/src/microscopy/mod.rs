@@ -377,7 +377,18 @@ impl MicroscopyFile {
         }
         let mut source = super::binary::FileSource::open(path)?;
         let head = source.read_up_to(0, 64)?;
-        let format = detect(&head).ok_or_else(|| match crate::topography::detect(&head) {
+        // An OME companion file: the TIFF set it describes ([`crate::tiff::companion`]).
+        let mut companion = || -> Result<bool> {
+            Ok(!crate::remote::is_url(path)
+                && crate::tiff::companion::looks_like_ome_xml(
+                    &source.read_up_to(0, crate::tiff::companion::HEAD_BYTES)?,
+                ))
+        };
+        let format = match detect(&head) {
+            None if companion()? => Some(MicroscopyFormat::Tiff),
+            found => found,
+        };
+        let format = format.ok_or_else(|| match crate::topography::detect(&head) {
             // A height map given where a micrograph is expected: say which command reads it.
             Some(map) => {
                 // Its channels, when the map reads, so that `--channel` can be chosen from here.

@@ -3,6 +3,7 @@
 //! and z stacks of the optics commands as [`Image`]s ([`read_pages`], [`read_image`]).
 
 pub mod axes;
+pub mod companion;
 pub mod metadata;
 pub mod read;
 pub mod spare;

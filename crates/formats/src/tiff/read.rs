@@ -94,6 +94,10 @@ pub struct TiffInfo {
     pub notes: Vec<String>,
     /// Channels, focal planes and time points, and the page of each plane.
     pub axes: TiffAxes,
+    /// The file the OME-XML was read from when the file's own XML only points to it
+    /// (`BinaryOnly`: a companion `.companion.ome` or the master TIFF of a multi-file set;
+    /// [`super::companion`]).
+    pub metadata_file: Option<PathBuf>,
 }
 
 impl TiffInfo {
@@ -214,12 +218,31 @@ fn decoder(
 
 impl TiffReader {
     /// Open a TIFF file and read its headers (every IFD, no pixel data).
+    ///
+    /// An OME companion file (the XML of a multi-file OME-TIFF set, [`super::companion`]) opens
+    /// the set through the TIFF holding its first plane, with the companion's XML.
     pub fn open(path: &Path) -> Result<Self> {
         crate::inputs::note_input(path);
+        if !crate::remote::is_url(path) && is_xml_file(path) {
+            let (anchor, xml) = super::companion::anchor(path).map_err(|why| {
+                Error::bad_input(
+                    Location::file(path),
+                    format!("an OME companion file whose set cannot be read: {why}"),
+                )
+            })?;
+            crate::inputs::note_input(&anchor);
+            let mut decoder = decoder(&anchor, |e| tiff_error(Location::file(&anchor), e))?;
+            let metadata = Metadata {
+                file: path.to_path_buf(),
+                xml,
+            };
+            let info = read_info(&anchor, &mut decoder, Some(metadata))?;
+            return Ok(TiffReader { decoder, info });
+        }
         let mut decoder = decoder(path, |e| {
             other_format(path).unwrap_or_else(|| tiff_error(Location::file(path), e))
         })?;
-        let info = read_info(path, &mut decoder)?;
+        let info = read_info(path, &mut decoder, None)?;
         Ok(TiffReader { decoder, info })
     }
 
@@ -459,7 +482,67 @@ fn sample_type_of(bits: u8, format: u16, at: &Location) -> Result<SampleType> {
     }
 }
 
-fn read_info<R: Read + Seek>(path: &Path, decoder: &mut Decoder<R>) -> Result<TiffInfo> {
+/// Whether the local file at `path` starts as OME-XML text (an OME companion file).
+fn is_xml_file(path: &Path) -> bool {
+    let mut head = Vec::with_capacity(super::companion::HEAD_BYTES);
+    std::fs::File::open(path)
+        .and_then(|f| {
+            f.take(super::companion::HEAD_BYTES as u64)
+                .read_to_end(&mut head)
+        })
+        .is_ok_and(|_| super::companion::looks_like_ome_xml(&head))
+}
+
+/// The ImageDescription of the first page of the TIFF at `path`, if it has one.
+pub(super) fn first_description(path: &Path) -> Result<Option<String>> {
+    crate::inputs::note_input(path);
+    let mut decoder = decoder(path, |e| tiff_error(Location::file(path), e))?;
+    Ok(match decoder.find_tag(Tag::ImageDescription) {
+        Ok(Some(tiff::decoder::ifd::Value::Ascii(s))) => Some(s),
+        _ => None,
+    })
+}
+
+/// OME-XML read from another file than the TIFF's own description.
+struct Metadata {
+    /// The file it was read from.
+    file: PathBuf,
+    xml: String,
+}
+
+/// The OME-XML a `BinaryOnly` description points to (`None` for any other description), or a
+/// note saying why it was not read.
+fn followed(path: &Path, description: Option<&str>, notes: &mut Vec<String>) -> Option<Metadata> {
+    let pointer = super::companion::pointer(description?)?;
+    if crate::remote::is_url(path) {
+        notes.push(format!(
+            "its OME-XML is kept in {}, which is not read beside a URL; the pages are read in \
+             file order",
+            pointer.metadata_file
+        ));
+        return None;
+    }
+    match super::companion::follow(path, &pointer) {
+        Ok((file, xml)) => {
+            crate::inputs::note_input(&file);
+            Some(Metadata { file, xml })
+        }
+        Err(why) => {
+            notes.push(format!(
+                "its OME-XML only points to the set's metadata file {} ({why}); the pages are \
+                 read alone, in file order",
+                pointer.metadata_file
+            ));
+            None
+        }
+    }
+}
+
+fn read_info<R: Read + Seek>(
+    path: &Path,
+    decoder: &mut Decoder<R>,
+    metadata: Option<Metadata>,
+) -> Result<TiffInfo> {
     let at = Location::page(path, 0);
     let err = |e| tiff_error(at.clone(), e);
     let (width, height) = decoder.dimensions().map_err(err)?;
@@ -487,7 +570,16 @@ fn read_info<R: Read + Seek>(path: &Path, decoder: &mut Decoder<R>) -> Result<Ti
     };
     let imagej = description.as_deref().and_then(metadata::parse_imagej);
     let mut notes = Vec::new();
-    let pixel_size = pixel_size_from_tags(decoder, description.as_deref(), &imagej, &mut notes);
+    let metadata = metadata.or_else(|| followed(path, description.as_deref(), &mut notes));
+    // The description the axes and the pixel size are read from: the followed XML in place of
+    // the pointer; a pointer not followed (said in a note) states no axes.
+    let axes_description = match &metadata {
+        Some(m) => Some(m.xml.as_str()),
+        None => description
+            .as_deref()
+            .filter(|d| super::companion::pointer(d).is_none()),
+    };
+    let pixel_size = pixel_size_from_tags(decoder, axes_description, &imagej, &mut notes);
     let bigtiff = is_bigtiff(path);
     let byte_order = match decoder.byte_order() {
         tiff::tags::ByteOrder::LittleEndian => "little",
@@ -499,7 +591,7 @@ fn read_info<R: Read + Seek>(path: &Path, decoder: &mut Decoder<R>) -> Result<Ti
         path,
         &pages,
         spp as usize,
-        description.as_deref(),
+        axes_description,
         imagej.as_ref(),
         &mut notes,
     );
@@ -537,6 +629,7 @@ fn read_info<R: Read + Seek>(path: &Path, decoder: &mut Decoder<R>) -> Result<Ti
         value_unit: imagej.as_ref().and_then(|m| m.value_unit.clone()),
         notes,
         axes,
+        metadata_file: metadata.map(|m| m.file),
     })
 }
 

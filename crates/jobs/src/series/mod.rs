@@ -94,11 +94,17 @@ impl Series {
     }
 
     /// Every file the series reads images from: its files, each followed by the other files
-    /// of its multi-file OME set that it reads planes from.
+    /// of its multi-file OME set that it reads planes from and the file its set's OME-XML was
+    /// read from, where that is another file (a companion file).
     pub fn image_files(&self) -> Vec<PathBuf> {
         let mut all: Vec<PathBuf> = Vec::new();
         for f in &self.files {
-            for p in std::iter::once(f.path.as_path()).chain(f.set_members()) {
+            // The set's metadata file too (a companion `.companion.ome`): it places the planes.
+            let metadata = f.tiff.as_ref().and_then(|t| t.metadata_file.as_deref());
+            for p in std::iter::once(f.path.as_path())
+                .chain(f.set_members())
+                .chain(metadata)
+            {
                 if !all.iter().any(|a| a == p) {
                     all.push(p.to_path_buf());
                 }

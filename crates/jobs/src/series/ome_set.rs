@@ -1,7 +1,8 @@
 //! Multi-file OME-TIFF sets among the files of an input: a set is read whole from any file
 //! whose OME-XML places planes in the others (`docs/formats.md`, "TIFF"), so each set is read
 //! once — whichever of its files comes first, and whether its other files carry the set's
-//! OME-XML too or only point to it (`BinaryOnly`, read alone as plain pages).
+//! OME-XML too or only point to it (`BinaryOnly`: the reader follows the pointer to the master
+//! TIFF or the companion file; a pointer it cannot follow leaves the file read alone).
 
 use std::collections::{HashMap, HashSet};
 use std::path::PathBuf;
