@@ -97,6 +97,45 @@ def test_tiff_reader_scale_and_values(series_tif):
     assert kwargs["metadata"]["contactscope"]["path"] == str(path)
 
 
+@needs_napari
+def test_an_ome_companion_file_opens_its_set(tmp_path):
+    """A multi-file OME-TIFF set whose XML is in ``set.companion.ome`` (each TIFF's own XML
+    only points to it): the companion opens the whole set, in the set's plane order."""
+    import tifffile
+
+    from contactscope.napari import readers
+
+    s = cs.synth_series(64, 60, 200e-9, [1e-3, 2e-3, 4e-3, 8e-3], seed=5)
+    names = ["set_0.ome.tif", "set_1.ome.tif"]
+    ns = "http://www.openmicroscopy.org/Schemas/OME/2016-06"
+    uuid = "urn:uuid:00000000-0000-4000-8000-000000000001"
+    blocks = "".join(
+        f'<TiffData FirstT="{2 * k}" IFD="0" PlaneCount="2"><UUID FileName="{n}">'
+        f"urn:uuid:00000000-0000-4000-8000-00000000001{k}</UUID></TiffData>"
+        for k, n in enumerate(names)
+    )
+    (tmp_path / "set.companion.ome").write_text(
+        f'<?xml version="1.0" encoding="UTF-8"?><OME xmlns="{ns}" UUID="{uuid}">'
+        '<Image ID="Image:0"><Pixels ID="Pixels:0" DimensionOrder="XYCZT" Type="uint16" '
+        'SizeX="64" SizeY="60" SizeC="1" SizeZ="1" SizeT="4" PhysicalSizeX="0.2" '
+        'PhysicalSizeXUnit="µm" PhysicalSizeY="0.2" PhysicalSizeYUnit="µm">'
+        f'<Channel ID="Channel:0:0" SamplesPerPixel="1"/>{blocks}</Pixels></Image></OME>'
+    )
+    pointer = (f'<?xml version="1.0" encoding="UTF-8"?><OME xmlns="{ns}">'
+               f'<BinaryOnly MetadataFile="set.companion.ome" UUID="{uuid}"/></OME>')
+    for k, name in enumerate(names):
+        with tifffile.TiffWriter(tmp_path / name) as w:
+            for j, page in enumerate(s.images[2 * k:2 * k + 2]):
+                w.write(page, description=pointer if j == 0 else None, metadata=None)
+    companion = str(tmp_path / "set.companion.ome")
+    reader = readers.get_micrograph_reader(companion)
+    assert reader is not None
+    [(data, kwargs, kind)] = reader(companion)
+    assert kind == "image"
+    np.testing.assert_array_equal(data, s.images)
+    assert kwargs["scale"][-2:] == pytest.approx([0.2, 0.2])
+
+
 def _store_with_masks(series_tif, tmp_path, cli):
     """A new OME-Zarr store written by `analyze --zarr-out` from the series TIFF."""
     path, _ = series_tif

@@ -8,7 +8,7 @@
 //! (OME-XML as tifffile writes it for axes TCYX; ImageJ's `channels/slices/frames`), and each
 //! result is compared with the same planes written as a plain single-channel TIFF.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use tiff::encoder::{colortype, TiffEncoder};
 use tiff::tags::Tag;
@@ -267,6 +267,54 @@ fn decimal_names_load_in_numeric_order_and_the_order_is_said() {
     assert!(!String::from_utf8_lossy(&o.stderr).contains("wrong order"));
 }
 
+/// Each of `inputs` analysed (into `tmp/NAME-k`) gives the areas and threshold of the plain
+/// file's analysis in `alone`; the output folders, in order.
+fn each_reads_as(
+    tmp: &Path,
+    name: &str,
+    inputs: &[PathBuf],
+    alone: &Path,
+    forces: &str,
+) -> Vec<PathBuf> {
+    inputs
+        .iter()
+        .enumerate()
+        .map(|(k, input)| {
+            let out = tmp.join(format!("{name}-{k}"));
+            analyze(input, &out, &["--forces", forces]);
+            assert_eq!(areas(&out), areas(alone), "{}", input.display());
+            assert_eq!(threshold(&out), threshold(alone));
+            out
+        })
+        .collect()
+}
+
+/// The first image of `out`'s areas.csv came from `first`, the fourth from `fourth`.
+fn images_come_from(out: &Path, first: &str, fourth: &str) {
+    let (header, rows) = crate::common::read_csv(&out.join("areas.csv"));
+    let image = header.iter().position(|h| h == "image").unwrap();
+    assert!(rows[0][image].contains(first), "{:?}", rows[0]);
+    assert!(rows[3][image].contains(fourth), "{:?}", rows[3]);
+}
+
+/// `batch ARCHIVE --out OUT --pattern *.ome.tif --forces FORCES` must succeed and say `what`.
+fn batch_says(archive: &Path, out: &Path, forces: &str, what: &str) {
+    let o = run_ok(&[
+        "batch",
+        s(archive),
+        "--out",
+        s(out),
+        "--pattern",
+        "*.ome.tif",
+        "--forces",
+        forces,
+        "--pixel-size",
+        "200nm",
+    ]);
+    let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+    assert!(said.contains(what), "{what}: {said}");
+}
+
 /// The OME-XML of a set of two files, `names[0]` holding time points 0–1 and `names[1]` time
 /// points 2–3 (OME-TIFF specification, multi-file datasets: every file carries the same XML).
 fn set_xml(names: [&str; 2]) -> String {
@@ -294,20 +342,10 @@ fn a_multi_file_ome_set_is_read_whole_from_any_of_its_files() {
     analyze(&plain, &alone, &["--forces", forces]);
 
     // Either file gives the four time points; the folder of both gives them once.
-    for (k, input) in [set.join(names[0]), set.join(names[1]), set.clone()]
-        .iter()
-        .enumerate()
-    {
-        let out = tmp.path().join(format!("set-{k}"));
-        analyze(input, &out, &["--forces", forces]);
-        assert_eq!(areas(&out), areas(&alone), "{}", input.display());
-        assert_eq!(threshold(&out), threshold(&alone));
-    }
+    let inputs = [set.join(names[0]), set.join(names[1]), set.clone()];
+    let outs = each_reads_as(tmp.path(), "set", &inputs, &alone, forces);
     // The images read from the other file say so.
-    let (header, rows) = crate::common::read_csv(&tmp.path().join("set-0").join("areas.csv"));
-    let image = header.iter().position(|h| h == "image").unwrap();
-    assert!(rows[0][image].contains(names[0]), "{:?}", rows[0]);
-    assert!(rows[3][image].contains(names[1]), "{:?}", rows[3]);
+    images_come_from(&outs[0], names[0], names[1]);
 
     // A set whose first file only points to the master's XML (BinaryOnly), in a folder where
     // it sorts first: read once (the pointer followed to the master's XML).
@@ -366,22 +404,7 @@ fn a_multi_file_ome_set_is_read_whole_from_any_of_its_files() {
         std::fs::copy(set.join(n), archive.join(n)).unwrap();
     }
     let out = tmp.path().join("batch");
-    let batch = |what: &str| {
-        let o = run_ok(&[
-            "batch",
-            s(&archive),
-            "--out",
-            s(&out),
-            "--pattern",
-            "*.ome.tif",
-            "--forces",
-            forces,
-            "--pixel-size",
-            "200nm",
-        ]);
-        let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
-        assert!(said.contains(what), "{what}: {said}");
-    };
+    let batch = |what: &str| batch_says(&archive, &out, forces, what);
     batch("1 series: 1 ok");
     let (_, rows) = crate::common::read_csv(&out.join("images.csv"));
     assert_eq!(rows.len(), 4);
@@ -435,25 +458,15 @@ fn an_ome_set_with_a_companion_file_is_read_from_any_of_its_files_and_from_the_c
         &planes[2..],
         &binary_only("set.companion.ome", uuid),
     );
-    for (k, input) in [
+    let inputs = [
         set.join(names[0]),
         set.join(names[1]),
         set.clone(),
         companion.clone(),
-    ]
-    .iter()
-    .enumerate()
-    {
-        let out = tmp.path().join(format!("set-{k}"));
-        analyze(input, &out, &["--forces", forces]);
-        assert_eq!(areas(&out), areas(&alone), "{}", input.display());
-        assert_eq!(threshold(&out), threshold(&alone));
-    }
+    ];
+    let outs = each_reads_as(tmp.path(), "set", &inputs, &alone, forces);
     // Through the companion the images name the TIFFs they came from.
-    let (header, rows) = crate::common::read_csv(&tmp.path().join("set-3").join("areas.csv"));
-    let image = header.iter().position(|h| h == "image").unwrap();
-    assert!(rows[0][image].contains(names[0]), "{:?}", rows[0]);
-    assert!(rows[3][image].contains(names[1]), "{:?}", rows[3]);
+    images_come_from(&outs[3], names[0], names[1]);
     // `info` says where the axes came from.
     let o = run_ok(&["info", s(&set.join(names[1]))]);
     let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
@@ -502,20 +515,7 @@ fn an_ome_set_with_a_companion_file_is_read_from_any_of_its_files_and_from_the_c
     // A batch over the set's folder: one series of four images; a changed companion (the
     // axes come from it) makes the series stale.
     let out = tmp.path().join("batch");
-    let batch = |what: &str| {
-        let o = run_ok(&[
-            "batch",
-            s(&set),
-            "--out",
-            s(&out),
-            "--pattern",
-            "*.ome.tif",
-            "--forces",
-            forces,
-        ]);
-        let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
-        assert!(said.contains(what), "{what}: {said}");
-    };
+    let batch = |what: &str| batch_says(&set, &out, forces, what);
     batch("1 series: 1 ok");
     let (_, rows) = crate::common::read_csv(&out.join("images.csv"));
     assert_eq!(rows.len(), 4);

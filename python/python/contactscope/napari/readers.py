@@ -36,7 +36,8 @@ from ._common import ERRORS, META, guarded, layer_meta, notify_error, one_line, 
 LayerData = Tuple[Any, Dict[str, Any], str]
 PathOrPaths = Union[str, Sequence[str]]
 
-MICROGRAPH_EXTENSIONS = (".tif", ".tiff", ".czi", ".nd2", ".lif", ".zarr")
+# `.ome`: an OME-TIFF set's companion file (`NAME.companion.ome`), which opens the set.
+MICROGRAPH_EXTENSIONS = (".tif", ".tiff", ".czi", ".nd2", ".lif", ".zarr", ".ome")
 TIFF_EXTENSIONS = (".tif", ".tiff")
 TOPOGRAPHY_EXTENSIONS = (".ibw", ".nid", ".mi", ".gwy", ".x3p", ".sdf", ".opd", ".plu", ".sur",
                          ".frt", ".gsf", ".top", ".stp", ".di", ".spm", ".001", ".al3d", ".tmd",
