@@ -370,7 +370,7 @@ pub fn read_measurement(
     }
     if let Some(mode) = detrend.as_deref() {
         ContainerDetrend::from_mode(mode)
-            .and_then(|d| d.apply(&mut map.heights))
+            .and_then(|d| d.apply(&mut map.heights, m.periodic))
             .map_err(|e| Error::bad_input(at(), format!("measurement {}: {e}", m.label())))?;
     }
     Ok((map, read.notes))

@@ -15,6 +15,7 @@
 //!   `.top`, Bruker/Nanoscope, vendor AFM formats) is `contactscope_formats::topography`, which
 //!   returns a [`HeightMap`]; [`Topography::from_height_map`] takes it.
 
+pub mod bearing;
 pub mod fill;
 pub mod generate;
 pub mod masked;

@@ -12,6 +12,7 @@
 //! | `height`, `rms-tilt` | the least-squares plane `a + b·x + c·y` |
 //! | `curvature`, `rms-curvature` | the least-squares quadric `a + b·x + c·y + d·x² + e·y² + f·x·y` |
 //! | `slope` | the plane whose slopes are the mean forward-difference slopes along x and y, placed so that the mean of the result is zero |
+//! | `median` | the median height of the piecewise-linear surface ([`super::bearing::median_height`]) |
 //!
 //! For `slope` SurfaceTopography takes the forward differences of a non-periodic map on the
 //! grid that both derivatives share, (nx − 1) × (ny − 1) points: the x differences leave out the
@@ -20,10 +21,14 @@
 //! reader, top line first), the line left out is the other one, and the slope differs by about
 //! one line's share (1e-4 relative on a 256-line map).
 //!
-//! Not provided, and refused by name ([`ContainerDetrend::from_mode`]): `median`
-//! (SurfaceTopography's median is the height at which the bearing area of the piecewise-linear
-//! surface is one half, found by bisection to 1e-6 of the height range, not a median of the
-//! points) and `mad-tilt`, `mad-curvature` (least absolute deviations).
+//! `median` is SurfaceTopography's median: the height at which the bearing area of the
+//! piecewise-linear surface is one half, found by bisection to 1e-6 of the height range (not a
+//! median of the points); a periodic map's surface closes across its edges.
+//!
+//! Not provided, and refused by name ([`ContainerDetrend::from_mode`]): `mad-tilt` and
+//! `mad-curvature` (the polynomial minimising the residual's median absolute deviation, which
+//! SurfaceTopography finds with scipy's Nelder–Mead from the least-squares fit: a result that
+//! is the optimiser's, to its own tolerances, more than the data's).
 
 use nalgebra::{DMatrix, DVector};
 use ndarray::Array2;
@@ -41,6 +46,8 @@ pub enum ContainerDetrend {
     Quadric,
     /// Subtract the mean-slope plane (`slope`).
     Slope,
+    /// Subtract the median height of the piecewise-linear surface (`median`).
+    Median,
 }
 
 impl ContainerDetrend {
@@ -51,19 +58,21 @@ impl ContainerDetrend {
             "height" | "rms-tilt" => ContainerDetrend::Plane,
             "curvature" | "rms-curvature" => ContainerDetrend::Quadric,
             "slope" => ContainerDetrend::Slope,
+            "median" => ContainerDetrend::Median,
             other => {
                 return Err(Error::InvalidArgument(format!(
                     "detrend mode '{other}' is not applied by contactscope (it applies center, \
-                     mean, height, rms-tilt, slope, curvature and rms-curvature)"
+                     mean, median, height, rms-tilt, slope, curvature and rms-curvature)"
                 )))
             }
         })
     }
 
-    /// Subtract the trend from `heights` (rows = y, NaN = invalid). Refused without a valid
+    /// Subtract the trend from `heights` (rows = y, NaN = invalid; `periodic`: the map repeats,
+    /// which only [`ContainerDetrend::Median`]'s surface depends on). Refused without a valid
     /// point, and for [`ContainerDetrend::Slope`] with an invalid one (its finite differences
     /// need every height).
-    pub fn apply(self, heights: &mut Array2<f64>) -> Result<()> {
+    pub fn apply(self, heights: &mut Array2<f64>, periodic: bool) -> Result<()> {
         let valid: Vec<f64> = heights.iter().copied().filter(|h| h.is_finite()).collect();
         if valid.is_empty() {
             return Err(Error::InvalidArgument(
@@ -78,6 +87,14 @@ impl ContainerDetrend {
             ContainerDetrend::Plane => subtract_least_squares(heights, 1)?,
             ContainerDetrend::Quadric => subtract_least_squares(heights, 2)?,
             ContainerDetrend::Slope => subtract_mean_slope(heights)?,
+            ContainerDetrend::Median => {
+                let median = super::bearing::median_height(heights, periodic).ok_or_else(|| {
+                    Error::InvalidArgument(
+                        "detrend mode 'median' needs two neighbouring valid heights".into(),
+                    )
+                })?;
+                heights.mapv_inplace(|h| h - median);
+            }
         }
         Ok(())
     }
@@ -236,11 +253,11 @@ mod tests {
         let mut h = quadric(9, 13);
         h[[3, 4]] = f64::NAN;
         let mut q = h.clone();
-        ContainerDetrend::Quadric.apply(&mut q).unwrap();
+        ContainerDetrend::Quadric.apply(&mut q, false).unwrap();
         assert!(worst(&q) < 1e-12, "{}", worst(&q));
         assert!(q[[3, 4]].is_nan());
         let mut p = h.clone();
-        ContainerDetrend::Plane.apply(&mut p).unwrap();
+        ContainerDetrend::Plane.apply(&mut p, false).unwrap();
         assert!(worst(&p) > 1e-3, "a plane cannot remove x², y², xy");
         // The residual of a plane fit is orthogonal to 1, x and y: zero mean over valid points.
         let valid: Vec<f64> = p.iter().copied().filter(|v| v.is_finite()).collect();
@@ -250,31 +267,34 @@ mod tests {
     #[test]
     fn slope_uses_the_shared_difference_grid() {
         let mut h = Array2::from_shape_fn((4, 5), |(i, j)| 1.0 + 2.0 * j as f64 - 0.5 * i as f64);
-        ContainerDetrend::Slope.apply(&mut h).unwrap();
+        ContainerDetrend::Slope.apply(&mut h, false).unwrap();
         assert!(worst(&h) < 1e-12, "{}", worst(&h));
         // Only the last row differs from a plane: the x slope ignores it, the y slope does not.
         let mut h =
             Array2::from_shape_fn((3, 3), |(i, j)| j as f64 + if i == 2 { 6.0 } else { 0.0 });
-        ContainerDetrend::Slope.apply(&mut h).unwrap();
+        ContainerDetrend::Slope.apply(&mut h, false).unwrap();
         // x slope 1 per pixel (rows 0, 1), y slope (6 + 0)/2 = 3 per pixel (columns 0, 1).
         assert!((h[(0, 1)] - h[(0, 0)]).abs() < 1e-12);
         assert!(((h[(1, 0)] - h[(0, 0)]) + 3.0).abs() < 1e-12, "{h:?}");
-        assert!(ContainerDetrend::from_mode("median").is_err());
+        assert_eq!(
+            ContainerDetrend::from_mode("median").unwrap(),
+            ContainerDetrend::Median
+        );
         let mut bad = quadric(3, 3);
         bad[[1, 1]] = f64::NAN;
-        assert!(ContainerDetrend::Slope.apply(&mut bad).is_err());
+        assert!(ContainerDetrend::Slope.apply(&mut bad, false).is_err());
         let mut empty = Array2::from_elem((2, 2), f64::NAN);
-        assert!(ContainerDetrend::Mean.apply(&mut empty).is_err());
+        assert!(ContainerDetrend::Mean.apply(&mut empty, false).is_err());
     }
 
     #[test]
     fn single_row_and_column_maps() {
         for shape in [(1, 6), (6, 1), (2, 2)] {
             let mut h = Array2::from_shape_fn(shape, |(i, j)| 2.0 + i as f64 + 3.0 * j as f64);
-            ContainerDetrend::Plane.apply(&mut h).unwrap();
+            ContainerDetrend::Plane.apply(&mut h, false).unwrap();
             assert!(worst(&h) < 1e-12, "{shape:?}: {}", worst(&h));
             let mut h = Array2::from_shape_fn(shape, |(i, j)| 2.0 + i as f64 + 3.0 * j as f64);
-            ContainerDetrend::Quadric.apply(&mut h).unwrap();
+            ContainerDetrend::Quadric.apply(&mut h, false).unwrap();
             assert!(worst(&h) < 1e-12, "{shape:?}: {}", worst(&h));
         }
     }
