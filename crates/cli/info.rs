@@ -73,8 +73,7 @@ pub fn run(args: Args) -> Result<()> {
     );
     match &i.metadata_file {
         Some(file) => println!(
-            "description:  {}, read from the set's metadata file {} (this file's only points \
-             to it)",
+            "description:  {}, read from the set's metadata file {}",
             i.description_kind,
             file.display()
         ),

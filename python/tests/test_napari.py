@@ -105,7 +105,7 @@ def test_an_ome_companion_file_opens_its_set(tmp_path):
 
     from contactscope.napari import readers
 
-    s = cs.synth_series(64, 60, 200e-9, [1e-3, 2e-3, 4e-3, 8e-3], seed=5)
+    s = cs.synth_series(64, 60, 250e-9, [1e-3, 1.5e-3, 2e-3, 3e-3], seed=5)
     names = ["set_0.ome.tif", "set_1.ome.tif"]
     ns = "http://www.openmicroscopy.org/Schemas/OME/2016-06"
     uuid = "urn:uuid:00000000-0000-4000-8000-000000000001"
@@ -117,8 +117,8 @@ def test_an_ome_companion_file_opens_its_set(tmp_path):
     (tmp_path / "set.companion.ome").write_text(
         f'<?xml version="1.0" encoding="UTF-8"?><OME xmlns="{ns}" UUID="{uuid}">'
         '<Image ID="Image:0"><Pixels ID="Pixels:0" DimensionOrder="XYCZT" Type="uint16" '
-        'SizeX="64" SizeY="60" SizeC="1" SizeZ="1" SizeT="4" PhysicalSizeX="0.2" '
-        'PhysicalSizeXUnit="µm" PhysicalSizeY="0.2" PhysicalSizeYUnit="µm">'
+        'SizeX="64" SizeY="60" SizeC="1" SizeZ="1" SizeT="4" PhysicalSizeX="0.25" '
+        'PhysicalSizeXUnit="µm" PhysicalSizeY="0.25" PhysicalSizeYUnit="µm">'
         f'<Channel ID="Channel:0:0" SamplesPerPixel="1"/>{blocks}</Pixels></Image></OME>'
     )
     pointer = (f'<?xml version="1.0" encoding="UTF-8"?><OME xmlns="{ns}">'
@@ -133,7 +133,7 @@ def test_an_ome_companion_file_opens_its_set(tmp_path):
     [(data, kwargs, kind)] = reader(companion)
     assert kind == "image"
     np.testing.assert_array_equal(data, s.images)
-    assert kwargs["scale"][-2:] == pytest.approx([0.2, 0.2])
+    assert kwargs["scale"][-2:] == pytest.approx([0.25, 0.25])
 
 
 def _store_with_masks(series_tif, tmp_path, cli):
