@@ -4,7 +4,7 @@
 //! the TIFF's folder — a TIFF of the set that carries the whole XML (the "master"), or an XML
 //! file of its own (`NAME.companion.ome`). The reader follows that pointer once, so that any file
 //! of the set reads the whole set; a companion file given as the input opens the set through
-//! the TIFF holding its first plane.
+//! the TIFF its first `TiffData` block names.
 
 use std::io::Read;
 use std::path::{Component, Path, PathBuf};
@@ -137,8 +137,9 @@ pub(crate) fn follow(path: &Path, pointer: &Pointer) -> Result<(PathBuf, String)
     Ok((file, xml))
 }
 
-/// The TIFF through which the set of a companion file is read (the file of the first
-/// `TiffData` block of the first image, which holds its first planes), and the companion's XML.
+/// The TIFF through which the set of a companion file is read (the file named by the first
+/// `TiffData` block of the first image; any file of the set reads the whole set), and the
+/// companion's XML.
 pub(crate) fn anchor(companion: &Path) -> Result<(PathBuf, String), String> {
     let xml = read_document(companion, None)?;
     let doc = roxmltree::Document::parse(&xml).map_err(|e| e.to_string())?;

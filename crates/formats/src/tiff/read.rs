@@ -220,29 +220,42 @@ impl TiffReader {
     /// Open a TIFF file and read its headers (every IFD, no pixel data).
     ///
     /// An OME companion file (the XML of a multi-file OME-TIFF set, [`super::companion`]) opens
-    /// the set through the TIFF holding its first plane, with the companion's XML.
+    /// the set through the TIFF of its first `TiffData` block, with the companion's XML.
     pub fn open(path: &Path) -> Result<Self> {
         crate::inputs::note_input(path);
-        if !crate::remote::is_url(path) && is_xml_file(path) {
-            let (anchor, xml) = super::companion::anchor(path).map_err(|why| {
-                Error::bad_input(
-                    Location::file(path),
-                    format!("an OME companion file whose set cannot be read: {why}"),
-                )
-            })?;
-            crate::inputs::note_input(&anchor);
-            let mut decoder = decoder(&anchor, |e| tiff_error(Location::file(&anchor), e))?;
-            let metadata = Metadata {
-                file: path.to_path_buf(),
-                xml,
-            };
-            let info = read_info(&anchor, &mut decoder, Some(metadata))?;
-            return Ok(TiffReader { decoder, info });
-        }
-        let mut decoder = decoder(path, |e| {
+        let opened = decoder(path, |e| {
             other_format(path).unwrap_or_else(|| tiff_error(Location::file(path), e))
+        });
+        match opened {
+            Ok(mut decoder) => {
+                let info = read_info(path, &mut decoder, None)?;
+                Ok(TiffReader { decoder, info })
+            }
+            // Not a TIFF: a companion file is looked for only then (no second open of every
+            // TIFF).
+            Err(_) if !crate::remote::is_url(path) && is_xml_file(path) => {
+                Self::open_companion(path)
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// The set of the OME companion file at `path`, through the TIFF of its first `TiffData`
+    /// block, with the companion's XML.
+    fn open_companion(path: &Path) -> Result<Self> {
+        let (anchor, xml) = super::companion::anchor(path).map_err(|why| {
+            Error::bad_input(
+                Location::file(path),
+                format!("an OME companion file whose set cannot be read: {why}"),
+            )
         })?;
-        let info = read_info(path, &mut decoder, None)?;
+        crate::inputs::note_input(&anchor);
+        let mut decoder = decoder(&anchor, |e| tiff_error(Location::file(&anchor), e))?;
+        let metadata = Metadata {
+            file: path.to_path_buf(),
+            xml,
+        };
+        let info = read_info(&anchor, &mut decoder, Some(metadata))?;
         Ok(TiffReader { decoder, info })
     }
 

@@ -39,14 +39,23 @@ pub(crate) fn one_file_per_set(files: Vec<PathBuf>) -> (Vec<PathBuf>, HashMap<Pa
             (canonical, members)
         })
         .collect();
-    let names = |j: usize, i: usize| sets[j].1.contains(&sets[i].0);
+    // For each file, the files that name it as a file of their set (one pass over the sets:
+    // a folder of thousands of plain TIFFs names none).
+    let mut named_by: HashMap<&PathBuf, Vec<usize>> = HashMap::new();
+    for (j, (_, members)) in sets.iter().enumerate() {
+        for m in members {
+            named_by.entry(m).or_default().push(j);
+        }
+    }
     let mut kept: Vec<usize> = Vec::new();
-    for i in 0..files.len() {
-        let by_kept = kept.iter().any(|&j| names(j, i));
-        let pointer = sets[i].1.is_empty()
-            && (0..files.len()).any(|j| j != i && !sets[j].1.is_empty() && names(j, i));
+    let mut is_kept = vec![false; files.len()];
+    for (i, (canonical, members)) in sets.iter().enumerate() {
+        let namers = named_by.get(canonical).map(Vec::as_slice).unwrap_or(&[]);
+        let by_kept = namers.iter().any(|&j| is_kept[j]);
+        let pointer = members.is_empty() && namers.iter().any(|&j| j != i);
         if !by_kept && !pointer {
             kept.push(i);
+            is_kept[i] = true;
         }
     }
     let chosen: Vec<PathBuf> = kept.iter().map(|&i| files[i].clone()).collect();
