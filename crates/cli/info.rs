@@ -62,7 +62,36 @@ pub fn run(args: Args) -> Result<()> {
         i.channels,
         i.channel_layout.describe()
     );
-    println!("axes:         {}", tiff_axes(&i.axes));
+    if i.images.len() > 1 {
+        println!(
+            "images:       {} in its OME-XML, each a series: choose one with --series 0..{}, or \
+             read them as the loads with --load-axis series",
+            i.images.len(),
+            i.images.len() - 1
+        );
+        for series in contactscope_formats::microscopy::tiff_series(&i) {
+            let name = match series.name.as_str() {
+                "" => String::new(),
+                n => format!(" '{n}'"),
+            };
+            let size = match (series.pixel_size.x_m, series.pixel_size.y_m) {
+                (Some(x), Some(y)) => format!(
+                    ", {} × {} pixels",
+                    units::format_length(x),
+                    units::format_length(y)
+                ),
+                _ => ", no pixel size".into(),
+            };
+            let a = &series.axes;
+            println!(
+                "  series {}{name}: T {} × Z {} × C {}, {} × {} px{size}",
+                series.index, a.t, a.z, a.c, a.x, a.y
+            );
+        }
+        println!("axes:         series 0: {}", tiff_axes(&i.axes));
+    } else {
+        println!("axes:         {}", tiff_axes(&i.axes));
+    }
     println!(
         "compression:  {} (predictor: {}), {}{}, {}-endian",
         i.compression,

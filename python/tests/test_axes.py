@@ -77,6 +77,31 @@ def test_a_channel_by_its_ome_name(tmp_path):
         cs.read_series(path)
 
 
+def test_each_image_of_a_multi_image_ome_tiff_is_tifffiles_series(tmp_path):
+    """Images written one after another into one OME-TIFF (stage positions): series k is
+    tifffile's ``series[k]``, with its own axes and pixel size; none is read unchosen."""
+    path = tmp_path / "positions.ome.tif"
+    first, second = _data("TCYX"), _data("ZYX")[:, :8, :6]
+    with tifffile.TiffWriter(path, ome=True) as w:
+        w.write(first, metadata={"axes": "TCYX", "Name": "left"})
+        w.write(second, metadata={"axes": "ZYX", "Name": "right",
+                                  "PhysicalSizeX": 0.1, "PhysicalSizeY": 0.1})
+    with tifffile.TiffFile(path) as f:
+        want = [s.asarray() for s in f.series]
+        assert [s.axes for s in f.series] == ["TCYX", "ZYX"]
+    info = cs.info(path)["series"]
+    assert [s["name"] for s in info] == ["left", "right"]
+    assert (info[1]["axes"]["Z"], info[1]["axes"]["Y"], info[1]["axes"]["X"]) == (2, 8, 6)
+    assert info[1]["pixel_size_m"]["x"] == pytest.approx(1e-7)
+    with pytest.raises(cs.InputError, match="'right'"):
+        cs.read_series(path, channel=0, load_axis="t")
+    got = cs.read_series(path, series=0, channel=1, load_axis="t")["images"]
+    np.testing.assert_array_equal(got, want[0][:, 1])
+    got = cs.read_series(path, series=1, load_axis="z")
+    np.testing.assert_array_equal(got["images"], want[1])
+    assert got["pixel_size_m"][0] == pytest.approx(1e-7)
+
+
 def test_rgb_arrays_are_refused_and_loads_last_warned_of():
     rgb = np.zeros((64, 48, 3), np.uint16)
     with pytest.raises(cs.InputError, match="rgb_to_gray"):

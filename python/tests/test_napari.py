@@ -136,6 +136,29 @@ def test_an_ome_companion_file_opens_its_set(tmp_path):
     assert kwargs["scale"][-2:] == pytest.approx([0.25, 0.25])
 
 
+@needs_napari
+def test_each_image_of_a_multi_image_ome_tiff_is_a_layer(tmp_path):
+    """Two stage positions in one OME-TIFF: one layer each, named by the image, with its own
+    pixel size (not eight pages of one stack)."""
+    import tifffile
+
+    from contactscope.napari import readers
+
+    s = cs.synth_series(64, 60, 250e-9, [1e-3, 1.5e-3, 2e-3, 3e-3], seed=6)
+    path = tmp_path / "positions.ome.tif"
+    with tifffile.TiffWriter(path, ome=True) as w:
+        w.write(s.images[:2], metadata={"axes": "TYX", "Name": "left", "PhysicalSizeX": 0.25,
+                                        "PhysicalSizeY": 0.25})
+        w.write(s.images[2:], metadata={"axes": "TYX", "Name": "right", "PhysicalSizeX": 0.1,
+                                        "PhysicalSizeY": 0.1})
+    layers = readers.get_micrograph_reader(str(path))(str(path))
+    assert [kwargs["name"] for _, kwargs, _ in layers] == [
+        "positions.ome [0: left]", "positions.ome [1: right]"]
+    np.testing.assert_array_equal(layers[0][0], s.images[:2])
+    np.testing.assert_array_equal(layers[1][0], s.images[2:])
+    assert layers[1][1]["scale"][-2:] == pytest.approx([0.1, 0.1])
+
+
 def _store_with_masks(series_tif, tmp_path, cli):
     """A new OME-Zarr store written by `analyze --zarr-out` from the series TIFF."""
     path, _ = series_tif

@@ -2,7 +2,7 @@
 //! axes"): an OME-TIFF's channels are not pooled into one series, an ImageJ hyperstack's focal
 //! planes are not taken for loads, a z stack is not a load series unless told so, a multi-file
 //! OME set is read whole (once) from any of its files, also when its metadata is kept in a
-//! companion file.
+//! companion file, and each image of a multi-image OME-TIFF is a series of its own.
 //!
 //! The files are written here page by page with the ImageDescription each writer would give
 //! (OME-XML as tifffile writes it for axes TCYX; ImageJ's `channels/slices/frames`), and each
@@ -102,6 +102,7 @@ fn ome_tiff_channels_are_channels_not_pages() {
     assert_eq!(series["axes"]["T"], 4);
     assert_eq!(series["channels"][1]["name"], "refl");
     assert_eq!(series["axes_from"], "ome");
+    assert!(info.get("metadata_file").is_none(), "{info}");
 
     // Without a channel: one refusal naming both channels.
     let forces = "4,10,20,40mN";
@@ -472,6 +473,10 @@ fn an_ome_set_with_a_companion_file_is_read_from_any_of_its_files_and_from_the_c
     let said = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
     assert!(said.contains("set.companion.ome"), "{said}");
     assert!(said.contains("T 4"), "{said}");
+    let o = run_ok(&["info", s(&set.join(names[1])), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let file = json["metadata_file"].as_str().unwrap_or_default();
+    assert!(file.ends_with("set.companion.ome"), "{json}");
 
     // The companion missing, or another set's: each file is read alone, in file order, and
     // says why (not the four time points of a set it cannot see).
@@ -524,4 +529,112 @@ fn an_ome_set_with_a_companion_file_is_read_from_any_of_its_files_and_from_the_c
     xml = xml.replace("SizeT=\"4\"", "SizeT=\"4\" Name=\"edited\"");
     std::fs::write(&companion, xml).unwrap();
     batch("1 analysed, 0 reused");
+}
+
+/// OME-XML of `images` images as tifffile writes one series after another in one file: each
+/// `(name, size_t, pixel size µm)`, its planes on the pages after the images before it.
+fn images_xml(images: &[(&str, usize, f64)]) -> String {
+    let mut ifd = 0;
+    let body: String = images
+        .iter()
+        .enumerate()
+        .map(|(k, (name, t, um))| {
+            let block = format!(
+                r#"<Image ID="Image:{k}" Name="{name}"><Pixels ID="Pixels:{k}" DimensionOrder="XYCZT" Type="uint16" SizeX="{W}" SizeY="{W}" SizeC="1" SizeZ="1" SizeT="{t}" PhysicalSizeX="{um}" PhysicalSizeY="{um}"><Channel ID="Channel:{k}:0" SamplesPerPixel="1"/><TiffData IFD="{ifd}" PlaneCount="{t}"/></Pixels></Image>"#
+            );
+            ifd += t;
+            block
+        })
+        .collect();
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?><OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06" Creator="tifffile.py 2026.3.3">{body}</OME>"#
+    )
+}
+
+#[test]
+fn each_image_of_a_multi_image_ome_tiff_is_a_series() {
+    let tmp = tempfile::tempdir().unwrap();
+    let forces = "4,10,20,40mN";
+    // Two stage positions of four time points each; the second at 0.1 µm pixels.
+    let first: Vec<Vec<u16>> = [4.0, 7.0, 10.0, 13.0]
+        .iter()
+        .map(|&r| disk(r, 2000, 0))
+        .collect();
+    let second: Vec<Vec<u16>> = [5.0, 9.0, 12.0, 16.0]
+        .iter()
+        .map(|&r| disk(r, 1500, 50))
+        .collect();
+    let ome = tmp.path().join("positions.ome.tif");
+    let pages: Vec<Vec<u16>> = first.iter().chain(&second).cloned().collect();
+    write_tiff(
+        &ome,
+        &pages,
+        &images_xml(&[("left", 4, 0.2), ("right", 4, 0.1)]),
+    );
+    let plain = tmp.path().join("right.tif");
+    write_tiff(&plain, &second, "plain pages");
+
+    let info = run_ok(&["info", s(&ome), "--json"]);
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(info["series"].as_array().map(Vec::len), Some(2), "{info}");
+    assert_eq!(info["series"][1]["name"], "right");
+    assert_eq!(info["series"][1]["pixel_size_um"]["x"], 0.1);
+    let text = String::from_utf8_lossy(&run_ok(&["info", s(&ome)]).stdout).to_string();
+    assert!(text.contains("series 1 'right'"), "{text}");
+
+    // Not pooled into one series of eight pages: a refusal naming both images.
+    let e = refused(&["analyze", s(&ome), "--forces", forces]);
+    assert!(e.contains("2 series") && e.contains("'right'"), "{e}");
+    // The second image alone: its planes and its own pixel size.
+    let (chosen, alone) = (tmp.path().join("chosen"), tmp.path().join("alone"));
+    let args = ["--series", "1", "--forces", forces];
+    run_ok(&[&["analyze", s(&ome), "--out", s(&chosen)][..], &args].concat());
+    run_ok(&[
+        "analyze",
+        s(&plain),
+        "--pixel-size",
+        "100nm",
+        "--out",
+        s(&alone),
+        "--forces",
+        forces,
+    ]);
+    assert_eq!(threshold(&chosen), threshold(&alone));
+    assert_eq!(areas(&chosen), areas(&alone));
+    let (header, rows) = crate::common::read_csv(&chosen.join("areas.csv"));
+    let um2 = crate::common::column(&header, &rows, "area_um2");
+    for (a, px) in um2.iter().zip(areas(&alone)) {
+        assert!(
+            (a - px * 0.01).abs() < 1e-9,
+            "{a} µm² for {px} px of 0.1 µm"
+        );
+    }
+
+    // One plane per image, the images the loads: read in image order...
+    let one_each = tmp.path().join("one_each.ome.tif");
+    let each: Vec<(&str, usize, f64)> = ["a", "b", "c", "d"].map(|n| (n, 1, 0.2)).to_vec();
+    write_tiff(&one_each, &first, &images_xml(&each));
+    let plain = tmp.path().join("first.tif");
+    write_tiff(&plain, &first, "plain pages");
+    let (loads, alone) = (tmp.path().join("loads"), tmp.path().join("first"));
+    analyze(
+        &one_each,
+        &loads,
+        &["--load-axis", "series", "--forces", forces],
+    );
+    analyze(&plain, &alone, &["--forces", forces]);
+    assert_eq!(areas(&loads), areas(&alone));
+    // ... and refused when the images differ in pixel size.
+    let mixed = tmp.path().join("mixed.ome.tif");
+    let sizes = [("a", 1, 0.2), ("b", 1, 0.2), ("c", 1, 0.1), ("d", 1, 0.2)];
+    write_tiff(&mixed, &first, &images_xml(&sizes));
+    let e = refused(&[
+        "analyze",
+        s(&mixed),
+        "--load-axis",
+        "series",
+        "--forces",
+        forces,
+    ]);
+    assert!(e.contains("image 2") && e.contains("0.1000"), "{e}");
 }

@@ -225,6 +225,7 @@ impl Selection {
         if let Some(info) = file.tiff_info() {
             return Ok(self
                 .tiff_planes(info, along, LoadDefault::None)?
+                .1
                 .into_iter()
                 .map(|(plane, _)| plane)
                 .collect());
@@ -558,9 +559,8 @@ fn read_tiff_planes(
     pixel_size_m: Option<(f64, f64)>,
 ) -> Result<Vec<Image>> {
     let mut reader = crate::tiff::TiffReader::open(path)?;
-    let info = reader.info().clone();
+    let (info, planes) = selection.tiff_planes(reader.info(), along, default)?;
     let pixel_size = pixel_size_or(info.pixel_size, pixel_size_m);
-    let planes = selection.tiff_planes(&info, along, default)?;
     // The other file of a multi-file OME set last read from.
     let mut member: Option<crate::tiff::TiffReader> = None;
     planes

@@ -11,8 +11,10 @@
 //! `planes` is present only when statistics are asked for; extra axes (`H`, `S`, …) appear in
 //! `axes` and as further keys of each plane. A scan without a y axis has `"rows": "Z"` (an X–Z
 //! section: `Y` counts focal planes, `pixel_size_um.y` is the z step) or `"rows": "T"` (an X–T
-//! line scan: `Y` counts time points, no y size); other series have no `rows` key. Statistics are over finite values (NaN and ±∞ of
-//! float images are left out); sums of integer images are exact.
+//! line scan: `Y` counts time points, no y size); other series have no `rows` key. A TIFF
+//! whose OME-XML was read from another file (a companion `.companion.ome`, a set's master TIFF)
+//! names it in `"metadata_file"`. Statistics are over finite values (NaN and ±∞ of float images
+//! are left out); sums of integer images are exact.
 
 use std::path::Path;
 
@@ -34,6 +36,10 @@ pub struct InfoSummary {
     pub format: String,
     /// One entry per series.
     pub series: Vec<SeriesSummary>,
+    /// The file a TIFF's OME-XML was read from when the TIFF only points to it (a companion
+    /// `.companion.ome` or the master TIFF of a multi-file set); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub metadata_file: Option<String>,
 }
 
 /// One series of [`InfoSummary`].
@@ -245,6 +251,10 @@ pub fn info_summary_selected(
         file: path.display().to_string(),
         format: file.format.name().to_string(),
         series,
+        metadata_file: file
+            .tiff_info()
+            .and_then(|i| i.metadata_file.as_ref())
+            .map(|m| m.display().to_string()),
     })
 }
 

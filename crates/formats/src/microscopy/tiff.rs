@@ -1,7 +1,8 @@
 //! TIFF described as a [`MicroscopyFile`](super::MicroscopyFile) series, through the existing
 //! [`crate::tiff`] reader: one series whose `T`, `Z` and `C` are the axes the file's OME-XML or
-//! ImageJ description states ([`crate::tiff::axes`]); pages without axis metadata are time
-//! points (`T`), and serve as the load axis whichever one is asked for
+//! ImageJ description states ([`crate::tiff::axes`]), one series per image of an OME-TIFF
+//! whose XML describes several (OME `Image` elements: stage positions, scenes); pages without
+//! axis metadata are time points (`T`), and serve as the load axis whichever one is asked for
 //! ([`super::select::Selection::tiff_planes`]).
 
 use std::collections::BTreeMap;
@@ -11,9 +12,9 @@ use super::select::{LoadAxis, SelectedPlane, Selection};
 use super::{Axes, ChannelInfo, PlaneIndex, SeriesInfo, VoxelSize};
 use crate::binary::bad;
 use crate::error::Result;
-use crate::image::Plane;
+use crate::image::{PixelSize, PixelSizeSource, Plane};
 use crate::param::Param;
-use crate::tiff::{AxesSource, Place, TiffInfo, TiffReader};
+use crate::tiff::{AxesSource, Place, TiffAxes, TiffInfo, TiffReader};
 
 /// An open TIFF.
 pub(crate) struct TiffBackend {
@@ -34,16 +35,11 @@ pub struct TiffPage {
     pub sample: usize,
 }
 
-/// The path of [`TiffAxes::other_files`]`[file]`: a multi-file OME set names its files by
-/// `UUID FileName`, relative to the folder of the file whose OME-XML names them (OME-TIFF
-/// specification, "multi-file datasets"). A name that is absolute or leaves the folder (`..`)
-/// is refused, as is one no file answers to.
-pub fn set_member(info: &TiffInfo, file: usize) -> Result<PathBuf> {
-    let name = info
-        .axes
-        .other_files
-        .get(file)
-        .ok_or_else(|| bad(&info.path, format!("no file {file} in this OME-TIFF set")))?;
+/// The path of the file `name` of `info`'s OME set (one of [`TiffInfo::set_files`]): a
+/// multi-file OME set names its files by `UUID FileName`, relative to the folder of the file
+/// whose OME-XML names them (OME-TIFF specification, "multi-file datasets"). A name that is
+/// absolute or leaves the folder (`..`) is refused, as is one no file answers to.
+pub fn set_member(info: &TiffInfo, name: &str) -> Result<PathBuf> {
     let relative = Path::new(name);
     let plain = relative
         .components()
@@ -100,9 +96,13 @@ pub fn open_member(info: &TiffInfo, path: &Path) -> Result<TiffReader> {
     Ok(reader)
 }
 
-/// Where plane (t, z, c) of a TIFF is read (module docs); an error when no page holds it.
-pub fn page_at(info: &TiffInfo, t: usize, z: usize, c: usize) -> Result<TiffPage> {
-    let (place, sample) = info.axes.place_of(t, z, c).ok_or_else(|| {
+/// Where plane (t, z, c) of series `series` of a TIFF is read (module docs); an error when no
+/// page holds it.
+pub fn page_at(info: &TiffInfo, series: usize, t: usize, z: usize, c: usize) -> Result<TiffPage> {
+    let axes = info
+        .axes_of(series)
+        .ok_or_else(|| bad(&info.path, format!("the file holds no series {series}")))?;
+    let (place, sample) = axes.place_of(t, z, c).ok_or_else(|| {
         bad(
             &info.path,
             format!("no page holds plane t {t}, z {z}, c {c}"),
@@ -115,17 +115,58 @@ pub fn page_at(info: &TiffInfo, t: usize, z: usize, c: usize) -> Result<TiffPage
             sample,
         },
         Place::There { file, ifd } => TiffPage {
-            path: set_member(info, file)?,
+            path: set_member(info, &axes.other_files[file])?,
             ifd,
             sample,
         },
     })
 }
 
-/// The one series of a TIFF, with the axes its metadata states.
+/// The series of a TIFF: one, with the axes its metadata states, or one per OME image.
+pub fn tiff_series(info: &TiffInfo) -> Vec<SeriesInfo> {
+    if info.images.is_empty() {
+        return vec![series_of_tiff(info)];
+    }
+    info.images
+        .iter()
+        .enumerate()
+        .map(|(k, image)| {
+            let view = match k {
+                0 => series_of_tiff(info),
+                _ => image_series(info, image),
+            };
+            SeriesInfo {
+                index: k,
+                name: image.name.clone().unwrap_or_default(),
+                ..view
+            }
+        })
+        .collect()
+}
+
+/// Series `k > 0` of a multi-image OME-TIFF.
+fn image_series(info: &TiffInfo, image: &crate::tiff::axes::OmeImage) -> SeriesInfo {
+    let pixel_size = image.pixel_size_m.map(|(x_m, y_m)| PixelSize {
+        x_m,
+        y_m,
+        source: PixelSizeSource::OmeXml,
+    });
+    series_of(&image.axes, image.width, image.height, info, pixel_size)
+}
+
+/// The series a TIFF shows alone (its first image's), with the axes its metadata states.
 pub fn series_of_tiff(info: &TiffInfo) -> SeriesInfo {
-    let axes = &info.axes;
-    let pixel_size = match info.pixel_size {
+    series_of(&info.axes, info.width, info.height, info, info.pixel_size)
+}
+
+fn series_of(
+    axes: &TiffAxes,
+    width: usize,
+    height: usize,
+    info: &TiffInfo,
+    pixel_size: Option<PixelSize>,
+) -> SeriesInfo {
+    let pixel_size = match pixel_size {
         Some(p) => VoxelSize {
             x_m: Some(p.x_m),
             y_m: Some(p.y_m),
@@ -144,8 +185,8 @@ pub fn series_of_tiff(info: &TiffInfo) -> SeriesInfo {
             t: axes.t,
             z: axes.z,
             c: axes.c,
-            y: info.height,
-            x: info.width,
+            y: height,
+            x: width,
             extra: BTreeMap::new(),
         },
         dtype: info.sample_type,
@@ -176,10 +217,10 @@ impl TiffBackend {
     }
 
     pub(crate) fn series(&self) -> Vec<SeriesInfo> {
-        vec![series_of_tiff(self.reader.info())]
+        tiff_series(self.reader.info())
     }
 
-    pub(crate) fn read_plane(&mut self, _info: &SeriesInfo, index: &PlaneIndex) -> Result<Plane> {
+    pub(crate) fn read_plane(&mut self, series: &SeriesInfo, index: &PlaneIndex) -> Result<Plane> {
         let info = self.reader.info();
         // Pages without axis metadata stand for whichever load axis was asked for (one of t
         // and z is then 0).
@@ -187,7 +228,7 @@ impl TiffBackend {
             AxesSource::Pages => (index.t + index.z, 0),
             _ => (index.t, index.z),
         };
-        let at = page_at(info, t, z, index.c)?;
+        let at = page_at(info, series.index, t, z, index.c)?;
         if at.path == info.path {
             return self.reader.read_page(at.ifd, at.sample);
         }
@@ -222,34 +263,47 @@ impl Selection {
     /// The planes of a TIFF this selection names, each with the file, IFD and sample it is read
     /// from (another file of a multi-file OME set, [`set_member`], for a plane stored there), in
     /// load order: along `along`, or the axis [`LoadDefault`] gives when none is named. Pages
-    /// without axis metadata are the load axis whichever is named.
+    /// without axis metadata are the load axis whichever is named. Also the file as the chosen
+    /// image shows it ([`TiffInfo::image`]: plane size, pixel size); along the images of a
+    /// multi-image OME-TIFF (`--load-axis series`) they must all have one plane size and pixel
+    /// size.
     pub fn tiff_planes(
         &self,
         info: &TiffInfo,
         along: Option<LoadAxis>,
         default: LoadDefault,
-    ) -> Result<Vec<(SelectedPlane, TiffPage)>> {
-        let (path, axes) = (&info.path, &info.axes);
+    ) -> Result<(TiffInfo, Vec<(SelectedPlane, TiffPage)>)> {
+        let path = &info.path;
+        let view = match along {
+            Some(LoadAxis::Series) => None,
+            _ => info.image(self.series.unwrap_or(0)),
+        };
+        let shown = view.as_ref().unwrap_or(info);
         let along = match along {
             Some(a) => Some(a),
-            None => self.tiff_default(info, default)?,
+            None => self.tiff_default(shown, default)?,
         };
-        let mut series = series_of_tiff(info);
-        if axes.source == AxesSource::Pages && along == Some(LoadAxis::Z) {
-            (series.axes.z, series.axes.t) = (series.axes.t, 1);
+        let mut series = tiff_series(info);
+        if info.axes.source == AxesSource::Pages && along == Some(LoadAxis::Z) {
+            (series[0].axes.z, series[0].axes.t) = (series[0].axes.t, 1);
         }
-        let planes = self.planes_in(path, &[series], along)?;
-        planes
+        let planes = self.planes_in(path, &series, along)?;
+        if along == Some(LoadAxis::Series) {
+            same_images(info, &series, &planes)?;
+        }
+        let planes = planes
             .into_iter()
             .map(|p| {
                 let (t, z, c) = (p.index.t, p.index.z, p.index.c);
-                let (t, z) = match axes.source {
+                let (t, z) = match info.axes.source {
                     AxesSource::Pages => (t + z, 0),
                     _ => (t, z),
                 };
-                Ok((p, page_at(info, t, z, c)?))
+                let at = page_at(info, p.series, t, z, c)?;
+                Ok((p, at))
             })
-            .collect()
+            .collect::<Result<Vec<_>>>()?;
+        Ok((view.unwrap_or_else(|| info.clone()), planes))
     }
 
     /// The load axis of a TIFF when none is named (see [`LoadDefault`]).
@@ -291,4 +345,36 @@ impl Selection {
         }
         Ok(None)
     }
+}
+
+/// Images of a multi-image OME-TIFF read as one load series: one plane size, sample type and
+/// pixel size, or an error naming the first image that differs.
+fn same_images(info: &TiffInfo, series: &[SeriesInfo], planes: &[SelectedPlane]) -> Result<()> {
+    let describe = |s: &SeriesInfo| {
+        let size = match (s.pixel_size.x_m, s.pixel_size.y_m) {
+            (Some(x), Some(y)) => format!("{:.4} × {:.4} µm pixels", x * 1e6, y * 1e6),
+            _ => "no pixel size".to_string(),
+        };
+        format!("{}×{} px, {}", s.axes.x, s.axes.y, size)
+    };
+    let Some(first) = planes.first().map(|p| &series[p.series]) else {
+        return Ok(());
+    };
+    for p in planes {
+        let other = &series[p.series];
+        if describe(other) != describe(first) {
+            return Err(bad(
+                &info.path,
+                format!(
+                    "its images are read as one load series (--load-axis series), but image {} \
+                     is {} and image {} {}",
+                    other.index,
+                    describe(other),
+                    first.index,
+                    describe(first)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }

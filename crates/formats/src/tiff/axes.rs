@@ -76,6 +76,22 @@ pub struct TiffAxes {
     pub other_files: Vec<String>,
 }
 
+/// One image of a multi-image OME-TIFF (an OME `Image` element: a stage position, a scene, a
+/// separate acquisition in one file), read as a series of its own.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OmeImage {
+    /// OME `Image Name`, `None` where absent.
+    pub name: Option<String>,
+    /// `SizeX`, pixels.
+    pub width: usize,
+    /// `SizeY`, pixels.
+    pub height: usize,
+    /// `PhysicalSizeX` and `PhysicalSizeY` (Y defaults to X), m.
+    pub pixel_size_m: Option<(f64, f64)>,
+    /// Its planes and the page of each.
+    pub axes: TiffAxes,
+}
+
 /// Where a plane of a TIFF's axes is stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Place {
@@ -159,7 +175,8 @@ impl TiffAxes {
 
     /// The axes the metadata state, checked against the pages (`pages`: IFD indices of the
     /// full-resolution pages; `samples`: samples per pixel); plain pages with a note when the
-    /// metadata disagree with the file.
+    /// metadata disagree with the file. The axes are those of the first image; an OME-XML
+    /// describing several images gives every image too (image 0 first; empty for one image).
     pub fn from_metadata(
         path: &Path,
         pages: &[usize],
@@ -167,11 +184,12 @@ impl TiffAxes {
         description: Option<&str>,
         imagej: Option<&ImageJDescription>,
         notes: &mut Vec<String>,
-    ) -> Self {
+    ) -> (Self, Vec<OmeImage>) {
         let samples = samples.max(1);
         if let Some(xml) = description.filter(|d| d.contains("<OME")) {
-            match ome_axes(path, xml, pages, samples) {
-                Ok(axes) => return axes,
+            match ome_images(path, xml, pages, samples, notes) {
+                Ok(mut images) if images.len() == 1 => return (images.remove(0).axes, images),
+                Ok(images) => return (images[0].axes.clone(), images),
                 Err(why) => notes.push(format!(
                     "OME-XML axes ignored ({why}); the pages are read in file order"
                 )),
@@ -179,14 +197,14 @@ impl TiffAxes {
         }
         if let Some(meta) = imagej {
             match imagej_axes(meta, pages, samples) {
-                Ok(Some(axes)) => return axes,
+                Ok(Some(axes)) => return (axes, Vec::new()),
                 Ok(None) => {}
                 Err(why) => notes.push(format!(
                     "ImageJ hyperstack axes ignored ({why}); the pages are read in file order"
                 )),
             }
         }
-        TiffAxes::plain(pages, samples)
+        (TiffAxes::plain(pages, samples), Vec::new())
     }
 }
 
@@ -283,14 +301,87 @@ fn physical(node: roxmltree::Node, name: &str, time: bool) -> Option<f64> {
     (x.is_finite() && x > 0.0).then_some(x)
 }
 
-/// OME-XML axes of the first image.
-fn ome_axes(path: &Path, xml: &str, pages: &[usize], samples: usize) -> Result<TiffAxes, String> {
+fn is(n: &roxmltree::Node, tag: &str) -> bool {
+    n.is_element() && n.tag_name().name() == tag
+}
+
+/// Every image the OME-XML describes (at least one; an error when the first cannot be read).
+/// An image that cannot be read is named in a note and left out with the images after it, so
+/// that an image's index is always its place in the file. Images without `TiffData` fill the
+/// pages in order, each after the planes of the images before it.
+fn ome_images(
+    path: &Path,
+    xml: &str,
+    pages: &[usize],
+    samples: usize,
+    notes: &mut Vec<String>,
+) -> Result<Vec<OmeImage>, String> {
     let doc = roxmltree::Document::parse(xml).map_err(|e| format!("unreadable XML: {e}"))?;
-    let is = |n: &roxmltree::Node, tag: &str| n.is_element() && n.tag_name().name() == tag;
-    let pixels = doc
+    let mut elements: Vec<(Option<roxmltree::Node>, roxmltree::Node)> = doc
         .descendants()
-        .find(|n| is(n, "Pixels"))
-        .ok_or("no Pixels element")?;
+        .filter(|n| is(n, "Image"))
+        .filter_map(|image| {
+            let pixels = image.children().find(|n| is(n, "Pixels"))?;
+            Some((Some(image), pixels))
+        })
+        .collect();
+    if elements.is_empty() {
+        // A Pixels element outside any Image: read as the one image.
+        let pixels = doc
+            .descendants()
+            .find(|n| is(n, "Pixels"))
+            .ok_or("no Pixels element")?;
+        elements.push((None, pixels));
+    }
+    let mut images = Vec::with_capacity(elements.len());
+    let mut start = 0usize;
+    for (k, (image, pixels)) in elements.into_iter().enumerate() {
+        let name = image
+            .and_then(|i| i.attribute("Name"))
+            .map(str::trim)
+            .filter(|s| !s.is_empty())
+            .map(str::to_string);
+        let read = ome_axes(path, pixels, pages, samples, start).and_then(|axes| {
+            let width = count(pixels, "SizeX")?;
+            let height = count(pixels, "SizeY")?;
+            Ok((axes, width, height))
+        });
+        let (axes, width, height) = match read {
+            Ok(r) => r,
+            Err(why) if k == 0 => return Err(why),
+            Err(why) => {
+                notes.push(format!(
+                    "OME-XML image {k}{} and the images after it are not read ({why})",
+                    name.as_deref().map_or(String::new(), |n| format!(" '{n}'"))
+                ));
+                break;
+            }
+        };
+        start = start.saturating_add(axes.table.len());
+        let pixel_size_m = physical(pixels, "PhysicalSizeX", false).map(|x| {
+            let y = physical(pixels, "PhysicalSizeY", false).unwrap_or(x);
+            (x, y)
+        });
+        images.push(OmeImage {
+            name,
+            width,
+            height,
+            pixel_size_m,
+            axes,
+        });
+    }
+    Ok(images)
+}
+
+/// The axes of one OME `Pixels` element; without `TiffData` its planes fill the pages from
+/// `start`.
+fn ome_axes(
+    path: &Path,
+    pixels: roxmltree::Node,
+    pages: &[usize],
+    samples: usize,
+    start: usize,
+) -> Result<TiffAxes, String> {
     let (c, z, t) = (
         count(pixels, "SizeC")?,
         count(pixels, "SizeZ")?,
@@ -366,7 +457,7 @@ fn ome_axes(path: &Path, xml: &str, pages: &[usize], samples: usize) -> Result<T
     if blocks.is_empty() {
         // No TiffData: the planes fill the pages in DimensionOrder.
         for (linear, slot) in table.iter_mut().enumerate() {
-            *slot = Place::Here(linear);
+            *slot = Place::Here(start.checked_add(linear).ok_or("an IFD overflows")?);
         }
         assigned.iter_mut().for_each(|a| *a = true);
     }
@@ -490,7 +581,7 @@ mod tests {
         let pages: Vec<usize> = (0..pages).collect();
         let mut notes = Vec::new();
         let imagej = parse_imagej(desc);
-        let a = TiffAxes::from_metadata(
+        let (a, _) = TiffAxes::from_metadata(
             Path::new("/x/a.ome.tif"),
             &pages,
             samples,
@@ -560,6 +651,60 @@ mod tests {
             notes[0].contains("overflow") || notes[0].contains("planes stated"),
             "{notes:?}"
         );
+    }
+
+    #[test]
+    fn every_ome_image_is_read_each_on_its_own_pages() {
+        let image = |k: usize, t: usize, extra: &str| {
+            format!(
+                r#"<Image ID="Image:{k}" Name="p{k}"><Pixels ID="Pixels:{k}" DimensionOrder="XYZCT" Type="uint16" SizeX="4" SizeY="3" SizeC="1" SizeZ="1" SizeT="{t}" {extra}></Pixels></Image>"#
+            )
+        };
+        // No TiffData: each image's planes follow the planes of the images before it.
+        let xml = format!(
+            "<OME>{}{}{}</OME>",
+            image(0, 2, ""),
+            image(1, 3, r#"PhysicalSizeX="100" PhysicalSizeXUnit="nm""#),
+            image(2, 1, "")
+        );
+        let pages: Vec<usize> = (0..6).collect();
+        let mut notes = Vec::new();
+        let (first, images) = TiffAxes::from_metadata(
+            Path::new("a.ome.tif"),
+            &pages,
+            1,
+            Some(&xml),
+            None,
+            &mut notes,
+        );
+        assert!(notes.is_empty(), "{notes:?}");
+        assert_eq!(images.len(), 3);
+        assert_eq!(first, images[0].axes);
+        assert_eq!(images[1].axes.pages_of_channel(0), vec![2, 3, 4]);
+        assert_eq!(images[2].axes.pages_of_channel(0), vec![5]);
+        assert_eq!(images[1].name.as_deref(), Some("p1"));
+        assert_eq!((images[1].width, images[1].height), (4, 3));
+        let (x, y) = images[1].pixel_size_m.unwrap();
+        assert!((x - 100e-9).abs() < 1e-20 && (y - 100e-9).abs() < 1e-20);
+        assert_eq!(images[0].pixel_size_m, None);
+        // An image the pages cannot hold: it and the images after it are left out, with a
+        // note; the images before it keep their indices.
+        let xml = format!(
+            "<OME>{}{}{}</OME>",
+            image(0, 2, ""),
+            image(1, 9, ""),
+            image(2, 1, "")
+        );
+        let (_, images) = TiffAxes::from_metadata(
+            Path::new("a.ome.tif"),
+            &pages,
+            1,
+            Some(&xml),
+            None,
+            &mut notes,
+        );
+        assert_eq!(images, Vec::new(), "one image left: no list");
+        assert!(notes[0].contains("image 1 'p1'"), "{notes:?}");
     }
 
     #[test]

@@ -11,7 +11,7 @@ pub mod write;
 
 use std::path::Path;
 
-pub use axes::{AxesSource, Place, TiffAxes};
+pub use axes::{AxesSource, OmeImage, Place, TiffAxes};
 pub use read::{ChannelLayout, TiffInfo, TiffReader};
 pub use write::{
     encode_f32_stack, encode_u16_stack, encode_u16_stack_compressed, encode_u8_stack, Compression,

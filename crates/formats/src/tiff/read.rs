@@ -14,7 +14,7 @@ use tiff::decoder::{Decoder, DecodingResult, DecodingSampleType, Limits};
 use tiff::tags::Tag;
 use tiff::{ColorType, TiffError};
 
-use super::axes::{AxesSource, TiffAxes};
+use super::axes::{AxesSource, OmeImage, TiffAxes};
 use super::metadata::{self, ImageJDescription};
 use crate::error::{Error, Location, Result};
 use crate::image::{PixelSize, PixelSizeSource, Plane, SampleType, Samples};
@@ -92,8 +92,12 @@ pub struct TiffInfo {
     pub value_unit: Option<String>,
     /// Notes about ignored or doubtful metadata.
     pub notes: Vec<String>,
-    /// Channels, focal planes and time points, and the page of each plane.
+    /// Channels, focal planes and time points, and the page of each plane (of the first image
+    /// of a multi-image OME-TIFF).
     pub axes: TiffAxes,
+    /// Every image of an OME-TIFF whose XML describes several (image 0 first, its axes those
+    /// above); empty for one image. Each is a series (`--series`).
+    pub images: Vec<OmeImage>,
     /// The file the OME-XML was read from when the file's own XML only points to it
     /// (`BinaryOnly`: a companion `.companion.ome` or the master TIFF of a multi-file set;
     /// [`super::companion`]).
@@ -104,6 +108,54 @@ impl TiffInfo {
     /// The IFD indices that hold `channel`, time points slowest, then focal planes.
     pub fn pages_of_channel(&self, channel: usize) -> Vec<usize> {
         self.axes.pages_of_channel(channel)
+    }
+
+    /// The series the file holds: its OME images, else 1.
+    pub fn series_count(&self) -> usize {
+        self.images.len().max(1)
+    }
+
+    /// The axes of series (OME image) `series`.
+    pub fn axes_of(&self, series: usize) -> Option<&TiffAxes> {
+        match self.images.is_empty() {
+            true => (series == 0).then_some(&self.axes),
+            false => self.images.get(series).map(|i| &i.axes),
+        }
+    }
+
+    /// The file as series `series` alone shows it: that image's axes, plane size, channels and
+    /// pixel size (OME `PhysicalSizeX/Y`; none stated, none), every image kept; `None` for a
+    /// series the file does not hold.
+    pub fn image(&self, series: usize) -> Option<TiffInfo> {
+        if series == 0 {
+            return (series < self.series_count()).then(|| self.clone());
+        }
+        let image = self.images.get(series)?;
+        Some(TiffInfo {
+            width: image.width,
+            height: image.height,
+            channels: image.axes.c,
+            pixel_size: image.pixel_size_m.map(|(x_m, y_m)| PixelSize {
+                x_m,
+                y_m,
+                source: PixelSizeSource::OmeXml,
+            }),
+            axes: image.axes.clone(),
+            ..self.clone()
+        })
+    }
+
+    /// The files of a multi-file OME set holding planes of any image of this file, as the
+    /// OME-XML names them (`UUID FileName`), each once.
+    pub fn set_files(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = Vec::new();
+        let all = std::iter::once(&self.axes).chain(self.images.iter().map(|i| &i.axes));
+        for name in all.flat_map(|a| a.other_files.iter()) {
+            if !names.contains(&name.as_str()) {
+                names.push(name);
+            }
+        }
+        names
     }
 }
 
@@ -600,7 +652,7 @@ fn read_info<R: Read + Seek>(
     };
     let pages = list_pages(decoder, path)?;
 
-    let axes = TiffAxes::from_metadata(
+    let (axes, images) = TiffAxes::from_metadata(
         path,
         &pages,
         spp as usize,
@@ -642,6 +694,7 @@ fn read_info<R: Read + Seek>(
         value_unit: imagej.as_ref().and_then(|m| m.value_unit.clone()),
         notes,
         axes,
+        images,
         metadata_file: metadata.map(|m| m.file),
     })
 }

@@ -116,10 +116,13 @@ impl Serialize for InfoOutcome {
     fn serialize<S: Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
         let summary = &self.summary;
         let series: Vec<SeriesJson<'_>> = summary.series.iter().map(SeriesJson).collect();
-        let mut m = s.serialize_map(Some(3))?;
+        let mut m = s.serialize_map(None)?;
         m.serialize_entry("file", &summary.file)?;
         m.serialize_entry("format", &summary.format)?;
         m.serialize_entry("series", &series)?;
+        if let Some(file) = &summary.metadata_file {
+            m.serialize_entry("metadata_file", file)?;
+        }
         m.end()
     }
 }

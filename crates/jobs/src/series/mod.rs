@@ -256,7 +256,7 @@ impl FileTable {
                 true => LoadDefault::AnyStack,
                 false => LoadDefault::Series,
             };
-            let planes = self.selection.tiff_planes(&info, self.load_axis, default)?;
+            let (info, planes) = self.selection.tiff_planes(&info, self.load_axis, default)?;
             SeriesFile::from_tiff(info, planes)
         } else {
             SeriesFile::from_vendor(path, &self.selection, self.load_axis)?

@@ -29,8 +29,10 @@ pub(crate) fn one_file_per_set(files: Vec<PathBuf>) -> (Vec<PathBuf>, HashMap<Pa
             if is_tiff(path) {
                 if let Ok(reader) = TiffReader::open(path) {
                     let info = reader.info().clone();
-                    members = (0..info.axes.other_files.len())
-                        .filter_map(|k| set_member(&info, k).ok())
+                    members = info
+                        .set_files()
+                        .into_iter()
+                        .filter_map(|name| set_member(&info, name).ok())
                         .filter_map(|m| m.canonicalize().ok())
                         .collect();
                     headers.insert(path.clone(), info);
