@@ -337,7 +337,7 @@ pub fn fraction(text: &str, flag: &str) -> Result<f64> {
 /// command that reads micrographs (rules in `contactscope_formats::microscopy::select`).
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct SelectionArgs {
-    /// Series of a CZI (scene) or LIF (image) file; needed when the file has several.
+    /// Series of a CZI (scene), LIF or OME-TIFF (image) file; needed when the file has several.
     #[arg(long)]
     pub series: Option<usize>,
     /// Channel, by index or by the name `info` shows (CZI, ND2, LIF: AF488, TL, …); needed
@@ -394,7 +394,7 @@ pub enum LoadAxisArg {
     T,
     /// Focal planes.
     Z,
-    /// Series (CZI scenes, LIF images).
+    /// Series (CZI scenes, LIF images, OME-TIFF images).
     Series,
 }
 

@@ -107,7 +107,7 @@ params! {
     Detrend: "--detrend", "detrend", "the detrending";
     /// Channel of a file (index for images, name for height maps).
     Channel: "--channel", "channel", "the channel";
-    /// Series (CZI scene, LIF image) of a file.
+    /// Series (CZI scene, LIF image, OME-TIFF image) of a file.
     Series: "--series", "series", "the series";
     /// Focal plane.
     Z: "--z", "z", "the focal plane (z)";

@@ -1,8 +1,8 @@
 //! Confocal microscopy files as one model: Zeiss CZI ([`czi`]), Nikon ND2 ([`nd2`]), Leica LIF
 //! ([`lif`]) and, described the same way, TIFF ([`crate::tiff`]).
 //!
-//! A [`MicroscopyFile`] holds a list of [`SeriesInfo`] (CZI scenes, LIF images; ND2 and TIFF
-//! have one series) read from the headers only; [`MicroscopyFile::read_plane`] decodes one 2-D
+//! A [`MicroscopyFile`] holds a list of [`SeriesInfo`] (CZI scenes, LIF images, the images of
+//! a multi-image OME-TIFF; ND2 and other TIFFs have one series) read from the headers only; [`MicroscopyFile::read_plane`] decodes one 2-D
 //! plane on request into a [`Plane`] (u16 codes plus offset, or f32), reading just the bytes it
 //! needs. Every count and size taken from a header is checked against the file length and
 //! against [`MAX_PLANE_BYTES`] before anything is allocated.
@@ -185,7 +185,7 @@ impl Rows {
     }
 }
 
-/// One series (CZI scene, LIF image, the whole ND2 or TIFF file).
+/// One series (CZI scene, LIF image, OME-TIFF image, the whole ND2 or other TIFF file).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SeriesInfo {
     /// Zero-based index in the file.

@@ -30,7 +30,7 @@ use crate::param::Param;
 /// The selection flags: each `None` when not given.
 #[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
 pub struct Selection {
-    /// `--series`: CZI scene, LIF image (ND2 and TIFF have one series).
+    /// `--series`: CZI scene, LIF image, image of a multi-image OME-TIFF (ND2 has one series).
     pub series: Option<usize>,
     /// `--channel`: an index or a name.
     pub channel: Option<ChannelChoice>,
@@ -165,7 +165,7 @@ pub enum LoadAxis {
     T,
     /// Focal planes.
     Z,
-    /// Series (CZI scenes, LIF images).
+    /// Series (CZI scenes, LIF images, OME-TIFF images).
     Series,
 }
 
