@@ -394,6 +394,35 @@ def test_container_choices_and_refusals(cli, tmp_path):
     assert np.isclose(one * 1e-9, quiet(t.rms_height_from_area), rtol=1e-9)
 
 
+def test_mad_detrends_are_refused_because_surface_topography_s_depend_on_the_unit(tmp_path):
+    """``mad-tilt`` is refused, and this is why: SurfaceTopography's Nelder–Mead tolerances
+    are absolute in the height unit, so one map stored in m keeps its least-squares tilt and
+    in nm gets another (docs/formats.md). Should SurfaceTopography's result stop depending on
+    the unit, this test fails and the mode can be applied."""
+    rng = np.random.default_rng(21)
+    h = (np.cumsum(rng.normal(size=(64, 48)), axis=0) * 1e-9
+         + np.cumsum(rng.normal(size=(64, 48)), axis=1) * 0.5e-9 + 3e-9 * np.arange(48))
+    detrended = {}
+    for unit, scale in (("m", 1.0), ("nm", 1e9)):
+        t = Topography(h * scale, (6.4e-6 * scale, 4.8e-6 * scale), unit=unit)
+        detrended[unit] = quiet(t.detrend("mad-tilt").heights) / scale
+    span = np.ptp(detrended["m"])
+    moved = np.ptp(detrended["m"] - detrended["nm"]) / span
+    assert moved > 1e-3, moved
+    print(f"SurfaceTopography mad-tilt, m against nm: {moved:.1e} of the height range")
+    t = Topography(h, (6.4e-6, 4.8e-6), unit="m")
+    container = tmp_path / "mad.zip"
+    quiet(t.to_netcdf, str(tmp_path / "mad.nc"))
+    with zipfile.ZipFile(container, "w") as z:
+        z.write(tmp_path / "mad.nc", "originals/mad.nc")
+        z.writestr("index.json", json.dumps({"versions": {}, "surfaces": [{"name": "lab",
+                   "topographies": [{"name": "mad.nc", "datafile": {"original": "originals/mad.nc"},
+                                     "size": [6.4, 4.8], "unit": "um", "is_periodic": False,
+                                     "data_source": 0, "detrend_mode": "mad-tilt"}]}]}))
+    with pytest.raises(cs.InputError, match="mad-tilt.*height unit.*'height'"):
+        cs.read_topography(container, detrend="none", measurement="0")
+
+
 def test_python_writes_the_same_export_as_the_command_line(cli, tmp_path):
     t = fourier_synthesis((48, 48), (4.8e-6, 4.8e-6), 0.8, rms_height=30e-9,
                           rng=np.random.default_rng(7), periodic=True, unit="m",

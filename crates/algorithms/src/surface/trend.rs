@@ -28,7 +28,9 @@
 //! Not provided, and refused by name ([`ContainerDetrend::from_mode`]): `mad-tilt` and
 //! `mad-curvature` (the polynomial minimising the residual's median absolute deviation, which
 //! SurfaceTopography finds with scipy's Nelder–Mead from the least-squares fit: a result that
-//! is the optimiser's, to its own tolerances, more than the data's).
+//! is the optimiser's, to its own tolerances, more than the data's — its tolerances are absolute
+//! in the container's height unit, so the same map stored in m keeps the least-squares tilt and
+//! in µm or nm gets another, `docs/formats.md`).
 
 use nalgebra::{DMatrix, DVector};
 use ndarray::Array2;
@@ -59,6 +61,25 @@ impl ContainerDetrend {
             "curvature" | "rms-curvature" => ContainerDetrend::Quadric,
             "slope" => ContainerDetrend::Slope,
             "median" => ContainerDetrend::Median,
+            mad @ ("mad-tilt" | "mad-curvature") => {
+                return Err(Error::InvalidArgument(format!(
+                    "detrend mode '{mad}' is not applied by contactscope: SurfaceTopography's \
+                     result for it is its optimiser's, whose tolerances are absolute in the \
+                     container's height unit (the same map in m and in nm is detrended \
+                     differently); set the measurement's detrend_mode to '{}' (the \
+                     least-squares {}) or 'median' in the container",
+                    if mad == "mad-tilt" {
+                        "height"
+                    } else {
+                        "curvature"
+                    },
+                    if mad == "mad-tilt" {
+                        "plane"
+                    } else {
+                        "quadric"
+                    }
+                )))
+            }
             other => {
                 return Err(Error::InvalidArgument(format!(
                     "detrend mode '{other}' is not applied by contactscope (it applies center, \
@@ -245,7 +266,14 @@ mod tests {
         let err = ContainerDetrend::from_mode("mad-tilt")
             .unwrap_err()
             .to_string();
-        assert!(err.contains("mad-tilt"), "{err}");
+        assert!(
+            err.contains("mad-tilt") && err.contains("'height'"),
+            "{err}"
+        );
+        let err = ContainerDetrend::from_mode("mad-curvature")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("'curvature'"), "{err}");
     }
 
     #[test]
