@@ -161,6 +161,42 @@ def test_topobank_containers_with_originals_apply_the_processing_alike(tmp_path)
     assert np.isfinite(ours["heights"]).all()
 
 
+def test_data_source_names_surface_topography_s_channel(tmp_path):
+    """``data_source: k`` is channel k of SurfaceTopography's reader for the original file:
+    every channel of the multi-channel examples, one container each, read as
+    ``read_container`` reads it (the same heights to 1e-9), or refused naming the channel
+    where ours is not a height map (a phase, a deflection in volts)."""
+    read, refused = 0, 0
+    for name in ["di-3.di", "spot_1-1000nm.ibw", "mi-1.mi", "nid-1.nid"]:
+        path = afm(name)
+        orient = orientation_of(path)
+        channels = [c.name for c in quiet(lambda: open_topography(str(path)).channels)]
+        assert len(channels) > 1, name
+        for k, channel in enumerate(channels):
+            container = tmp_path / f"{name}-{k}.zip"
+            meta = {"name": name, "datafile": {"original": f"originals/{name}"},
+                    "size": [1.0, 1.0], "unit": "um", "is_periodic": False,
+                    "data_source": k, "detrend_mode": "center"}
+            with zipfile.ZipFile(container, "w") as z:
+                z.write(path, f"originals/{name}")
+                z.writestr("index.json", json.dumps({"versions": {}, "surfaces": [
+                    {"name": "lab", "topographies": [meta]}]}))
+            label = f"{name} data_source {k} ({channel})"
+            try:
+                ours = cs.read_topography(container, detrend="none", measurement="0")
+            except cs.InputError as e:
+                # Refused by our reader: the message names the channel it was asked for.
+                assert channel.split(" (")[0] in str(e) or channel in str(e), (label, str(e))
+                refused += 1
+                continue
+            (theirs,) = list(quiet(read_container, str(container))[0])
+            assert_same_topography(ours, theirs, orient, label)
+            read += 1
+    print(f"data_source: {read} channels read as SurfaceTopography reads them, {refused} "
+          "refused as not height maps")
+    assert read >= 8, read
+
+
 def test_the_median_detrend_is_surface_topography_s(tmp_path):
     """``detrend_mode: median`` subtracts the height at which the bearing area of the
     piecewise-linear surface is one half (SurfaceTopography's median, found by bisection to

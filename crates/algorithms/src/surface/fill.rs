@@ -234,6 +234,7 @@ mod tests {
             format: TopographyFormat::Sdf,
             channel: "height".into(),
             channels: vec!["height".into()],
+            height_channels: vec![true],
             heights,
             dx_m: 1e-6,
             dy_m: 1e-6,

@@ -18,7 +18,7 @@
 //! |---|---|
 //! | `size` | the physical size (x, y) in `unit`, used when the data file states no pixel size (a file's own size wins; a difference above 1e-4 relative is noted) |
 //! | `unit` | the unit of `size` and of the heights when the data file states none |
-//! | `data_source` | SurfaceTopography's index of the data file's channel: 0 (the schema's default, which contact.engineering always writes) or absent is read as the file's height channel (SurfaceTopography's channel 0 of the formats tested, `.di`, `.ibw`, `.mi`, `.nid`); another index is refused, naming the channels for `--channel`, because our readers list channels in their own order |
+//! | `data_source` | SurfaceTopography's index of the data file's channel: 0 (the schema's default) or absent is read as the file's height channel (SurfaceTopography's channel 0 of the formats tested, `.di`, `.ibw`, `.mi`, `.nid`); another index is the channel SurfaceTopography's reader lists at that place (Nanoscope, Igor, PicoView: every channel in file order; Nanosurf: the channels in a length unit), refused for other formats, naming the channels for `--channel` |
 //! | `is_periodic` | the measurement is periodic ([`MeasurementMap::periodic`]) |
 //! | `height_scale` | heights multiplied by it (original files only) |
 //! | `fill_undefined_data_mode` | `do-not-fill`, or `harmonic` (original files only; applied by the caller) |
@@ -291,8 +291,7 @@ impl Container {
             None => None,
         };
         // The channel: by name as asked, else the file's height channel; a `data_source` other
-        // than 0 names a channel in SurfaceTopography's order, which is not ours (the Nanosurf
-        // reader's first channel is a deflection there and a height here): refused below.
+        // than 0 names a channel in SurfaceTopography's order ([`surface_topography_channel`]).
         let mut options = ReadOptions {
             // A placeholder: replaced below by the file's own pixel size, or by `size`.
             pixel_size_m: Some(PLACEHOLDER_PIXEL_M),
@@ -300,22 +299,26 @@ impl Container {
             channel: channel.map(str::to_string),
         };
         let map_read = read_with_unit(&file, &mut options).map_err(relabel);
-        if let (None, Some(k @ 1..)) = (channel, m.data_source) {
-            let channels = map_read
-                .as_ref()
-                .map(|m| m.channels.join("', '"))
-                .unwrap_or_default();
-            return Err(bad(
-                &shown,
-                format!(
-                    "measurement {}: data_source {k} is a channel index in SurfaceTopography's \
-                     order, which contactscope's reader does not share; name the channel with \
-                     {} (the file has '{channels}')",
-                    m.label(),
-                    crate::param::Param::Channel
-                ),
-            ));
-        }
+        let map_read = match (channel, m.data_source) {
+            (None, Some(k @ 1..)) => {
+                let first = map_read?;
+                let name = surface_topography_channel(&first, k).map_err(|why| {
+                    bad(
+                        &shown,
+                        format!(
+                            "measurement {}: data_source {k} {why}; name the channel with {} \
+                             (the file has '{}')",
+                            m.label(),
+                            crate::param::Param::Channel,
+                            first.channels.join("', '")
+                        ),
+                    )
+                })?;
+                options.channel = Some(name);
+                read_with_unit(&file, &mut options).map_err(relabel)
+            }
+            _ => map_read,
+        };
         let mut map = map_read?;
         let mut notes = Vec::new();
         let stated = map.replaced_pixel_size_m.take();
@@ -672,4 +675,36 @@ fn yaml_to_json(path: &Path, text: &str) -> Result<Value> {
         }
     }
     Ok(docs.first().map(convert).unwrap_or(Value::Null))
+}
+
+/// The channel SurfaceTopography's reader gives as channel `k` of this file (`data_source` of
+/// a container's measurement), by its name here; an error saying why where the two readers'
+/// channel lists are not known to correspond. Checked against SurfaceTopography's own readers
+/// on their example files (`python/tests/test_contact_engineering.py`): its Nanoscope, Igor
+/// and PicoView readers list every channel of the file, in the file's order, as ours do; its
+/// Nanosurf reader lists only the channels in a length unit (`Dim2Unit`).
+fn surface_topography_channel(map: &HeightMap, k: usize) -> std::result::Result<String, String> {
+    use super::TopographyFormat as F;
+    let theirs: Vec<&String> = match map.format {
+        F::Nanoscope | F::Ibw | F::Mi => map.channels.iter().collect(),
+        F::Nid => map
+            .channels
+            .iter()
+            .zip(&map.height_channels)
+            .filter_map(|(name, &height)| height.then_some(name))
+            .collect(),
+        other => {
+            return Err(format!(
+                "is a channel index in SurfaceTopography's order, which is not known for {} \
+                 files",
+                other.name()
+            ))
+        }
+    };
+    theirs.get(k).map(|name| name.to_string()).ok_or_else(|| {
+        format!(
+            "is beyond the {} channel(s) SurfaceTopography's reader lists for this file",
+            theirs.len()
+        )
+    })
 }

@@ -168,7 +168,10 @@ impl HeightMap {
         let at = Location::file(path);
         Quantity::PixelSize.check_at(self.dx_m, &at)?;
         Quantity::PixelSize.check_at(self.dy_m, &at)?;
-        plausible_heights(path, &self.heights)
+        // Which channel, where the file has several (a phase or potential channel whose
+        // values are not heights).
+        let channel = (self.channels.len() > 1).then_some(self.channel.as_str());
+        plausible_heights(path, &self.heights, channel)
     }
 }
 
@@ -364,15 +367,20 @@ pub(crate) fn slice<'a>(
 pub const MAX_FILE_HEIGHT_M: f64 = 1.0;
 
 /// An error naming the file when a height lies beyond ±[`MAX_FILE_HEIGHT_M`].
-pub(crate) fn plausible_heights(path: &Path, heights: &Array2<f64>) -> Result<()> {
+pub(crate) fn plausible_heights(
+    path: &Path,
+    heights: &Array2<f64>,
+    channel: Option<&str>,
+) -> Result<()> {
     let nx = heights.ncols().max(1);
+    let channel = channel.map_or(String::new(), |c| format!("channel '{c}': "));
     match heights.iter().position(|h| h.abs() > MAX_FILE_HEIGHT_M) {
         None => Ok(()),
         Some(k) => Err(bad(
             path,
             format!(
-                "height at row {}, column {} is {:e} m, beyond ±{MAX_FILE_HEIGHT_M} m (heights \
-                 in another unit? see --height-unit)",
+                "{channel}height at row {}, column {} is {:e} m, beyond ±{MAX_FILE_HEIGHT_M} m \
+                 (heights in another unit, or not heights? see --height-unit)",
                 k / nx,
                 k % nx,
                 heights.iter().nth(k).copied().unwrap_or(f64::NAN)
@@ -400,7 +408,7 @@ pub(crate) fn topography(
     let at = Location::file(path);
     Quantity::PixelSize.check_at(pixel_size_m.0, &at)?;
     Quantity::PixelSize.check_at(pixel_size_m.1, &at)?;
-    plausible_heights(path, &array)?;
+    plausible_heights(path, &array, None)?;
     if array.is_empty() {
         return Err(bad(path, "topography has no pixels"));
     }
@@ -419,6 +427,7 @@ pub(crate) fn topography(
         format,
         channel: "height".into(),
         channels: vec!["height".into()],
+        height_channels: vec![true],
         heights: array,
         dx_m: pixel_size_m.0,
         dy_m: pixel_size_m.1,

@@ -171,6 +171,9 @@ pub struct HeightMap {
     pub channel: String,
     /// Every channel of the file.
     pub channels: Vec<String>,
+    /// Whether each of `channels` holds heights (a length unit, or a height-like name where the
+    /// file states no unit).
+    pub height_channels: Vec<bool>,
     /// Heights in metres, shape `(ny, nx)`; NaN where the instrument marked no valid point.
     pub heights: Array2<f64>,
     /// Pixel size along x (columns), m; NaN (with `dy_m`) when the file states none, as
@@ -517,6 +520,7 @@ pub(crate) fn height_map(
         format,
         channel: channels[index].name.clone(),
         channels: channels.iter().map(|c| c.name.clone()).collect(),
+        height_channels: channels.iter().map(|c| c.height).collect(),
         heights,
         dx_m,
         dy_m,
