@@ -347,8 +347,9 @@ impl Selection {
     }
 }
 
-/// Images of a multi-image OME-TIFF read as one load series: one plane size, sample type and
-/// pixel size, or an error naming the first image that differs.
+/// Images of a multi-image OME-TIFF read as one load series: one plane size and one pixel size
+/// (to 0.1 nm, as the file states it: an override by `--pixel-size` does not make two stated
+/// sizes agree, as for a CZI's scenes), or an error naming the first image that differs.
 fn same_images(info: &TiffInfo, series: &[SeriesInfo], planes: &[SelectedPlane]) -> Result<()> {
     let describe = |s: &SeriesInfo| {
         let size = match (s.pixel_size.x_m, s.pixel_size.y_m) {

@@ -333,15 +333,17 @@ fn ome_images(
             .ok_or("no Pixels element")?;
         elements.push((None, pixels));
     }
-    let mut images = Vec::with_capacity(elements.len());
+    let mut images = Vec::new();
     let mut start = 0usize;
+    // The planes all images may state together (each image's table is allocated).
+    let mut budget = (pages.len().max(1) * 4096).min(MAX_PLANES);
     for (k, (image, pixels)) in elements.into_iter().enumerate() {
         let name = image
             .and_then(|i| i.attribute("Name"))
             .map(str::trim)
             .filter(|s| !s.is_empty())
             .map(str::to_string);
-        let read = ome_axes(path, pixels, pages, samples, start).and_then(|axes| {
+        let read = ome_axes(path, pixels, pages, samples, start, budget).and_then(|axes| {
             let width = count(pixels, "SizeX")?;
             let height = count(pixels, "SizeY")?;
             Ok((axes, width, height))
@@ -358,6 +360,7 @@ fn ome_images(
             }
         };
         start = start.saturating_add(axes.table.len());
+        budget = budget.saturating_sub(axes.table.len());
         let pixel_size_m = physical(pixels, "PhysicalSizeX", false).map(|x| {
             let y = physical(pixels, "PhysicalSizeY", false).unwrap_or(x);
             (x, y)
@@ -381,6 +384,7 @@ fn ome_axes(
     pages: &[usize],
     samples: usize,
     start: usize,
+    budget: usize,
 ) -> Result<TiffAxes, String> {
     let (c, z, t) = (
         count(pixels, "SizeC")?,
@@ -413,8 +417,9 @@ fn ome_axes(
         .and_then(|n| n.checked_mul(t))
         .ok_or("counts overflow")?;
     // Checked before the plane table is allocated: a multi-file set may state more planes
-    // than this file's pages, but not without bound.
-    if planes > (pages.len().max(1) * 4096).min(MAX_PLANES) {
+    // than this file's pages, but not without bound (`budget`: what the images before this one
+    // left of the file's bound).
+    if planes > budget {
         return Err(format!("{planes} planes stated"));
     }
     // Linear plane index in DimensionOrder → (t, z, c), and back.
@@ -518,10 +523,10 @@ fn ome_axes(
             "no TiffData places the plane t {pt}, z {pz}, c {pc}"
         ));
     }
-    // Every IFD named must be a full-resolution page of this file.
+    // Every IFD named must be a full-resolution page of this file (`pages` is in IFD order).
     for place in &table {
         let Place::Here(ifd) = place else { continue };
-        if !pages.contains(ifd) {
+        if pages.binary_search(ifd).is_err() {
             return Err(format!(
                 "SizeC {c} × SizeZ {z} × SizeT {t} planes need page {ifd}; the file has {} pages",
                 pages.len()
@@ -705,6 +710,31 @@ mod tests {
         );
         assert_eq!(images, Vec::new(), "one image left: no list");
         assert!(notes[0].contains("image 1 'p1'"), "{notes:?}");
+        // The planes of all images together are bounded (each image's table is allocated):
+        // a one-page file may state 4096 planes kept in other files, not 4096 per image.
+        let elsewhere = |k: usize| {
+            image(
+                k,
+                3000,
+                "",
+            )
+            .replace(
+                "></Pixels>",
+                r#"><TiffData IFD="0" PlaneCount="3000"><UUID FileName="b.ome.tif">urn:2</UUID></TiffData></Pixels>"#,
+            )
+        };
+        let xml = format!("<OME>{}{}</OME>", elsewhere(0), elsewhere(1));
+        let mut notes = Vec::new();
+        let (first, images) = TiffAxes::from_metadata(
+            Path::new("a.ome.tif"),
+            &[0],
+            1,
+            Some(&xml),
+            None,
+            &mut notes,
+        );
+        assert_eq!((first.t, images.len()), (3000, 0));
+        assert!(notes[0].contains("3000 planes stated"), "{notes:?}");
     }
 
     #[test]
