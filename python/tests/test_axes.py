@@ -213,3 +213,38 @@ def test_a_set_whose_metadata_is_a_companion_file_reads_whole(tmp_path):
         for channel in range(c):
             got = cs.read_series(tmp_path / source, channel=channel)["images"]
             np.testing.assert_array_equal(got, data[:, channel], err_msg=f"{source} c {channel}")
+
+
+def test_a_companion_naming_one_image_per_file_reads_each_image(tmp_path):
+    """A companion file describing two images (stage positions), each stored in a TIFF of its
+    own that only points to the companion: read from the companion or from either TIFF, series
+    k is image k's planes, named as the companion names it."""
+    ns = "http://www.openmicroscopy.org/Schemas/OME/2016-06"
+    uuid = "urn:uuid:00000000-0000-4000-8000-000000000001"
+    pointer = (f'<?xml version="1.0" encoding="UTF-8"?><OME xmlns="{ns}">'
+               f'<BinaryOnly MetadataFile="set.companion.ome" UUID="{uuid}"/></OME>')
+    names = ["posA.ome.tif", "posB.ome.tif"]
+    written, images = [], ""
+    for k, name in enumerate(names):
+        data = _data("TYX")[:, :, k:]  # the two images differ in width too
+        written.append(data)
+        with tifffile.TiffWriter(tmp_path / name) as w:
+            for j, page in enumerate(data):
+                w.write(page, description=pointer if j == 0 else None, metadata=None)
+        t, y, x = data.shape
+        images += (
+            f'<Image ID="Image:{k}" Name="{name[:4]}"><Pixels ID="Pixels:{k}" '
+            f'DimensionOrder="XYCZT" Type="uint16" SizeX="{x}" SizeY="{y}" SizeC="1" SizeZ="1" '
+            f'SizeT="{t}"><Channel ID="Channel:{k}:0" SamplesPerPixel="1"/>'
+            f'<TiffData IFD="0" PlaneCount="{t}"><UUID FileName="{name}">'
+            f"urn:uuid:00000000-0000-4000-8000-00000000001{k}</UUID></TiffData></Pixels></Image>")
+    (tmp_path / "set.companion.ome").write_text(
+        f'<?xml version="1.0" encoding="UTF-8"?><OME xmlns="{ns}" UUID="{uuid}">{images}</OME>')
+    for source in ["set.companion.ome", *names]:
+        info = cs.info(tmp_path / source)["series"]
+        assert [s["name"] for s in info] == ["posA", "posB"], source
+        for k in range(2):
+            got = cs.read_series(tmp_path / source, series=k, load_axis="t")["images"]
+            np.testing.assert_array_equal(got, written[k], err_msg=f"{source} series {k}")
+        with pytest.raises(cs.InputError, match="'posB'"):
+            cs.read_series(tmp_path / source, load_axis="t")

@@ -133,6 +133,30 @@ pub const TEMPLATES: &[Template] = &[
         ["topography", "t-force.spm", "--json"]
     ),
     t!(
+        "info-ome-images",
+        ["two.ome.tif"],
+        ["two.ome.tif"],
+        ["info", "two.ome.tif", "--json"]
+    ),
+    t!(
+        "analyze-ome-image",
+        ["two.ome.tif"],
+        ["two.ome.tif"],
+        [
+            "analyze",
+            "two.ome.tif",
+            "--series",
+            "1",
+            "--channel",
+            "fluo",
+            "--forces",
+            "1,2,4mN",
+            "--out",
+            "OUT",
+            "-q"
+        ]
+    ),
+    t!(
         "topography-sxm",
         ["t.sxm"],
         ["t.sxm"],

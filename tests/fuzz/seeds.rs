@@ -75,6 +75,45 @@ fn sxm(dir: &Path) {
     fs::write(dir.join("t.sxm"), bytes).unwrap();
 }
 
+/// A multi-image OME-TIFF (`crates/formats/src/tiff/axes.rs`): two stage positions of three
+/// time points each, 48² 16-bit pages, their OME-XML (image names, pixel sizes, `TiffData`) in
+/// the first page's description, as tifffile writes one series after another.
+fn ome_images(dir: &Path) {
+    use tiff::encoder::{colortype, TiffEncoder};
+    const W: usize = 48;
+    let images: String = (0..2)
+        .map(|k| {
+            format!(
+                r#"<Image ID="Image:{k}" Name="position {k}"><Pixels ID="Pixels:{k}" DimensionOrder="XYCZT" Type="uint16" SizeX="{W}" SizeY="{W}" SizeC="1" SizeZ="1" SizeT="3" PhysicalSizeX="0.2" PhysicalSizeY="0.2"><Channel ID="Channel:{k}:0" Name="fluo" SamplesPerPixel="1"/><TiffData IFD="{}" PlaneCount="3"/></Pixels></Image>"#,
+                3 * k
+            )
+        })
+        .collect();
+    let xml = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?><OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06">{images}</OME>"#
+    );
+    let mut enc = TiffEncoder::new(fs::File::create(dir.join("two.ome.tif")).unwrap()).unwrap();
+    for page in 0..6 {
+        let r = 4.0 + 3.0 * (page % 3) as f64;
+        let pixels: Vec<u16> = (0..W * W)
+            .map(|i| {
+                let (x, y) = ((i % W) as f64 - 23.5, (i / W) as f64 - 23.5);
+                300 + ((i * 7919) % 23) as u16 + if x * x + y * y < r * r { 2000 } else { 0 }
+            })
+            .collect();
+        let mut image = enc
+            .new_image::<colortype::Gray16>(W as u32, W as u32)
+            .unwrap();
+        if page == 0 {
+            image
+                .encoder()
+                .write_tag(tiff::tags::Tag::ImageDescription, xml.as_str())
+                .unwrap();
+        }
+        image.write_data(&pixels).unwrap();
+    }
+}
+
 /// A small WSxM `.top` file as `crates/formats/src/topography/wsxm.rs` documents the format: three text lines,
 /// an INI-like header, `[Header end]`, then int16 little-endian heights.
 fn wsxm(dir: &Path) {
@@ -211,6 +250,7 @@ pub fn build(dir: &Path) {
         .extract(dir.join("tc"))
         .unwrap();
     text_matrix(dir);
+    ome_images(dir);
     wsxm(dir);
     nanoscope(dir);
     sxm(dir);

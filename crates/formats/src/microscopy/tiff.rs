@@ -12,7 +12,7 @@ use super::select::{LoadAxis, SelectedPlane, Selection};
 use super::{Axes, ChannelInfo, PlaneIndex, SeriesInfo, VoxelSize};
 use crate::binary::bad;
 use crate::error::Result;
-use crate::image::{PixelSize, PixelSizeSource, Plane};
+use crate::image::{PixelSize, Plane};
 use crate::param::Param;
 use crate::tiff::{AxesSource, Place, TiffAxes, TiffInfo, TiffReader};
 
@@ -122,7 +122,8 @@ pub fn page_at(info: &TiffInfo, series: usize, t: usize, z: usize, c: usize) -> 
     })
 }
 
-/// The series of a TIFF: one, with the axes its metadata states, or one per OME image.
+/// The series of a TIFF: one, with the axes its metadata states, or one per OME image, each
+/// with its own plane size and pixel size ([`TiffInfo::image`]).
 pub fn tiff_series(info: &TiffInfo) -> Vec<SeriesInfo> {
     if info.images.is_empty() {
         return vec![series_of_tiff(info)];
@@ -131,27 +132,14 @@ pub fn tiff_series(info: &TiffInfo) -> Vec<SeriesInfo> {
         .iter()
         .enumerate()
         .map(|(k, image)| {
-            let view = match k {
-                0 => series_of_tiff(info),
-                _ => image_series(info, image),
-            };
+            let pixel_size = info.image_pixel_size(image);
             SeriesInfo {
                 index: k,
                 name: image.name.clone().unwrap_or_default(),
-                ..view
+                ..series_of(&image.axes, image.width, image.height, info, pixel_size)
             }
         })
         .collect()
-}
-
-/// Series `k > 0` of a multi-image OME-TIFF.
-fn image_series(info: &TiffInfo, image: &crate::tiff::axes::OmeImage) -> SeriesInfo {
-    let pixel_size = image.pixel_size_m.map(|(x_m, y_m)| PixelSize {
-        x_m,
-        y_m,
-        source: PixelSizeSource::OmeXml,
-    });
-    series_of(&image.axes, image.width, image.height, info, pixel_size)
 }
 
 /// The series a TIFF shows alone (its first image's), with the axes its metadata states.

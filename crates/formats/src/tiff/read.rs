@@ -123,26 +123,38 @@ impl TiffInfo {
         }
     }
 
-    /// The file as series `series` alone shows it: that image's axes, plane size, channels and
-    /// pixel size (OME `PhysicalSizeX/Y`; none stated, none), every image kept; `None` for a
-    /// series the file does not hold.
+    /// The file as series `series` alone shows it: that image's axes, plane size (OME `SizeX`,
+    /// `SizeY`: the file's first page may belong to another image), channels and pixel size
+    /// ([`TiffInfo::image_pixel_size`]), every image kept; `None` for a series the file does
+    /// not hold.
     pub fn image(&self, series: usize) -> Option<TiffInfo> {
-        if series == 0 {
-            return (series < self.series_count()).then(|| self.clone());
+        if self.images.is_empty() {
+            return (series == 0).then(|| self.clone());
         }
         let image = self.images.get(series)?;
         Some(TiffInfo {
             width: image.width,
             height: image.height,
             channels: image.axes.c,
-            pixel_size: image.pixel_size_m.map(|(x_m, y_m)| PixelSize {
+            pixel_size: self.image_pixel_size(image),
+            axes: image.axes.clone(),
+            ..self.clone()
+        })
+    }
+
+    /// The pixel size of one image of a multi-image OME-TIFF: its `PhysicalSizeX/Y`, else the
+    /// file's own (resolution tags or an ImageJ description; never another image's OME size).
+    pub fn image_pixel_size(&self, image: &OmeImage) -> Option<PixelSize> {
+        match image.pixel_size_m {
+            Some((x_m, y_m)) => Some(PixelSize {
                 x_m,
                 y_m,
                 source: PixelSizeSource::OmeXml,
             }),
-            axes: image.axes.clone(),
-            ..self.clone()
-        })
+            None => self
+                .pixel_size
+                .filter(|p| p.source != PixelSizeSource::OmeXml),
+        }
     }
 
     /// The files of a multi-file OME set holding planes of any image of this file, as the
