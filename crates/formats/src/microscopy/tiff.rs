@@ -291,7 +291,11 @@ impl Selection {
                 Ok((p, at))
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok((view.unwrap_or_else(|| info.clone()), planes))
+        // Along the images, they share one plane and pixel size (checked above): image 0's.
+        let shown = view
+            .or_else(|| info.image(0))
+            .unwrap_or_else(|| info.clone());
+        Ok((shown, planes))
     }
 
     /// The load axis of a TIFF when none is named (see [`LoadDefault`]).
