@@ -4,6 +4,7 @@
 
 pub mod axes;
 pub mod companion;
+mod images;
 pub mod metadata;
 pub mod read;
 pub mod spare;
