@@ -638,3 +638,96 @@ fn each_image_of_a_multi_image_ome_tiff_is_a_series() {
     ]);
     assert!(e.contains("image 2") && e.contains("0.1000"), "{e}");
 }
+
+#[test]
+fn a_file_of_a_set_with_planes_of_another_size_is_refused_by_every_reader() {
+    use tiff::encoder::{colortype, TiffEncoder};
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b) = ("a.ome.tif", "b.ome.tif");
+    let xml = set_xml([a, b]);
+    write_tiff(
+        &tmp.path().join(a),
+        &[disk(4.0, 2000, 0), disk(7.0, 2000, 0)],
+        &xml,
+    );
+    // The second file's pages are 40² where the set says 48².
+    let mut enc = TiffEncoder::new(std::fs::File::create(tmp.path().join(b)).unwrap()).unwrap();
+    for k in 0..2 {
+        let mut image = enc.new_image::<colortype::Gray16>(40, 40).unwrap();
+        if k == 0 {
+            image
+                .encoder()
+                .write_tag(Tag::ImageDescription, xml.as_str())
+                .unwrap();
+        }
+        image.write_data(&vec![300u16; 40 * 40]).unwrap();
+    }
+    let (file, out) = (tmp.path().join(a), tmp.path().join("out"));
+    // The analysis, the plane reader of `threshold`, and `info --stats` (every plane decoded).
+    for args in [
+        vec![
+            "analyze",
+            s(&file),
+            "--forces",
+            "4,10,20,40mN",
+            "--out",
+            s(&out),
+        ],
+        vec!["threshold", s(&file)],
+        vec!["info", s(&file), "--stats"],
+    ] {
+        let e = refused(&args);
+        assert!(e.contains(b) && e.contains("40×40"), "{args:?}: {e}");
+        assert_eq!(e.trim().lines().count(), 1, "{e}");
+    }
+}
+
+#[test]
+fn an_image_kept_in_a_file_whose_first_page_is_another_image_s_reads() {
+    use tiff::encoder::{colortype, TiffEncoder};
+    let tmp = tempfile::tempdir().unwrap();
+    // Image 0 (48²) in a.ome.tif; images 1 (48²) and 2 (40²) on pages 0 and 1 of b.ome.tif.
+    let image = |k: usize, size: usize, file: &str, ifd: usize| {
+        format!(
+            r#"<Image ID="Image:{k}" Name="p{k}"><Pixels ID="Pixels:{k}" DimensionOrder="XYCZT" Type="uint16" SizeX="{size}" SizeY="{size}" SizeC="1" SizeZ="1" SizeT="1"><Channel ID="Channel:{k}:0" SamplesPerPixel="1"/><TiffData IFD="{ifd}" PlaneCount="1"><UUID FileName="{file}">urn:uuid:00000000-0000-0000-0000-00000000000{k}</UUID></TiffData></Pixels></Image>"#
+        )
+    };
+    let xml = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?><OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06">{}{}{}</OME>"#,
+        image(0, W, "a.ome.tif", 0),
+        image(1, W, "b.ome.tif", 0),
+        image(2, 40, "b.ome.tif", 1)
+    );
+    write_tiff(&tmp.path().join("a.ome.tif"), &[disk(4.0, 2000, 0)], &xml);
+    let small: Vec<u16> = (0..40 * 40)
+        .map(|i| if i % 40 < 20 { 300 } else { 2300 })
+        .collect();
+    let mut enc =
+        TiffEncoder::new(std::fs::File::create(tmp.path().join("b.ome.tif")).unwrap()).unwrap();
+    let mut first = enc
+        .new_image::<colortype::Gray16>(W as u32, W as u32)
+        .unwrap();
+    first
+        .encoder()
+        .write_tag(Tag::ImageDescription, xml.as_str())
+        .unwrap();
+    first.write_data(&disk(7.0, 2000, 0)).unwrap();
+    enc.new_image::<colortype::Gray16>(40, 40)
+        .unwrap()
+        .write_data(&small)
+        .unwrap();
+    // Image 2 read through a.ome.tif: b.ome.tif's first page (image 1's, 48²) does not make
+    // its 40² plane another size than the series.
+    let a = tmp.path().join("a.ome.tif");
+    for args in [
+        vec!["threshold", s(&a), "--series", "2"],
+        vec!["info", s(&a), "--series", "2", "--stats"],
+    ] {
+        let o = run_ok(&args);
+        let said = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(
+            said.contains("1600") || said.contains("2300"),
+            "{args:?}: {said}"
+        );
+    }
+}

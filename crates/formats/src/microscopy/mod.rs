@@ -33,7 +33,7 @@ mod tiff;
 pub mod zarr;
 pub mod zarr_write;
 
-pub use tiff::{open_member, series_of_tiff, set_member, tiff_series, LoadDefault, TiffPage};
+pub use tiff::{series_of_tiff, set_member, tiff_series, LoadDefault, TiffPage};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -563,18 +563,11 @@ fn read_tiff_planes(
     let pixel_size = pixel_size_or(info.pixel_size, pixel_size_m);
     // The other file of a multi-file OME set last read from.
     let mut member: Option<crate::tiff::TiffReader> = None;
+    let expect = (info.width, info.height, info.sample_type);
     planes
         .into_iter()
         .map(|(_, at)| {
-            let plane = if at.path == info.path {
-                reader.read_page(at.ifd, at.sample)?
-            } else {
-                if member.as_ref().is_none_or(|m| m.info().path != at.path) {
-                    member = Some(super::tiff::open_member(&info, &at.path)?);
-                }
-                let m = member.as_mut().expect("just opened");
-                m.read_page(at.ifd, at.sample)?
-            };
+            let plane = super::tiff::read_set_page(&mut reader, &mut member, &at, expect)?;
             Ok(Image::of_plane(&plane, pixel_size, &at.path, at.ifd))
         })
         .collect()

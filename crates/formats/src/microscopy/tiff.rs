@@ -12,7 +12,7 @@ use super::select::{LoadAxis, SelectedPlane, Selection};
 use super::{Axes, ChannelInfo, PlaneIndex, SeriesInfo, VoxelSize};
 use crate::binary::bad;
 use crate::error::Result;
-use crate::image::{PixelSize, Plane};
+use crate::image::{PixelSize, Plane, SampleType};
 use crate::param::Param;
 use crate::tiff::{AxesSource, Place, TiffAxes, TiffInfo, TiffReader};
 
@@ -72,28 +72,44 @@ pub fn set_member(info: &TiffInfo, name: &str) -> Result<PathBuf> {
     Ok(path)
 }
 
-/// Open `path`, another file of `info`'s OME set, and check that its pages are planes of the
-/// same size and type.
-pub fn open_member(info: &TiffInfo, path: &Path) -> Result<TiffReader> {
-    let reader = TiffReader::open(path)?;
-    let other = reader.info();
-    if (other.width, other.height, other.sample_type) != (info.width, info.height, info.sample_type)
-    {
+/// Read the page `at` names, from the TIFF `own` or from another file of its OME set (`member`
+/// keeps the one last opened). A page read from another file must hold a plane of the
+/// series' size and sample type (`expect`: width, height, type); its first page need not (it
+/// may belong to another image of the set).
+pub(crate) fn read_set_page(
+    own: &mut TiffReader,
+    member: &mut Option<TiffReader>,
+    at: &TiffPage,
+    expect: (usize, usize, SampleType),
+) -> Result<Plane> {
+    if at.path == own.info().path {
+        return own.read_page(at.ifd, at.sample);
+    }
+    if member.as_ref().is_none_or(|m| m.info().path != at.path) {
+        *member = Some(TiffReader::open(&at.path)?);
+    }
+    let plane = member
+        .as_mut()
+        .expect("just opened")
+        .read_page(at.ifd, at.sample)?;
+    if (plane.width, plane.height, plane.sample_type) != expect {
         return Err(bad(
-            path,
+            &at.path,
             format!(
-                "a file of the OME-TIFF set of {} holds {}×{} {} pages, the set {}×{} {}",
-                info.path.display(),
-                other.width,
-                other.height,
-                other.sample_type.name(),
-                info.width,
-                info.height,
-                info.sample_type.name()
+                "page {} of this file of the OME-TIFF set of {} holds a {}×{} {} plane, the \
+                 series {}×{} {}",
+                at.ifd,
+                own.info().path.display(),
+                plane.width,
+                plane.height,
+                plane.sample_type.name(),
+                expect.0,
+                expect.1,
+                expect.2.name()
             ),
         ));
     }
-    Ok(reader)
+    Ok(plane)
 }
 
 /// Where plane (t, z, c) of series `series` of a TIFF is read (module docs); an error when no
@@ -217,20 +233,8 @@ impl TiffBackend {
             _ => (index.t, index.z),
         };
         let at = page_at(info, series.index, t, z, index.c)?;
-        if at.path == info.path {
-            return self.reader.read_page(at.ifd, at.sample);
-        }
-        if self
-            .member
-            .as_ref()
-            .is_none_or(|m| m.info().path != at.path)
-        {
-            self.member = Some(open_member(info, &at.path)?);
-        }
-        self.member
-            .as_mut()
-            .expect("just opened")
-            .read_page(at.ifd, at.sample)
+        let expect = (series.axes.x, series.axes.y, series.dtype);
+        read_set_page(&mut self.reader, &mut self.member, &at, expect)
     }
 }
 
