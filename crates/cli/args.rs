@@ -232,8 +232,8 @@ pub struct TopographyInput {
     pub path: PathBuf,
     #[command(flatten)]
     pub options: HeightMapOptions,
-    /// Channel of a multi-channel vendor height map, by name (e.g. Height); default: the
-    /// file's height channel.
+    /// Channel of a multi-channel vendor height map, by name (e.g. Height) or by its place in
+    /// the list `topography` prints (0, 1, …); default: the file's height channel.
     #[arg(long)]
     pub channel: Option<String>,
     /// Fill a vendor map's invalid (unmeasured, masked) points instead of refusing the map:

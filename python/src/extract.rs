@@ -114,6 +114,30 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ChannelArg {
     }
 }
 
+/// `channel=` of a height map: a channel's name (a `str`) or its place in the file's list of
+/// channels (an int ≥ 0), passed on as the text the readers take (`--channel`).
+pub(crate) struct HeightChannel(pub(crate) String);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for HeightChannel {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Ok(s) = obj.cast::<PyString>() {
+            return Ok(HeightChannel(s.to_string()));
+        }
+        match index(&obj, "channel=") {
+            Ok(Some(i)) => Ok(HeightChannel(i.to_string())),
+            Ok(None) => Err(wrong_type("channel=", "a name (a str) or an index", &obj)),
+            Err(e) if e.is_instance_of::<PyTypeError>(obj.py()) => Err(wrong_type(
+                "channel=",
+                "a channel's name (a str), its index (an int ≥ 0) or None",
+                &obj,
+            )),
+            Err(e) => Err(e),
+        }
+    }
+}
+
 /// An optional item of a dict the Python layer built from keywords, with a message naming the
 /// keyword and what it takes when the value does not fit.
 pub(crate) fn item<'py, T: FromPyObjectOwned<'py>>(

@@ -13,6 +13,7 @@ use contactscope_formats::param::Param;
 use contactscope_jobs::fit_hardening::{BodyRequest, FitRequest, MeasuredInput};
 
 use crate::convert::outcome_dict;
+use crate::extract::HeightChannel;
 use crate::heights::{height_input, HeightsArg};
 use crate::{bad, compute, PixelArg};
 
@@ -154,7 +155,7 @@ fn fit_hardening<'py>(
     detrend: &str,
     periodic: bool,
     height_unit: Option<f64>,
-    channel: Option<String>,
+    channel: Option<HeightChannel>,
     fill_invalid: Option<&str>,
     device: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -169,7 +170,7 @@ fn fit_hardening<'py>(
         imaging_pixel_size,
         detrend,
         periodic,
-        (height_unit, channel, fill_invalid),
+        (height_unit, channel.map(|c| c.0), fill_invalid),
         device,
     )?;
     let mut request = FitRequest::new(measured_input(measured)?, body);

@@ -16,6 +16,7 @@ use contactscope_jobs::surface::SurfaceRequest;
 use contactscope_jobs::topography::TopographyRequest;
 
 use crate::convert::outcome_dict;
+use crate::extract::HeightChannel;
 use crate::heights::{detrend_of, fill_of};
 use crate::{bad, compute, PixelArg};
 
@@ -32,7 +33,7 @@ fn read_topography<'py>(
     pixel_size: Option<PixelArg>,
     height_unit: Option<f64>,
     detrend: &str,
-    channel: Option<String>,
+    channel: Option<HeightChannel>,
     fill_invalid: Option<&str>,
     measurement: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -42,7 +43,7 @@ fn read_topography<'py>(
             pixel_size_m: crate::pixel_opt(pixel_size)?,
             height_unit_m: height_unit,
             detrend: detrend_of(detrend)?,
-            channel,
+            channel: channel.map(|c| c.0),
             fill_invalid: fill_of(fill_invalid)?,
             ..TopographyRequest::new(path).source
         },

@@ -15,6 +15,7 @@ use contactscope_jobs::simulate::{
 };
 
 use crate::convert::outcome_dict;
+use crate::extract::HeightChannel;
 use crate::heights::{height_input, HeightsArg};
 use crate::{bad, compute, PixelArg};
 
@@ -182,7 +183,7 @@ fn simulate<'py>(
     maps: MapsArg,
     detrend: &str,
     height_unit: Option<f64>,
-    channel: Option<String>,
+    channel: Option<HeightChannel>,
     fill_invalid: Option<&str>,
     device: &str,
     measurement: Option<String>,
@@ -194,7 +195,7 @@ fn simulate<'py>(
         pixel_size,
         detrend,
         height_unit,
-        channel,
+        channel.map(|c| c.0),
         fill_invalid,
         measurement,
     )?;

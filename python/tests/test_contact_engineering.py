@@ -8,6 +8,7 @@ skipped when absent); a generated surface is used besides them.
 """
 
 import csv
+import gzip
 import io
 import json
 import pathlib
@@ -29,6 +30,7 @@ from SurfaceTopography.Generation import fourier_synthesis  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 AFM = ROOT.parent / "shared" / "data" / "real-afm"
+FIXTURES = ROOT / "fixtures" / "surface-topography"
 AFM_FILES = ["di-3.di", "spot_1-1000nm.ibw", "mi-1.mi", "nid-1.nid", "top-1.top"]
 UNIT_M = {"m": 1.0, "mm": 1e-3, "µm": 1e-6, "um": 1e-6, "nm": 1e-9, "Å": 1e-10, "pm": 1e-12}
 
@@ -166,9 +168,13 @@ def test_data_source_names_surface_topography_s_channel(tmp_path):
     every channel of the multi-channel examples, one container each, read as
     ``read_container`` reads it (the same heights to 1e-9), or refused naming the channel
     where ours is not a height map (a phase, a deflection in volts)."""
-    read, refused = 0, 0
-    for name in ["di-3.di", "spot_1-1000nm.ibw", "mi-1.mi", "nid-1.nid"]:
-        path = afm(name)
+    read, refused, by_place = 0, 0, 0
+    # di-2 (SurfaceTopography's fixture): two channels named Height, then a deflection.
+    di2 = tmp_path / "di-2.di"
+    di2.write_bytes(gzip.decompress((FIXTURES / "di-2.di.gz").read_bytes()))
+    paths = [afm(n) for n in ["di-3.di", "spot_1-1000nm.ibw", "mi-1.mi", "nid-1.nid"]] + [di2]
+    for path in paths:
+        name = path.name
         orient = orientation_of(path)
         channels = [c.name for c in quiet(lambda: open_topography(str(path)).channels)]
         assert len(channels) > 1, name
@@ -192,9 +198,17 @@ def test_data_source_names_surface_topography_s_channel(tmp_path):
             (theirs,) = list(quiet(read_container, str(container))[0])
             assert_same_topography(ours, theirs, orient, label)
             read += 1
-    print(f"data_source: {read} channels read as SurfaceTopography reads them, {refused} "
-          "refused as not height maps")
-    assert read >= 8, read
+            if not name.endswith(".nid"):
+                # Where SurfaceTopography numbers every channel, ``channel=k`` is its channel k.
+                direct = cs.read_topography(path, detrend="none", channel=k)
+                assert direct["summary"]["channel"] == ours["summary"]["channel"], label
+                np.testing.assert_allclose(direct["heights"] - direct["heights"].mean(),
+                                           ours["heights"], rtol=0, err_msg=label,
+                                           atol=1e-12 * np.abs(ours["heights"]).max())
+                by_place += 1
+    print(f"data_source: {read} channels read as SurfaceTopography reads them ({by_place} "
+          f"also as channel=k), {refused} refused as not height maps")
+    assert read >= 10 and by_place >= 6, (read, by_place)
 
 
 def test_the_median_detrend_is_surface_topography_s(tmp_path):

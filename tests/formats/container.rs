@@ -227,7 +227,8 @@ fn containers_refuse_what_they_cannot_do_with_one_line() {
     );
     fails(
         &["topography", c_arg, "--measurement", "second"],
-        "data_source 1 is a channel index in SurfaceTopography's order",
+        "measurement s/second: data_source 1 is a channel index in SurfaceTopography's order, \
+         which is not known for npy files",
     );
     fails(
         &[
@@ -257,6 +258,96 @@ fn containers_refuse_what_they_cannot_do_with_one_line() {
     assert!(
         !whole.status.success(),
         "a measurement that cannot be read fails the listing"
+    );
+}
+
+/// A 2 × 2 Nanoscope file of three channels, as the Nanoscope manual lays it out (a text header,
+/// then int16 data at each channel's `Data offset`): `Height` first (the default channel) with
+/// its data beyond the end of the file, then `Phase` (degrees), then `ZSensor` with the raw
+/// values `zsensor` (0.002 nm per count: 6.5536 V / 65536 × 20 nm/V).
+fn nanoscope_with_a_broken_height(zsensor: [i16; 4]) -> Vec<u8> {
+    let mut text = String::from(
+        "\\*File list\r\n\\Data length: 1024\r\n\\*Ciao scan list\r\n\
+         \\@Sens. Zsens: V 20 nm/V\r\n\\@Sens. Phase: V 1 deg/V\r\n",
+    );
+    for (name, quantity, offset) in [
+        ("Height", "Zsens", 4096),
+        ("Phase", "Phase", 1024),
+        ("ZSensor", "Zsens", 1032),
+    ] {
+        text.push_str(&format!(
+            "\\*Ciao image list\r\n\\Data offset: {offset}\r\n\\Bytes/pixel: 2\r\n\
+             \\Samps/line: 2\r\n\\Number of lines: 2\r\n\\Scan Size: 4 2 ~m\r\n\
+             \\@2:Image Data: S [{name}] \"{name}\"\r\n\
+             \\@2:Z scale: V [Sens. {quantity}] (0.0001 V/LSB) 6.5536 V\r\n"
+        ));
+    }
+    text.push_str("\\*File list end\r\n");
+    let mut out = text.into_bytes();
+    assert!(out.len() <= 1024, "header of {} bytes", out.len());
+    out.resize(1024, 0);
+    out.extend([1i16, 2, 3, 4].iter().flat_map(|v| v.to_le_bytes()));
+    out.extend(zsensor.iter().flat_map(|v| v.to_le_bytes()));
+    out
+}
+
+#[test]
+fn a_data_source_is_read_whatever_the_file_s_default_channel_holds() {
+    // SurfaceTopography's channel k of a Nanoscope file is its k-th channel in file order; the
+    // channel is read by its place, so a default channel (here the first height channel, whose
+    // data lie beyond the file) that cannot be read does not stop another from being read.
+    let dir = tempfile::tempdir().unwrap();
+    let c = dir.path().join("c");
+    write(
+        &c.join("scan.di"),
+        &nanoscope_with_a_broken_height([500, 1500, 2500, 3500]),
+    );
+    let topo = |name: &str, k: usize| {
+        json!({"name": name, "datafile": {"original": "scan.di"}, "size": [4.0, 2.0],
+               "unit": "um", "data_source": k, "detrend_mode": "center"})
+    };
+    let meta = json!({"surfaces": [{"name": "s", "topographies": [
+        topo("default", 0), topo("phase", 1), topo("zsensor", 2), topo("beyond", 3)]}]});
+    write(&c.join("index.json"), &serde_json::to_vec(&meta).unwrap());
+    let c_arg = c.to_str().unwrap();
+    let z = topography_json(&[
+        "topography",
+        c_arg,
+        "--measurement",
+        "zsensor",
+        "--detrend",
+        "none",
+        "--json",
+    ]);
+    assert_eq!(z["channel"], "ZSensor", "{z}");
+    // Raw 500…3500 at 0.002 nm per count: 1, 3, 5, 7 nm (centred by the container's mode).
+    let um = |key: &str| z[key].as_f64().unwrap();
+    let range_nm = (um("height_max_um") - um("height_min_um")) * 1e3;
+    assert!((range_nm - 6.0).abs() < 1e-9, "{range_nm}");
+    assert!(um("height_mean_um").abs() < 1e-12, "{z}");
+    assert_eq!(z["nx"], 2, "{z}");
+    let refused = |measurement: &str, needles: &[&str]| {
+        let out = run(&["topography", c_arg, "--measurement", measurement]);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{measurement} was read");
+        assert_eq!(err.trim().lines().count(), 1, "one line: {err}");
+        for needle in needles {
+            assert!(err.contains(needle), "{measurement}: {err}");
+        }
+    };
+    // The default channel's own error; the phase refused as not a height; beyond the list.
+    refused("default", &["scan.di", "Height"]);
+    refused(
+        "phase",
+        &["measurement s/phase: data_source 1:", "'Phase'", "height"],
+    );
+    refused(
+        "beyond",
+        &[
+            "data_source 3:",
+            "no channel 3 (channels count from 0)",
+            "3 channel(s)",
+        ],
     );
 }
 

@@ -392,7 +392,7 @@ def read_topography(
     pixel_size: Optional[PixelSize] = None,
     height_unit: Optional[float] = None,
     detrend: str = "plane",
-    channel: Optional[str] = None,
+    channel: Union[int, str, None] = None,
     fill_invalid: Optional[str] = None,
     measurement: Optional[str] = None,
 ) -> TopographyResult: ...
@@ -478,7 +478,7 @@ def simulate(
     maps: Union[str, bool] = "all",
     detrend: str = "plane",
     height_unit: Optional[float] = None,
-    channel: Optional[str] = None,
+    channel: Union[int, str, None] = None,
     fill_invalid: Optional[str] = None,
     device: str = "cpu",
     measurement: Optional[str] = None,
@@ -540,7 +540,7 @@ def fit_hardening(
     detrend: str = "plane",
     periodic: bool = False,
     height_unit: Optional[float] = None,
-    channel: Optional[str] = None,
+    channel: Union[int, str, None] = None,
     fill_invalid: Optional[str] = None,
     device: str = "cpu",
 ) -> FitResult: ...

@@ -298,26 +298,11 @@ impl Container {
             height_unit_m: unit_m,
             channel: channel.map(str::to_string),
         };
-        let map_read = read_with_unit(&file, &mut options).map_err(relabel);
         let map_read = match (channel, m.data_source) {
             (None, Some(k @ 1..)) => {
-                let first = map_read?;
-                let name = surface_topography_channel(&first, k).map_err(|why| {
-                    bad(
-                        &shown,
-                        format!(
-                            "measurement {}: data_source {k} {why}; name the channel with {} \
-                             (the file has '{}')",
-                            m.label(),
-                            crate::param::Param::Channel,
-                            first.channels.join("', '")
-                        ),
-                    )
-                })?;
-                options.channel = Some(name);
-                read_with_unit(&file, &mut options).map_err(relabel)
+                read_data_source(&file, &mut options, (k, &m.label())).map_err(relabel)
             }
-            _ => map_read,
+            _ => read_with_unit(&file, &mut options).map_err(relabel),
         };
         let mut map = map_read?;
         let mut notes = Vec::new();
@@ -677,34 +662,102 @@ fn yaml_to_json(path: &Path, text: &str) -> Result<Value> {
     Ok(docs.first().map(convert).unwrap_or(Value::Null))
 }
 
-/// The channel SurfaceTopography's reader gives as channel `k` of this file (`data_source` of
-/// a container's measurement), by its name here; an error saying why where the two readers'
-/// channel lists are not known to correspond. Checked against SurfaceTopography's own readers
-/// on their example files (`python/tests/test_contact_engineering.py`): its Nanoscope, Igor
-/// and PicoView readers list every channel of the file, in the file's order, as ours do; its
-/// Nanosurf reader lists only the channels in a length unit (`Dim2Unit`).
-fn surface_topography_channel(map: &HeightMap, k: usize) -> std::result::Result<String, String> {
+/// Read the channel SurfaceTopography's reader gives as channel `k` of this file (`data_source`
+/// of a container's measurement). Checked against SurfaceTopography's own readers on their
+/// example files (`python/tests/test_contact_engineering.py`): its Nanoscope, Igor and PicoView
+/// readers list every channel of the file in the file's order, as ours do, so `k` is our
+/// channel `k`, read at once (whatever the file's default channel holds); its Nanosurf reader
+/// lists only the channels in a length unit (`Dim2Unit`), found among ours after a first read.
+/// Other formats are refused: which of their channels SurfaceTopography counts is not known.
+fn read_data_source(
+    file: &Path,
+    options: &mut ReadOptions,
+    (k, label): (usize, &str),
+) -> Result<HeightMap> {
     use super::TopographyFormat as F;
-    let theirs: Vec<&String> = match map.format {
-        F::Nanoscope | F::Ibw | F::Mi => map.channels.iter().collect(),
-        F::Nid => map
-            .channels
-            .iter()
-            .zip(&map.height_channels)
-            .filter_map(|(name, &height)| height.then_some(name))
-            .collect(),
+    // A reader's error (a channel not in a length unit) says which measurement asked for it.
+    let read = |options: &mut ReadOptions| {
+        read_with_unit(file, options).map_err(|e| match e {
+            Error::BadInput { at, reason } => Error::BadInput {
+                at,
+                reason: format!("measurement {label}: data_source {k}: {reason}"),
+            },
+            other => other,
+        })
+    };
+    let format = super::vendor::detect_file(file)?;
+    let refuse = |why: String, channels: &[String]| {
+        let list = if channels.is_empty() {
+            String::new()
+        } else {
+            format!(" (the file has '{}')", channels.join("', '"))
+        };
+        bad(
+            file,
+            format!(
+                "measurement {label}: data_source {k} {why}; name the channel with {}{list}",
+                crate::param::Param::Channel
+            ),
+        )
+    };
+    match format {
+        Some(F::Nanoscope | F::Ibw | F::Mi) => {
+            options.channel = Some(k.to_string());
+            let map = read(options)?;
+            match map.channels.get(k) {
+                Some(name) if *name == map.channel => Ok(map),
+                // A channel named like the number was read by its name: read the k-th.
+                Some(name) => {
+                    options.channel = Some(name.clone());
+                    read(options)
+                }
+                None => Err(refuse(
+                    format!(
+                        "is beyond the {} channel(s) of the file",
+                        map.channels.len()
+                    ),
+                    &map.channels,
+                )),
+            }
+        }
+        Some(F::Nid) => {
+            let first = read(options)?;
+            let lengths: Vec<&String> = first
+                .channels
+                .iter()
+                .zip(&first.height_channels)
+                .filter_map(|(name, &height)| height.then_some(name))
+                .collect();
+            let name = lengths.get(k).ok_or_else(|| {
+                refuse(
+                    format!(
+                        "is beyond the {} channel(s) SurfaceTopography's reader lists for this \
+                         file (those in a length unit)",
+                        lengths.len()
+                    ),
+                    &first.channels,
+                )
+            })?;
+            if **name == first.channel {
+                return Ok(first);
+            }
+            options.channel = Some(name.to_string());
+            read(options)
+        }
         other => {
-            return Err(format!(
-                "is a channel index in SurfaceTopography's order, which is not known for {} \
-                 files",
-                other.name()
+            // Read as by default only to name the format and list the channels.
+            let map = read_with_unit(file, &mut options.clone()).ok();
+            let name = other
+                .or(map.as_ref().map(|m| m.format))
+                .map_or("this file's format", |f| f.name());
+            let channels = map.map(|m| m.channels).unwrap_or_default();
+            Err(refuse(
+                format!(
+                    "is a channel index in SurfaceTopography's order, which is not known for \
+                     {name} files"
+                ),
+                &channels,
             ))
         }
-    };
-    theirs.get(k).map(|name| name.to_string()).ok_or_else(|| {
-        format!(
-            "is beyond the {} channel(s) SurfaceTopography's reader lists for this file",
-            theirs.len()
-        )
-    })
+    }
 }

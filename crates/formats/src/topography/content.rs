@@ -88,13 +88,19 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
     let single = |map: Result<HeightMap>| -> Result<HeightMap> {
         let map = map?;
         match &options.channel {
-            Some(want) if !map.channel.eq_ignore_ascii_case(want) => Err(bad(
-                path,
-                format!(
-                    "no channel '{want}': this {} file holds one height map",
-                    map.format.name()
-                ),
-            )),
+            // Its one channel by name, or as channel 0.
+            Some(want)
+                if !map.channel.eq_ignore_ascii_case(want)
+                    && want.trim().parse::<usize>() != Ok(0) =>
+            {
+                Err(bad(
+                    path,
+                    format!(
+                        "no channel '{want}': this {} file holds one height map",
+                        map.format.name()
+                    ),
+                ))
+            }
             _ => Ok(map),
         }
     };

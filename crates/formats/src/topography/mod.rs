@@ -145,7 +145,8 @@ pub struct ReadOptions {
     pub pixel_size_m: Option<(f64, f64)>,
     /// Metres per stored height unit, for formats that state none (default: metres).
     pub height_unit_m: Option<f64>,
-    /// Channel of a multi-channel vendor file, by name (default: its height channel).
+    /// Channel of a multi-channel vendor file, by name or by its place in the file's list (0,
+    /// 1, …) (default: its height channel).
     pub channel: Option<String>,
 }
 

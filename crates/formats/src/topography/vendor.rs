@@ -398,11 +398,29 @@ pub(crate) fn choose(
         return Err(bad(path, "the file holds no data channel"));
     }
     match request {
+        // The exact name first, then a position in the list (0, 1, …: what a SurfaceTopography
+        // container's `data_source` and a file with two channels of one name need), then the
+        // first name containing the text.
         Some(want) => {
             let want_l = want.to_lowercase();
-            channels
+            let exact = channels
                 .iter()
-                .position(|c| c.name.to_lowercase() == want_l)
+                .position(|c| c.name.to_lowercase() == want_l);
+            if let (None, Ok(k)) = (exact, want.trim().parse::<usize>()) {
+                return if k < channels.len() {
+                    Ok(k)
+                } else {
+                    Err(bad(
+                        path,
+                        format!(
+                            "no channel {k} (channels count from 0); the file has {} channel(s): {}",
+                            channels.len(),
+                            list()
+                        ),
+                    ))
+                };
+            }
+            exact
                 .or_else(|| {
                     channels
                         .iter()
@@ -611,6 +629,19 @@ mod tests {
         assert_eq!(choose(p, &signals, None).unwrap(), 2);
         let only = entries(&[("Deflection", true), ("Phase", false)]);
         assert!(choose(p, &only, None).is_err());
+        // By position: after an exact name (a channel named "1" is that channel), before a
+        // name containing the digits; beyond the list an error that counts them.
+        assert_eq!(choose(p, &c, Some("2")).unwrap(), 2);
+        assert_eq!(choose(p, &c, Some(" 0 ")).unwrap(), 0);
+        let numbered = entries(&[("Height 2", true), ("Phase", false), ("0", true)]);
+        assert_eq!(choose(p, &numbered, Some("0")).unwrap(), 2);
+        assert_eq!(choose(p, &numbered, Some("2")).unwrap(), 2);
+        assert_eq!(choose(p, &numbered, Some("1")).unwrap(), 1);
+        let err = choose(p, &c, Some("3")).unwrap_err().to_string();
+        assert!(
+            err.contains("no channel 3 (channels count from 0)") && err.contains("3 channel(s)"),
+            "{err}"
+        );
     }
 
     #[test]
