@@ -60,8 +60,16 @@ pub fn run(args: Args) -> Result<()> {
         summary.format, summary.channel
     );
     if summary.channels.len() > 1 {
-        let others: Vec<String> = summary.channels.iter().map(|c| format!("'{c}'")).collect();
-        println!("channels:    {} (choose with --channel)", others.join(", "));
+        let listed: Vec<String> = summary
+            .channels
+            .iter()
+            .enumerate()
+            .map(|(k, c)| format!("{k} '{c}'"))
+            .collect();
+        println!(
+            "channels:    {} (choose with --channel NAME or --channel N)",
+            listed.join(", ")
+        );
     }
     println!(
         "size:        {} × {} px = {:.4} × {:.4} µm",
