@@ -229,6 +229,30 @@ def test_sflz_files_read_as_surfalize_wrote_them(cli):
         assert summary["valid_points"] == measured.sum()
 
 
+def test_zon_files_read_as_surface_topography_reads_them(cli):
+    """The committed Keyence ZON files (tests/data/zon_fixture.py; zstd members and stored
+    ones) against SurfaceTopography's ZONReader: every measured height equal (its arrays are
+    (x, y), ours rows = y), the same points unmeasured, the same pixel size; and against the
+    fixture's own formula (counts of 10 nm)."""
+    st = pytest.importorskip("SurfaceTopography")
+    y, x = np.mgrid[0:14, 0:20]
+    counts = (300 * (x - 9.5) ** 2 - 150 * (y - 6.5) ** 2 + 4000 * (x > 12) - 7).astype(np.int32)
+    for name in ["tiny.zon", "tiny-plain.zon"]:
+        path = ROOT / "fixtures" / "zon" / name
+        theirs = st.open_topography(str(path)).topography()
+        h = np.ma.masked_invalid(theirs.heights()).T
+        ours = cs.read_topography(path, detrend="none", fill_invalid="nearest")
+        measured = ~np.ma.getmaskarray(h)
+        assert ours.heights.shape == h.shape == counts.shape
+        np.testing.assert_array_equal(ours.heights[measured], np.asarray(h)[measured])
+        np.testing.assert_allclose(ours.heights[measured], counts[measured] * 1e-8, rtol=1e-12)
+        size = np.array(theirs.physical_sizes) / np.array(theirs.nb_grid_pts)
+        assert ours.pixel_size_m == pytest.approx(tuple(size), rel=1e-12)
+        summary = json.loads(cli("topography", path, "--json"))
+        assert summary["format"] == "zon"
+        assert summary["valid_points"] == measured.sum() == 272
+
+
 def test_a_zygo_datx_file_is_refused_by_name(tmp_path):
     """An HDF5 file laid out as Zygo's DATX (a root MetaData table, Measurement/Surface) is
     refused naming the format, not read as plain datasets in an unknown unit."""

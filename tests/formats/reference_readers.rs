@@ -25,6 +25,11 @@
 //!   Nanonis scan `sxm_moire_10nm.sxm` against nanonispy 1.1.0
 //!   (`tests/data/nanonis_sxm_probeflow_reference.csv`, `nanonis_sxm_reference.py`).
 //!
+//! * Keyence `.zon`: `tests/test_files/test_1.zon` of `fredericjs/surfalize@f558db5` (a VR-6100
+//!   scan, GPL-3.0: not committed; `CONTACTSCOPE_ZON_DIR`), and always the two small files of
+//!   `fixtures/zon` (`zon_fixture.py`); reference `tests/data/zon_reference.csv`
+//!   (`zon_reference.py`, SurfaceTopography 1.27.1's `ZONReader`).
+//!
 //! And, always (the files are our own, written by the reference package itself): surfalize
 //! `.sflz`, the three files of `fixtures/sflz` (`sflz_fixture.py`: zlib, LZMA and no
 //! compression; uint32, float64 and int16 heights; um, nm and mm); reference
@@ -334,5 +339,31 @@ fn the_committed_jpk_hdf5_export_reads_its_counts_in_metres() {
             .unwrap_err()
             .to_string();
         assert!(err.contains("states its height unit"), "{file}: {err}");
+    }
+}
+
+#[test]
+fn zon_files_read_as_surface_topography_reads_them() {
+    let dir = crate::common::root().join("fixtures/zon");
+    assert_eq!(
+        compare_files(&dir, "zon_reference.csv", |f| f.starts_with("tiny")),
+        2
+    );
+    // Row 0 is the first row stored, each row's padding skipped (the fixture's counts are
+    // trunc(300·(x − 9.5)² − 150·(y − 6.5)² + 4000·[x > 12] − 7), 10 nm each), and a pixel
+    // whose validity byte is 4 is measured while 1, 2 and 3 are not.
+    let map = read_height_map(&dir.join("tiny.zon"), &ReadOptions::default()).unwrap();
+    assert_eq!(map.heights[(0, 5)], -269.0 * 1e-8);
+    assert_eq!(map.heights[(13, 15)], 6730.0 * 1e-8);
+    assert!(map.heights[(5, 7)].is_nan() && map.heights[(9, 3)].is_nan());
+    assert!(map.heights[(3, 10)].is_finite());
+    if let Some(dir) = folder(
+        "CONTACTSCOPE_ZON_DIR",
+        "test_1.zon of fredericjs/surfalize@f558db5 (tests/test_files)",
+    ) {
+        assert_eq!(
+            compare_files(&dir, "zon_reference.csv", |f| f == "test_1.zon"),
+            1
+        );
     }
 }

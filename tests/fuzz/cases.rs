@@ -193,6 +193,18 @@ pub const TEMPLATES: &[Template] = &[
         ["topography", "t-earlier.sflz", "--json"]
     ),
     t!(
+        "topography-zon",
+        ["t.zon"],
+        ["t.zon"],
+        ["topography", "t.zon", "--json"]
+    ),
+    t!(
+        "topography-zon-plain",
+        ["t-plain.zon"],
+        ["t-plain.zon"],
+        ["topography", "t-plain.zon", "--json"]
+    ),
+    t!(
         "topography-sflz-lzma",
         ["t-lzma.sflz"],
         ["t-lzma.sflz"],

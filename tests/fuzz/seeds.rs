@@ -263,6 +263,8 @@ pub fn build(dir: &Path) {
         ("sflz/lzma_f8.sflz", "t-lzma.sflz"),
         ("sflz/earlier_zlib_u4.sflz", "t-earlier.sflz"),
         ("createc/A250407.141806.dat", "t-createc.dat"),
+        ("zon/tiny.zon", "t.zon"),
+        ("zon/tiny-plain.zon", "t-plain.zon"),
     ] {
         fs::copy(
             crate::common::root().join("fixtures").join(fixture),

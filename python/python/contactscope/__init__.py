@@ -509,7 +509,7 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
     """A height map from any format contactscope reads (npy, TIFF, GSF, text matrices with or
     without a Gwyddion or h=/w= header, x y z grids, gzip text, WSxM, Nanoscope, Nanonis sxm, TopoStats, JPK TIFF and HDF5, Igor ibw,
     Nanosurf nid, PicoView mi, Park TIFF, Gwyddion, X3P, SDF, Wyko opd, Sensofar plu, Digital
-    Surf sur and mnt, surfalize sflz, Createc dat, FRT, Alicona al3d, TrueMap tmd, NanoFocus nms, Image Metrology bcr/bcrf,
+    Surf sur and mnt, surfalize sflz, Keyence zon, Createc dat, FRT, Alicona al3d, TrueMap tmd, NanoFocus nms, Image Metrology bcr/bcrf,
     Zygo MetroPro dat, NetCDF, HDF5 … recognised by content; ``docs/formats.md``), read as the
     command line's ``topography`` reads it (the same checks and messages).
 

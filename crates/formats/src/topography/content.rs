@@ -28,7 +28,7 @@ fn known_unread(head: &[u8]) -> Option<&'static str> {
         "a Keyence VK3/VK4 file: not read by contactscope (no sample file to test a reader on); \
          export the map as .gsf or a text matrix"
     } else if starts(b"KPK") {
-        "a Keyence ZON file: not read by contactscope (no sample file to test a reader on); \
+        "a Keyence ZON file of a version contactscope does not read (KPK0 and KPK1 are read); \
          export the map as .gsf or a text matrix"
     } else if starts(b"[Parameter]") || starts(b"[Paramet32]") {
         "a Createc image of the older uncompressed layout ([Parameter], [Paramet32]): not read \
@@ -232,7 +232,7 @@ mod tests {
                 "force-curve file without an image",
             ),
             (b"VK4_\0\0\0\0", "Keyence"),
-            (b"KPK\0\0\0\0\0BM", "Keyence ZON"),
+            (b"KPK\0\0\0\0\0BM", "Keyence ZON file of a version"),
             (b"[Paramet32]\r\nNum.X=4\r\n", "Createc image of the older"),
             (
                 b"Experiment\tbias spectroscopy\t\r\n",

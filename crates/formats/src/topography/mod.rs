@@ -59,6 +59,7 @@
 //! | WSxM images `.top`, `.stp`, … | `wsxm` | `WSxM file copyright` | integers: `raw·Z amplitude/(max − min)`; floats as stored | X/Y amplitude / points | none |
 //! | surfalize `.sflz` | [`sflz`] | `SFLZ` | the height layer in the file's unit; integer layers mapped onto their stated range | `step_x`, `step_y` | NaN; the integer sentinel |
 //! | Createc `.dat` | [`createc`] | `[Paramco32]` | float32 DAC counts × `Dacto[A]z` (nm) × `GainZ`/10; first column dropped | `Length x[A]`/`Num.X` | lines not scanned dropped |
+//! | Keyence `.zon` | [`zon`] | `KPK0`, `KPK1` | int32 × `MeterPerUnit` (m) | `MeterPerPixel` | validity bits 0–1 |
 //! | Nanonis `.sxm` | [`sxm`] | `:NANONIS_VERSION:` | float32 as stored, in the `DATA_INFO` unit; backward lines mirrored, scans `up` flipped | `SCAN_RANGE` / `SCAN_PIXELS` | NaN (not scanned) |
 //!
 //! A file that states no pixel size (HDF5; a MetroPro file with a camera resolution of 0; a
@@ -107,6 +108,7 @@ pub mod sxm;
 pub mod tmd;
 mod vendor;
 pub mod x3p;
+pub mod zon;
 
 mod content;
 mod gsf;

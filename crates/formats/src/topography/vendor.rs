@@ -6,7 +6,7 @@ use std::path::Path;
 
 use super::{
     al3d, bcr, createc, frt, gwy, hdf5, ibw, jpk, metropro, mi, mnt, nanoscope, netcdf, nid, nms,
-    opd, opdx, park, plu, sdf, sflz, sur, sxm, tmd, wsxm, x3p,
+    opd, opdx, park, plu, sdf, sflz, sur, sxm, tmd, wsxm, x3p, zon,
 };
 
 use ndarray::Array2;
@@ -72,6 +72,8 @@ pub enum TopographyFormat {
     Gsf,
     /// Text matrix, with or without a header (also gzip-compressed).
     Text,
+    /// Keyence ZON (VR-series 3D macroscopes).
+    Zon,
     /// `x y z` points on a regular grid (text).
     Xyz,
     /// WSxM image (`.top`, `.stp`, …).
@@ -131,6 +133,7 @@ impl TopographyFormat {
             TopographyFormat::Sflz => "sflz",
             TopographyFormat::Createc => "createc",
             TopographyFormat::JpkHdf5 => "jpk-h5",
+            TopographyFormat::Zon => "zon",
         }
     }
 
@@ -248,6 +251,8 @@ pub fn detect(head: &[u8]) -> Option<TopographyFormat> {
         Some(TopographyFormat::Sflz)
     } else if starts(createc::MAGIC) {
         Some(TopographyFormat::Createc)
+    } else if starts(b"KPK0") || starts(b"KPK1") {
+        Some(TopographyFormat::Zon)
     } else if head.get(nms::VERSION_AT..nms::VERSION_AT + nms::VERSION.len()) == Some(nms::VERSION)
     {
         Some(TopographyFormat::Nms)
@@ -303,7 +308,7 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
             path,
             "not a height-map format contactscope recognises from its content (ibw, nid, mi, \
              Park TIFF, gwy, x3p, sdf, opd, plu, sur, frt, al3d, tmd, nms, bcr/bcrf, metropro, netcdf, hdf5, mnt, opdx, \
-             nanoscope, wsxm, sxm, jpk, sflz, createc)",
+             nanoscope, wsxm, sxm, jpk, sflz, createc, zon)",
         )
     })?;
     match format {
@@ -336,6 +341,7 @@ pub fn read(path: &Path, channel: Option<&str>) -> Result<HeightMap> {
                 TopographyFormat::NetCdf => netcdf::read(path, &bytes, channel),
                 TopographyFormat::Hdf5 => hdf5::read(path, &bytes, channel),
                 TopographyFormat::Opdx => opdx::read(path, &bytes, channel),
+                TopographyFormat::Zon => zon::read(path, &bytes, channel),
                 TopographyFormat::X3p
                 | TopographyFormat::Mnt
                 | TopographyFormat::Npy

@@ -10,7 +10,7 @@ file's pixel size (1 where the file does not state it) and the file's name and s
 
 Height maps: AFM and profilometer files (Igor ibw, Nanosurf nid, PicoView mi, Gwyddion gwy,
 X3P, SDF, Wyko opd, Sensofar plu, Digital Surf sur and mnt, FRT, GSF, WSxM top/stp, Nanoscope
-di/spm/001, Nanonis sxm, TopoStats, JPK TIFF and HDF5, surfalize sflz, Createc and Zygo MetroPro dat
+di/spm/001, Nanonis sxm, TopoStats, JPK TIFF and HDF5, surfalize sflz, Keyence zon, Createc and Zygo MetroPro dat
 (recognised by their first bytes: .dat is a common name), Alicona al3d, TrueMap tmd, NanoFocus nms, Image Metrology bcr/bcrf, Vision64 opdx,
 NetCDF nc, HDF5 h5, Park TIFF) through :func:`contactscope.read_topography`, as the command line's ``topography``
 reads them (plane-levelled, its default): one image layer of heights in µm, scale in µm.
@@ -42,7 +42,7 @@ TIFF_EXTENSIONS = (".tif", ".tiff")
 TOPOGRAPHY_EXTENSIONS = (".ibw", ".nid", ".mi", ".gwy", ".x3p", ".sdf", ".opd", ".plu", ".sur",
                          ".frt", ".gsf", ".top", ".stp", ".di", ".spm", ".001", ".al3d", ".tmd",
                          ".nms", ".bcr", ".bcrf", ".mnt", ".opdx", ".nc", ".h5", ".sxm", ".topostats", ".jpk",
-                         ".jpk-qi-image", ".sflz", ".h5-jpk")
+                         ".jpk-qi-image", ".sflz", ".h5-jpk", ".zon")
 
 
 CHANNEL_COLOURS = ("green", "magenta", "cyan", "yellow", "red", "blue", "gray")
