@@ -11,6 +11,7 @@ import csv
 import gzip
 import io
 import json
+import os
 import pathlib
 import warnings
 import zipfile
@@ -209,6 +210,34 @@ def test_data_source_names_surface_topography_s_channel(tmp_path):
     print(f"data_source: {read} channels read as SurfaceTopography reads them ({by_place} "
           f"also as channel=k), {refused} refused as not height maps")
     assert read >= 10 and by_place >= 6, (read, by_place)
+
+
+def test_a_container_downloaded_from_contact_engineering_reads_as_read_container(tmp_path):
+    """SurfaceTopography's own `container-2.zip` (its test/file_format_examples, CC-BY-4.0
+    data, 1.1 MB: not committed; run when CONTACTSCOPE_ST_EXAMPLES names that folder): a
+    download of topobank 0.13 (`meta.yml` with `!!python/tuple` sizes), a Bruker AFM map with
+    `height_scale` 0.112 and `detrend_mode: height` read with SurfaceTopography's grid, size and
+    heights; its two line scans refused as line scans, naming the measurement's file."""
+    folder = os.environ.get("CONTACTSCOPE_ST_EXAMPLES")
+    if not folder:
+        pytest.skip("set CONTACTSCOPE_ST_EXAMPLES to SurfaceTopography's test/file_format_examples")
+    container = pathlib.Path(folder) / "container-2.zip"
+    theirs = list(quiet(read_container, str(container))[0])
+    maps = 0
+    for k, t in enumerate(theirs):
+        original = t.info["datafile"]["original"]
+        if t.dim == 1:
+            with pytest.raises(cs.InputError, match="line scan") as e:
+                cs.read_topography(container, detrend="none", measurement=str(k))
+            assert original in str(e.value)
+            continue
+        raw = tmp_path / original
+        with zipfile.ZipFile(container) as z:
+            raw.write_bytes(z.read(original))
+        ours = cs.read_topography(container, detrend="none", measurement=str(k))
+        assert_same_topography(ours, t, orientation_of(raw), original)
+        maps += 1
+    assert maps == 1 and len(theirs) == 3
 
 
 def test_the_median_detrend_is_surface_topography_s(tmp_path):
