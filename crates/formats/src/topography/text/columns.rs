@@ -75,6 +75,15 @@ pub(crate) fn xyz_grid(path: &Path, rows: &[[f64; 3]]) -> Result<Grid> {
     if nx_distinct < 2 || ny_distinct < 2 {
         return Err(line_scan(path, rows.len(), None));
     }
+    // A profile with a column of flags beside it (x, height, valid 1/0: a stylus's HFM
+    // export): x runs one way through the file, every x once, and the third column holds at
+    // most two values (1 and 0, in whatever unit the column was read). No spacing is said: a
+    // units line such a file may have (`[mm];[mm];[1/0]`) is skipped with the titles.
+    let one_way = xs.windows(2).all(|w| w[1] > w[0]) || xs.windows(2).all(|w| w[1] < w[0]);
+    let third = distinct(&rows.iter().map(|r| r[2]).collect::<Vec<f64>>());
+    if one_way && third.len() <= 2 {
+        return Err(line_scan(path, rows.len(), None));
+    }
     let (Some(ax), Some(ay)) = (regular(&xs), regular(&ys)) else {
         return Err(off_grid(format!(
             "{nx_distinct} distinct x and {ny_distinct} distinct y, unevenly spaced"
@@ -164,5 +173,32 @@ mod tests {
         let line = [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [2.0, 0.0, 1.0]];
         let err = xyz_grid(p, &line).unwrap_err().to_string();
         assert!(err.contains("line scan"), "{err}");
+        // x, a height and a validity flag: a profile, not points off a grid.
+        let flagged: Vec<[f64; 3]> = (0..50)
+            .map(|i| {
+                [
+                    1e-3 * f64::from(i),
+                    0.1 * f64::from(i % 7),
+                    f64::from(u8::from(i != 9)),
+                ]
+            })
+            .collect();
+        let err = xyz_grid(p, &flagged).unwrap_err().to_string();
+        assert!(
+            err.contains("line scan (one profile of 50 points)"),
+            "{err}"
+        );
+        // Scattered points with heights of their own stay points off a grid.
+        let scattered: Vec<[f64; 3]> = (0..50)
+            .map(|i| {
+                [
+                    1e-3 * f64::from(i),
+                    0.1 * f64::from(i % 7),
+                    0.5 * f64::from(i % 3),
+                ]
+            })
+            .collect();
+        let err = xyz_grid(p, &scattered).unwrap_err().to_string();
+        assert!(err.contains("not on a regular grid"), "{err}");
     }
 }
