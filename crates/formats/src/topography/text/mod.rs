@@ -80,11 +80,34 @@ fn numbers(line: &str) -> Option<Vec<f64>> {
     tokens.iter().map(|t| t.parse::<f64>().ok()).collect()
 }
 
-/// The parsed file: what its header states, its numbers row by row, and the row length.
+/// The parsed file: what its header states, its numbers row by row, the row length, and the
+/// columns' units where a title line gives them ([`column_units`]).
 struct Parsed {
     stated: Stated,
     rows: Vec<Vec<f64>>,
     columns: usize,
+    units: Option<Vec<Option<f64>>>,
+}
+
+/// A title line of bracketed units, one per column (`[mm];[mm];[µm]`, as profilometer exports
+/// write under the column names): metres per unit of each column, `None` for a column that is
+/// not a length (`[1/0]`); `None` for any other line.
+fn column_units(line: &str) -> Option<Vec<Option<f64>>> {
+    let tokens: Vec<&str> = line
+        .split([';', ',', '\t', ' '])
+        .map(str::trim)
+        .filter(|t| !t.is_empty())
+        .collect();
+    if tokens.is_empty() {
+        return None;
+    }
+    tokens
+        .iter()
+        .map(|t| {
+            let unit = t.strip_prefix('[')?.strip_suffix(']')?;
+            Some(super::length_factor(unit))
+        })
+        .collect()
 }
 
 fn parse(path: &Path, text: &str) -> Result<Parsed> {
@@ -93,6 +116,7 @@ fn parse(path: &Path, text: &str) -> Result<Parsed> {
     let mut rows: Vec<Vec<f64>> = Vec::new();
     let mut titles = 0;
     let mut columns = 0;
+    let mut units = None;
     for (index, line) in text.lines().enumerate() {
         let number = index + 1;
         let trimmed = line.trim();
@@ -126,7 +150,12 @@ fn parse(path: &Path, text: &str) -> Result<Parsed> {
                 }
                 rows.push(values);
             }
-            _ if rows.is_empty() && titles < MAX_TITLE_LINES => titles += 1,
+            _ if rows.is_empty() && titles < MAX_TITLE_LINES => {
+                titles += 1;
+                if let Some(found) = column_units(content) {
+                    units = Some(found);
+                }
+            }
             _ => {
                 let token = content
                     .split([';', ',', ' ', '\t'])
@@ -148,6 +177,7 @@ fn parse(path: &Path, text: &str) -> Result<Parsed> {
         stated,
         rows,
         columns,
+        units,
     })
 }
 
@@ -163,6 +193,7 @@ pub(crate) fn read_str(
         stated,
         rows,
         columns,
+        units,
     } = parse(path, text)?;
     let unit = match (stated.unit_m, options.height_unit_m) {
         (Some(_), Some(_)) => {
@@ -182,9 +213,29 @@ pub(crate) fn read_str(
     let index = choose(path, &channels, options.channel.as_deref())?;
     let convert = super::to_metres(unit);
     if !stated.any() && columns == 3 && rows.len() > 3 {
+        // Units under the column titles: x and y in theirs, z in its own when a length (then
+        // no other may be given), else as the unit above says.
+        let (to_x, to_y, to_z): (Box<dyn Fn(f64) -> f64>, Box<dyn Fn(f64) -> f64>, _) =
+            match units.as_deref() {
+                Some(&[Some(ux), Some(uy), uz]) => {
+                    if uz.is_some() && options.height_unit_m.is_some() {
+                        return Err(bad(
+                            path,
+                            "the file states its columns' units ([…] under the titles); do \
+                             not give a height unit",
+                        ));
+                    }
+                    let z: Box<dyn Fn(f64) -> f64> = match uz {
+                        Some(uz) => Box::new(move |v| v * uz),
+                        None => Box::new(&convert),
+                    };
+                    (Box::new(move |v| v * ux), Box::new(move |v| v * uy), z)
+                }
+                _ => (Box::new(&convert), Box::new(&convert), Box::new(&convert)),
+            };
         let points: Vec<[f64; 3]> = rows
             .iter()
-            .map(|r| [convert(r[0]), convert(r[1]), convert(r[2])])
+            .map(|r| [to_x(r[0]), to_y(r[1]), to_z(r[2])])
             .collect();
         let (heights, shape, spacing) = columns::xyz_grid(path, &points)?;
         let mut map = height_map(
@@ -243,6 +294,42 @@ mod tests {
 
     fn read(text: &str, options: &ReadOptions) -> Result<HeightMap> {
         read_str(Path::new("m.txt"), text, options, TopographyFormat::Text)
+    }
+
+    #[test]
+    fn units_under_the_column_titles_scale_x_y_and_z() {
+        assert_eq!(
+            column_units("[mm];[mm];[1/0]"),
+            Some(vec![Some(1e-3), Some(1e-3), None])
+        );
+        assert_eq!(column_units("X;Y;Z"), None);
+        assert_eq!(column_units("[um] height"), None);
+        let mut text = String::from("X;Y;Z\n[mm];[mm];[um]\n");
+        for y in 0..3 {
+            for x in 0..4 {
+                text.push_str(&format!(
+                    "{};{};{}\n",
+                    0.01 * f64::from(x),
+                    0.02 * f64::from(y),
+                    x + y
+                ));
+            }
+        }
+        let m = read(&text, &ReadOptions::default()).unwrap();
+        assert_eq!((m.nx(), m.ny()), (4, 3));
+        assert!((m.dx_m - 1e-5).abs() < 1e-15 && (m.dy_m - 2e-5).abs() < 1e-15);
+        assert!((m.heights[(2, 3)] - 5e-6).abs() < 1e-18);
+        let given = ReadOptions {
+            height_unit_m: Some(1e-9),
+            ..ReadOptions::default()
+        };
+        let err = read(&text, &given).unwrap_err().to_string();
+        assert!(err.contains("states its columns' units"), "{err}");
+        // A z column that is not a length takes the height unit given.
+        let flagless = text.replace("[um]", "[a.u.]");
+        let m = read(&flagless, &given).unwrap();
+        assert!((m.dx_m - 1e-5).abs() < 1e-15);
+        assert!((m.heights[(2, 3)] - 5e-9).abs() < 1e-21);
     }
 
     fn sized() -> ReadOptions {
