@@ -215,24 +215,24 @@ pub(crate) fn read_str(
     if !stated.any() && columns == 3 && rows.len() > 3 {
         // Units under the column titles: x and y in theirs, z in its own when a length (then
         // no other may be given), else as the unit above says.
-        let (to_x, to_y, to_z): (Box<dyn Fn(f64) -> f64>, Box<dyn Fn(f64) -> f64>, _) =
-            match units.as_deref() {
-                Some(&[Some(ux), Some(uy), uz]) => {
-                    if uz.is_some() && options.height_unit_m.is_some() {
-                        return Err(bad(
-                            path,
-                            "the file states its columns' units ([…] under the titles); do \
-                             not give a height unit",
-                        ));
-                    }
-                    let z: Box<dyn Fn(f64) -> f64> = match uz {
-                        Some(uz) => Box::new(move |v| v * uz),
-                        None => Box::new(&convert),
-                    };
-                    (Box::new(move |v| v * ux), Box::new(move |v| v * uy), z)
+        let (ux, uy, uz) = match units.as_deref() {
+            Some(&[Some(ux), Some(uy), uz]) => {
+                if uz.is_some() && options.height_unit_m.is_some() {
+                    return Err(bad(
+                        path,
+                        "the file states its columns' units ([…] under the titles); do not \
+                         give a height unit",
+                    ));
                 }
-                _ => (Box::new(&convert), Box::new(&convert), Box::new(&convert)),
-            };
+                (ux, uy, uz.unwrap_or(unit))
+            }
+            _ => (unit, unit, unit),
+        };
+        let (to_x, to_y, to_z) = (
+            super::to_metres(ux),
+            super::to_metres(uy),
+            super::to_metres(uz),
+        );
         let points: Vec<[f64; 3]> = rows
             .iter()
             .map(|r| [to_x(r[0]), to_y(r[1]), to_z(r[2])])
