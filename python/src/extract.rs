@@ -118,6 +118,9 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ChannelArg {
 /// channels (an int ≥ 0), passed on as the text the readers take (`--channel`).
 pub(crate) struct HeightChannel(pub(crate) String);
 
+/// What a height map's `channel=` takes, as its errors say.
+const EXPECTED: &str = "a channel's name (a str), its index (an int ≥ 0) or None";
+
 impl<'a, 'py> FromPyObject<'a, 'py> for HeightChannel {
     type Error = PyErr;
 
@@ -127,12 +130,11 @@ impl<'a, 'py> FromPyObject<'a, 'py> for HeightChannel {
         }
         match index(&obj, "channel=") {
             Ok(Some(i)) => Ok(HeightChannel(i.to_string())),
-            Ok(None) => Err(wrong_type("channel=", "a name (a str) or an index", &obj)),
-            Err(e) if e.is_instance_of::<PyTypeError>(obj.py()) => Err(wrong_type(
-                "channel=",
-                "a channel's name (a str), its index (an int ≥ 0) or None",
-                &obj,
-            )),
+            // `None` never reaches here (pyo3 maps it to an absent channel).
+            Ok(None) => Err(wrong_type("channel=", EXPECTED, &obj)),
+            Err(e) if e.is_instance_of::<PyTypeError>(obj.py()) => {
+                Err(wrong_type("channel=", EXPECTED, &obj))
+            }
             Err(e) => Err(e),
         }
     }

@@ -412,31 +412,25 @@ pub(crate) fn choose(
             let exact = channels
                 .iter()
                 .position(|c| c.name.to_lowercase() == want_l);
-            if let (None, Ok(k)) = (exact, want.trim().parse::<usize>()) {
-                return if k < channels.len() {
-                    Ok(k)
-                } else {
-                    Err(bad(
-                        path,
-                        format!(
-                            "no channel {k} (channels count from 0); the file has {} channel(s): {}",
-                            channels.len(),
-                            list()
-                        ),
-                    ))
-                };
-            }
+            let place = want.trim().parse::<usize>().ok();
             exact
+                .or_else(|| place.filter(|&k| k < channels.len()))
                 .or_else(|| {
                     channels
                         .iter()
                         .position(|c| c.name.to_lowercase().contains(&want_l))
                 })
                 .ok_or_else(|| {
-                    bad(
-                        path,
-                        format!("no channel '{want}'; the file has {}", list()),
-                    )
+                    let reason = match place {
+                        Some(k) => format!(
+                            "no channel {k} (channels count from 0); the file has {} \
+                             channel(s): {}",
+                            channels.len(),
+                            list()
+                        ),
+                        None => format!("no channel '{want}'; the file has {}", list()),
+                    };
+                    bad(path, reason)
                 })
         }
         // A file of one channel holds nothing else to choose: its channel is read whatever its
@@ -636,13 +630,16 @@ mod tests {
         let only = entries(&[("Deflection", true), ("Phase", false)]);
         assert!(choose(p, &only, None).is_err());
         // By position: after an exact name (a channel named "1" is that channel), before a
-        // name containing the digits; beyond the list an error that counts them.
+        // name containing the digits (which a number beyond the list still finds); else an
+        // error that counts them.
         assert_eq!(choose(p, &c, Some("2")).unwrap(), 2);
         assert_eq!(choose(p, &c, Some(" 0 ")).unwrap(), 0);
         let numbered = entries(&[("Height 2", true), ("Phase", false), ("0", true)]);
         assert_eq!(choose(p, &numbered, Some("0")).unwrap(), 2);
         assert_eq!(choose(p, &numbered, Some("2")).unwrap(), 2);
         assert_eq!(choose(p, &numbered, Some("1")).unwrap(), 1);
+        let seventh = entries(&[("Height 7", true), ("Phase", false)]);
+        assert_eq!(choose(p, &seventh, Some("7")).unwrap(), 0);
         let err = choose(p, &c, Some("3")).unwrap_err().to_string();
         assert!(
             err.contains("no channel 3 (channels count from 0)") && err.contains("3 channel(s)"),

@@ -213,10 +213,10 @@ pub(crate) fn read_str(
     let index = choose(path, &channels, options.channel.as_deref())?;
     let convert = super::to_metres(unit);
     if !stated.any() && columns == 3 && rows.len() > 3 {
-        // Units under the column titles: x and y in theirs, z in its own when a length (then
-        // no other may be given), else as the unit above says.
+        // Units under the column titles: each column in its own where it is a length (a
+        // height unit may then not be given for z), else as the unit above says.
         let (ux, uy, uz) = match units.as_deref() {
-            Some(&[Some(ux), Some(uy), uz]) => {
+            Some(&[ux, uy, uz]) => {
                 if uz.is_some() && options.height_unit_m.is_some() {
                     return Err(bad(
                         path,
@@ -224,7 +224,7 @@ pub(crate) fn read_str(
                          give a height unit",
                     ));
                 }
-                (ux, uy, uz.unwrap_or(unit))
+                (ux.unwrap_or(unit), uy.unwrap_or(unit), uz.unwrap_or(unit))
             }
             _ => (unit, unit, unit),
         };
@@ -330,6 +330,10 @@ mod tests {
         let m = read(&flagless, &given).unwrap();
         assert!((m.dx_m - 1e-5).abs() < 1e-15);
         assert!((m.heights[(2, 3)] - 5e-9).abs() < 1e-21);
+        // x and y in pixels: z keeps its stated unit.
+        let pixels = text.replace("[mm];[mm]", "[px];[px]");
+        let m = read(&pixels, &ReadOptions::default()).unwrap();
+        assert!((m.heights[(2, 3)] - 5e-6).abs() < 1e-18);
     }
 
     fn sized() -> ReadOptions {
