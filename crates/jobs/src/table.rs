@@ -295,7 +295,9 @@ pub(crate) fn csv_text(
 /// value to the same decimal place (`0.8712 ± 0.00043` → `0.87120 ± 0.00043`, `153.6 ± 12.3` →
 /// `154 ± 12`, `15360 ± 1234` → `15400 ± 1200`); far from 1 (a value or uncertainty past
 /// 10⁹ or below 10⁻⁸) in scientific notation (`1.500e-12 ± 3.0e-14`). An uncertainty that is
-/// zero or not finite cannot set the digits: the value keeps four significant digits then.
+/// zero or not finite cannot set the digits: the value keeps four significant digits then; one
+/// below the value's eighth significant digit neither: the value keeps eight
+/// (`3.6999999999999966 ± 1.7e-16` → `3.7000000 ± 1.7e-16`).
 pub fn value_pm(value: f64, se: f64) -> String {
     if !value.is_finite() {
         return format!("{value} ± {se}");
@@ -309,6 +311,16 @@ pub fn value_pm(value: f64, se: f64) -> String {
     let se = round_at(se, last);
     let last = exponent(se) - 1;
     let magnitude = exponent(value.abs().max(se));
+    if magnitude - last >= MAX_DIGITS {
+        // An uncertainty below the value's eighth digit (an exact fit, rounding noise) does
+        // not set the digits: the value to eight significant digits.
+        let value = if (-8..9).contains(&magnitude) {
+            significant(value, MAX_DIGITS)
+        } else {
+            format!("{value:.*e}", (MAX_DIGITS - 1) as usize)
+        };
+        return format!("{value} ± {se:.1e}");
+    }
     if !(-8..9).contains(&magnitude) || !(-9..9).contains(&last) {
         let digits = (exponent(value.abs().max(se)) - last).max(1) as usize;
         return format!("{value:.digits$e} ± {se:.1e}");
@@ -318,6 +330,9 @@ pub fn value_pm(value: f64, se: f64) -> String {
     let value = round_at(value, last) + 0.0;
     format!("{value:.decimals$} ± {se:.decimals$}")
 }
+
+/// The most significant digits [`value_pm`] writes of a value.
+const MAX_DIGITS: i32 = 8;
 
 /// [`value_pm`] when there is an uncertainty, else the value alone to `decimals` places.
 pub fn value_pm_or(value: f64, se: Option<f64>, decimals: usize) -> String {
@@ -402,6 +417,11 @@ mod tests {
         assert_eq!(value_pm(2.5e10, 1.2e8), "2.500e10 ± 1.2e8");
         // No usable uncertainty: four significant digits and the uncertainty as it is.
         assert_eq!(value_pm(0.87123, 0.0), "0.8712 ± 0");
+        assert_eq!(value_pm(3.6999999999999966, 1.7e-16), "3.7000000 ± 1.7e-16");
+        assert_eq!(value_pm(-123.456789012, 1e-9), "-123.45679 ± 1.0e-9");
+        assert_eq!(value_pm(1.5e-12, 1e-30), "1.5000000e-12 ± 1.0e-30");
+        assert_eq!(value_pm(1.23456789, 1.2e-7), "1.2345679 ± 1.2e-7");
+        assert_eq!(value_pm(1.23456789, 1.2e-6), "1.2345679 ± 0.0000012");
         assert_eq!(value_pm(153.64, f64::NAN), "153.6 ± NaN");
         assert_eq!(value_pm(f64::INFINITY, 1.0), "inf ± 1");
         assert_eq!(value_pm_or(0.87123, None, 3), "0.871");
