@@ -118,25 +118,50 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ChannelArg {
 /// channels (an int ≥ 0), passed on as the text the readers take (`--channel`).
 pub(crate) struct HeightChannel(pub(crate) String);
 
-/// What a height map's `channel=` takes, as its errors say.
-const EXPECTED: &str = "a channel's name (a str), its index (an int ≥ 0) or None";
-
 impl<'a, 'py> FromPyObject<'a, 'py> for HeightChannel {
     type Error = PyErr;
 
     fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        if let Ok(s) = obj.cast::<PyString>() {
-            return Ok(HeightChannel(s.to_string()));
+        name_or_index(
+            obj,
+            "channel=",
+            "a channel's name (a str), its index (an int ≥ 0) or None",
+        )
+        .map(HeightChannel)
+    }
+}
+
+/// `measurement=` of a surface container: a measurement's name (a `str`) or its index in the
+/// container (an int ≥ 0), passed on as the text the reader takes (`--measurement`).
+pub(crate) struct Measurement(pub(crate) String);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Measurement {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        name_or_index(
+            obj,
+            "measurement=",
+            "a measurement's name (a str), its index (an int ≥ 0) or None",
+        )
+        .map(Measurement)
+    }
+}
+
+/// A name (a `str`, as given) or an index (an int ≥ 0, as its digits); a message naming
+/// `keyword` and what it takes (`expected`) otherwise.
+fn name_or_index(obj: Borrowed<'_, '_, PyAny>, keyword: &str, expected: &str) -> PyResult<String> {
+    if let Ok(s) = obj.cast::<PyString>() {
+        return Ok(s.to_string());
+    }
+    match index(&obj, keyword) {
+        Ok(Some(i)) => Ok(i.to_string()),
+        // `None` never reaches here (pyo3 maps it to an absent argument).
+        Ok(None) => Err(wrong_type(keyword, expected, &obj)),
+        Err(e) if e.is_instance_of::<PyTypeError>(obj.py()) => {
+            Err(wrong_type(keyword, expected, &obj))
         }
-        match index(&obj, "channel=") {
-            Ok(Some(i)) => Ok(HeightChannel(i.to_string())),
-            // `None` never reaches here (pyo3 maps it to an absent channel).
-            Ok(None) => Err(wrong_type("channel=", EXPECTED, &obj)),
-            Err(e) if e.is_instance_of::<PyTypeError>(obj.py()) => {
-                Err(wrong_type("channel=", EXPECTED, &obj))
-            }
-            Err(e) => Err(e),
-        }
+        Err(e) => Err(e),
     }
 }
 

@@ -16,7 +16,7 @@ use contactscope_jobs::surface::SurfaceRequest;
 use contactscope_jobs::topography::TopographyRequest;
 
 use crate::convert::outcome_dict;
-use crate::extract::HeightChannel;
+use crate::extract::{HeightChannel, Measurement};
 use crate::heights::{detrend_of, fill_of};
 use crate::{bad, compute, PixelArg};
 
@@ -35,11 +35,11 @@ fn read_topography<'py>(
     detrend: &str,
     channel: Option<HeightChannel>,
     fill_invalid: Option<&str>,
-    measurement: Option<String>,
+    measurement: Option<Measurement>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = TopographyRequest {
         source: TopographySource {
-            measurement,
+            measurement: measurement.map(|m| m.0),
             pixel_size_m: crate::pixel_opt(pixel_size)?,
             height_unit_m: height_unit,
             detrend: detrend_of(detrend)?,

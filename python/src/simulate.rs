@@ -15,7 +15,7 @@ use contactscope_jobs::simulate::{
 };
 
 use crate::convert::outcome_dict;
-use crate::extract::HeightChannel;
+use crate::extract::{HeightChannel, Measurement};
 use crate::heights::{height_input, HeightsArg};
 use crate::{bad, compute, PixelArg};
 
@@ -164,6 +164,11 @@ impl LoadObserver for KeepMaps {
 /// docstring. Returns the outcome (SI) and the stacks (loads, ny, nx) `maps` asks for.
 #[pyfunction]
 #[pyo3(signature = (heights, pixel_size, modulus, loads, model="elastic", hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=false, tolerance=None, max_iterations=None, maps=MapsArg::Name("all".into()), detrend="plane", height_unit=None, channel=None, fill_invalid=None, device="cpu", measurement=None, contact_engineering=None))]
+// The signature as Python's `help` and `inspect` show it: `maps`' default is a Rust value, which
+// PyO3 would print as `...`.
+#[pyo3(
+    text_signature = "(heights, pixel_size, modulus, loads, model='elastic', hardness=None, k=None, initial_hardness=None, alpha=None, radius=None, periodic=False, tolerance=None, max_iterations=None, maps='all', detrend='plane', height_unit=None, channel=None, fill_invalid=None, device='cpu', measurement=None, contact_engineering=None)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -186,7 +191,7 @@ fn simulate<'py>(
     channel: Option<HeightChannel>,
     fill_invalid: Option<&str>,
     device: &str,
-    measurement: Option<String>,
+    measurement: Option<Measurement>,
     contact_engineering: Option<std::path::PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let device = crate::convert::device_of(device)?;
@@ -197,7 +202,7 @@ fn simulate<'py>(
         height_unit,
         channel.map(|c| c.0),
         fill_invalid,
-        measurement,
+        measurement.map(|m| m.0),
     )?;
     let model = model_of(model, hardness, k, initial_hardness, alpha)?;
     let maps = maps_of(maps)?;

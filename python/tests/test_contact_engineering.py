@@ -464,6 +464,13 @@ def test_container_choices_and_refusals(cli, tmp_path):
         cs.read_topography(container)
     with pytest.raises(cs.InputError, match="no measurement 5"):
         cs.read_topography(container, measurement="5")
+    # An index as an int chooses as its digits do; other types are refused naming the keyword.
+    np.testing.assert_array_equal(cs.read_topography(container, measurement=1)["heights"],
+                                  cs.read_topography(container, measurement="1")["heights"])
+    with pytest.raises(cs.InputError, match="no measurement 5"):
+        cs.read_topography(container, measurement=np.int64(5))
+    with pytest.raises(TypeError, match="measurement=.*index"):
+        cs.read_topography(container, measurement=1.0)
     with pytest.raises(cs.InputError, match="not a contact.engineering surface container"):
         cs.read_topography(afm("mi-1.mi"), measurement="0")
     whole = json.loads(cli("topography", container, "--detrend", "none", "--json"))

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import os
 import warnings as _warnings
-from typing import Any, Dict, Iterable, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Dict, Iterable, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -38,6 +38,9 @@ from ._contactscope import (  # noqa: F401  (re-exported)
     get_num_threads,
     set_num_threads,
 )
+
+if TYPE_CHECKING:
+    from ._contactscope import SeriesSpec
 
 __version__ = _cs.__version__
 #: The git commit this build came from (``None`` when built outside a checkout, e.g. from the sdist).
@@ -120,7 +123,7 @@ class Results(dict):
         return pd.DataFrame(list(self.rows))
 
 
-def _warn(result: Dict[str, Any]) -> None:
+def _warn(result: Mapping[str, Any]) -> None:
     """Each of the job's warnings as a :class:`ContactscopeWarning` (they stay on the result)."""
     for text in result.get("warnings") or ():
         _warnings.warn(text, ContactscopeWarning, stacklevel=3)
@@ -133,7 +136,7 @@ class Series(Results):
     ``pixel_size_source`` and ``warnings``. :func:`analyze` and :func:`otsu_threshold` given a
     Series read its files as the command line does (same thresholds, areas and file names)."""
 
-    def __init__(self, *args: Any, spec: Optional[Dict[str, Any]] = None,
+    def __init__(self, *args: Any, spec: Optional[SeriesSpec] = None,
                  pixel_size: Optional[PixelSize] = None, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self._spec = spec
@@ -503,9 +506,9 @@ def compare(micrographs: Any, forces: Optional[Sequence[float]], pixel_size: Opt
 
 def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
                     height_unit: Optional[float] = None, detrend: str = "plane", *,
-                    channel: Optional[str] = None,
+                    channel: Union[int, str, None] = None,
                     fill_invalid: Optional[str] = None,
-                    measurement: Optional[str] = None) -> Results:
+                    measurement: Union[int, str, None] = None) -> Results:
     """A height map from any format contactscope reads (npy, TIFF, GSF, text matrices with or
     without a Gwyddion or h=/w= header, x y z grids, gzip text, WSxM, Nanoscope, Nanonis sxm, TopoStats, JPK TIFF and HDF5, Igor ibw,
     Nanosurf nid, PicoView mi, Park TIFF, Gwyddion, X3P, SDF, Wyko opd, Sensofar plu, Digital
@@ -519,8 +522,8 @@ def read_topography(path: PathLike, pixel_size: Optional[PixelSize] = None,
     ``fill_invalid`` is "mean", "nearest" or "harmonic"; ``notes`` then says how many points
     were filled. A contact.engineering surface container (ZIP or folder) is read with its own
     processing (size, unit, height scale, filling, detrending, as SurfaceTopography's
-    ``read_container``); ``measurement`` chooses one by index ("0") or name ("name" or
-    "surface/name"), needed when it holds several.
+    ``read_container``); ``measurement`` chooses one by index (``0`` or "0") or name ("name"
+    or "surface/name"), needed when it holds several.
 
     Returns ``heights`` (rows = y, m; filled as asked, then detrended by ``detrend``: "none",
     "mean" or "plane", the command line's default), ``pixel_size_m`` ((x, y), m), ``notes`` and
@@ -581,9 +584,9 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
              periodic: bool = False, tolerance: Optional[float] = None,
              max_iterations: Optional[int] = None, maps: Union[str, bool] = "all",
              detrend: str = "plane",
-             height_unit: Optional[float] = None, channel: Optional[str] = None,
+             height_unit: Optional[float] = None, channel: Union[int, str, None] = None,
              fill_invalid: Optional[str] = None, device: str = "cpu",
-             measurement: Optional[str] = None,
+             measurement: Union[int, str, None] = None,
              contact_engineering: Optional[PathLike] = None) -> Results:
     """A load ramp on a rough body pressed on a flat of contact modulus E* ``modulus`` (Pa) at
     normal forces ``loads`` (N, in order; the plastic state carries from load to load): the
@@ -611,8 +614,8 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
     ``plastic`` (m); with ``"contact"`` ``contact`` only; with ``"none"`` none (``True`` and
     ``False`` mean ``"all"`` and ``"none"``). The command line's ``--maps`` takes the same choice.
 
-    ``measurement`` chooses the measurement of a contact.engineering surface container (a
-    measurement marked periodic is solved with periodic boundaries). ``contact_engineering``: a
+    ``measurement`` chooses the measurement of a contact.engineering surface container by
+    index or name, as :func:`read_topography` does (a measurement marked periodic is solved with periodic boundaries). ``contact_engineering``: a
     ``.zip`` path to write contact.engineering's contact-mechanics download to (``plot.csv``,
     ``result-step-N.nc``, ``info.txt``; the command line's ``--export contact-engineering``,
     ``docs/outputs.md``), written once every load is solved.
@@ -721,7 +724,7 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
                   max_iterations: Optional[int] = None, imaging_fwhm: Optional[float] = None,
                   imaging_pixel_size: Optional[PixelSize] = None, client: Any = None, *,
                   detrend: str = "plane", periodic: bool = False,
-                  height_unit: Optional[float] = None, channel: Optional[str] = None,
+                  height_unit: Optional[float] = None, channel: Union[int, str, None] = None,
                   fill_invalid: Optional[str] = None, device: str = "cpu",
                   area_intervals: Optional[Any] = None) -> FitResults:
     """Fit contact models to a measured area–load curve: the command line's ``fit-hardening``,
@@ -748,7 +751,7 @@ def fit_hardening(forces: Any, areas: Optional[Sequence[float]], heights: Any,
     if client is not None:
         from . import distributed
 
-        if len(families) != 1 or isinstance(forces, (str, os.PathLike)):
+        if len(families) != 1 or isinstance(forces, (str, os.PathLike)) or areas is None:
             raise InputError("a distributed fit takes one family and forces and areas")
         return distributed.fit_hardening(forces, areas, heights, pixel_size, modulus,
                                          radius=radius, family=families[0], range=range,

@@ -6,11 +6,14 @@ from __future__ import annotations
 
 import numbers
 import os
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Union
 
 import numpy as np
 
 from ._contactscope import InputError
+
+if TYPE_CHECKING:
+    from ._contactscope import SeriesSpec
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -85,7 +88,7 @@ def spec(paths_or_manifest: Union[PathLike, Sequence[PathLike]],
          forces: Optional[Sequence[float]] = None, channel: Union[int, str, None] = None,
          series: Optional[int] = None, z: Optional[int] = None, t: Optional[int] = None,
          axes: Optional[Dict[str, int]] = None,
-         load_axis: Optional[str] = None) -> Dict[str, Any]:
+         load_axis: Optional[str] = None) -> SeriesSpec:
     """The files of a series as the command line takes them: files and folders, or one
     manifest (``.csv``), with the selection flags."""
     if isinstance(paths_or_manifest, (str, os.PathLike)):

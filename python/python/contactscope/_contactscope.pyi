@@ -4,7 +4,7 @@ The public, documented API is the package :mod:`contactscope`, which wraps these
 """
 
 from os import PathLike
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, TypedDict, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, TypedDict, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -203,7 +203,7 @@ class AutocorrResult(TypedDict):
     warnings: List[str]
 
 def autocorrelation(
-    images: List[Union[Path, Stack]],
+    images: Sequence[Union[Path, Stack]],
     pixel_size: Optional[PixelSize] = None,
     max_lag: Optional[float] = None,
     series: Optional[int] = None,
@@ -394,7 +394,7 @@ def read_topography(
     detrend: str = "plane",
     channel: Union[int, str, None] = None,
     fill_invalid: Optional[str] = None,
-    measurement: Optional[str] = None,
+    measurement: Union[int, str, None] = None,
 ) -> TopographyResult: ...
 
 class SurfaceResult(TypedDict):
@@ -481,7 +481,7 @@ def simulate(
     channel: Union[int, str, None] = None,
     fill_invalid: Optional[str] = None,
     device: str = "cpu",
-    measurement: Optional[str] = None,
+    measurement: Union[int, str, None] = None,
     contact_engineering: Optional[Path] = None,
 ) -> SimulateResult: ...
 class RampResult(TypedDict):
@@ -725,6 +725,7 @@ class BatchOutcome(TypedDict):
     images_table: TableColumns
     series_table: TableColumns
 
+@final
 class BatchPlan:
     def run(
         self, progress: Optional[Callable[[str, int, int], None]] = None

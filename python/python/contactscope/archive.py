@@ -111,7 +111,8 @@ class BatchResult:
     written to ``images.parquet`` and ``series.parquet``) and ``outcome`` (counts, failures,
     warnings, the files written). Unpacks as ``images, series = cs.batch(...)``."""
 
-    def __init__(self, outcome: Dict[str, Any]) -> None:
+    def __init__(self, outcome: Mapping[str, Any]) -> None:
+        outcome = dict(outcome)
         self.images = _frame(outcome.pop("images_table"))
         self.series = _frame(outcome.pop("series_table"))
         self.outcome = outcome

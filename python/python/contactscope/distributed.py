@@ -34,11 +34,15 @@ import math
 import os
 import socket
 import sys
-from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple
+from typing import (TYPE_CHECKING, Any, Callable, Dict, Iterator, List, Mapping, Optional,
+                    Sequence, Tuple)
 
 import numpy as np
 
 from . import FitResults, Results, _cs, _f64
+
+if TYPE_CHECKING:
+    from .archive import BatchResult
 
 __all__ = ["local_client", "sweep", "fit_hardening", "batch", "brent_minimum", "thread_plan"]
 
@@ -394,7 +398,7 @@ def sweep(loads: Sequence[float], pixel_size: Any, modulus: float, *,
         futures = [ex.scatter(m, broadcast=True, hash=False) for m in maps]
         for seed in seeds:
             labels.append({"surface": len(futures), "seed": int(seed)})
-            futures.append(ex.submit(_surface_task, dict(surface_spec), int(seed),
+            futures.append(ex.submit(_surface_task, dict(surface_spec or {}), int(seed),
                                      threads.plan(len(seeds)), **_pure(ex)))
         tasks = []
         grid = list(itertools.product(range(len(futures)), values))

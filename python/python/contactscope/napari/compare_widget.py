@@ -15,7 +15,7 @@ side by side, as the paper's Fig. 2 shows its models.
 from __future__ import annotations
 
 import os
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 from qtpy.QtWidgets import (QCheckBox, QComboBox, QDoubleSpinBox, QFileDialog, QFormLayout,
@@ -75,6 +75,11 @@ def command_line(request: SeriesRequest, simulation: str, psf_fwhm_m: float, dih
     return words + ["--out", out]
 
 
+#: What one comparison runs on: the series, the simulation folders, the PSF's FWHM (m) and
+#: whether the dihedral registration is on.
+Arguments = Tuple[SeriesRequest, List[str], float, bool]
+
+
 def export(request: SeriesRequest, simulation: Any, psf_fwhm_m: float, dihedral: bool,
            parent: str) -> List[str]:
     """The command line's ``compare`` folder for each simulation folder, written by its own
@@ -116,7 +121,7 @@ class CompareWidget(QWidget):
         super().__init__()
         self.viewer = napari_viewer
         self.outcome: Optional[Dict[str, Any]] = None
-        self._compared: Optional[tuple] = None  # the arguments of the comparison shown
+        self._compared: Optional[Arguments] = None  # the arguments of the comparison shown
         self._worker = None
 
         self.simulation = QLineEdit()
@@ -202,7 +207,7 @@ class CompareWidget(QWidget):
         """The simulation folders typed or chosen, in order."""
         return [s.strip() for s in self.simulation.text().split(";") if s.strip()]
 
-    def _arguments(self):
+    def _arguments(self) -> Arguments:
         request = self.current_request()
         return (request, self.simulations(), self.fwhm_m(), self.dihedral.isChecked())
 
@@ -239,8 +244,8 @@ class CompareWidget(QWidget):
         self._shown(args, outcome)
         return outcome
 
-    def _shown(self, args: tuple, outcome: Dict[str, Any]) -> None:
-        self.show(outcome)
+    def _shown(self, args: Arguments, outcome: Dict[str, Any]) -> None:
+        self.show_outcome(outcome)
         self._compared = args
         self.export_button.setEnabled(True)
 
@@ -278,7 +283,7 @@ class CompareWidget(QWidget):
         self.status.setText(f"error: {message}")
         notify_error(f"contactscope: {message}")
 
-    def show(self, outcome: Dict[str, Any]) -> None:
+    def show_outcome(self, outcome: Dict[str, Any]) -> None:
         """The registered pairs as layers (the micrographs, then each model's imaged map) and
         the scores in the table."""
         self.outcome = outcome

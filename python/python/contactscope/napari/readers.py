@@ -25,7 +25,7 @@ from __future__ import annotations
 import itertools
 import os
 import warnings
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -34,7 +34,9 @@ import contactscope as cs
 from ._common import ERRORS, META, guarded, layer_meta, notify_error, one_line, stem, um
 
 LayerData = Tuple[Any, Dict[str, Any], str]
-PathOrPaths = Union[str, Sequence[str]]
+# What napari hands a reader: one path, or a list of them.
+PathOrPaths = Union[str, List[str], Tuple[str, ...]]
+Reader = Callable[[PathOrPaths], Optional[List[LayerData]]]
 
 # `.ome`: an OME-TIFF set's companion file (`NAME.companion.ome`), which opens the set.
 MICROGRAPH_EXTENSIONS = (".tif", ".tiff", ".czi", ".nd2", ".lif", ".zarr", ".ome")
@@ -65,7 +67,7 @@ def _micrographs_in(folder: str) -> List[str]:
             and (_ext(n) != ".zarr" or _is_zarr_store(os.path.join(folder, n)))]
 
 
-def get_micrograph_reader(path: PathOrPaths) -> Optional[Callable[[PathOrPaths], List[LayerData]]]:
+def get_micrograph_reader(path: PathOrPaths) -> Optional[Reader]:
     """The reader of a micrograph file, a folder of micrographs or a list of micrograph files;
     ``None`` (napari's "no reader") for anything else or a file contactscope cannot open."""
     if isinstance(path, (list, tuple)):
@@ -89,7 +91,7 @@ def get_micrograph_reader(path: PathOrPaths) -> Optional[Callable[[PathOrPaths],
     return read_micrographs
 
 
-def get_topography_reader(path: PathOrPaths) -> Optional[Callable[[PathOrPaths], List[LayerData]]]:
+def get_topography_reader(path: PathOrPaths) -> Optional[Reader]:
     """The reader of an AFM or profilometer height map; ``None`` for anything else."""
     if isinstance(path, (list, tuple)):
         return None
@@ -147,11 +149,13 @@ def _planes_of_channel(path: str, fmt: str, series: int, channel: int,
     stacks = []
     for combo in itertools.product(range(nz), *[range(n) for n in extras.values()]):
         z, rest = combo[0], dict(zip(extras, combo[1:]))
-        select = dict(series=series, channel=channel, z=z, axes=rest or None)
+        axes = rest or None
         if nt > 1:
-            stacks.append(cs.read_image(path, load_axis="t", **select).images)
+            image = cs.read_image(path, series=series, channel=channel, z=z, axes=axes,
+                                  load_axis="t")
         else:
-            stacks.append(cs.read_image(path, t=0, **select).images)
+            image = cs.read_image(path, series=series, channel=channel, z=z, axes=axes, t=0)
+        stacks.append(image.images)
     data = np.stack(stacks, axis=1)  # (T, Z × extras, Y, X)
     return data.reshape(nt, nz, *extras.values(), *shape)
 

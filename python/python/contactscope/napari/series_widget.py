@@ -345,7 +345,7 @@ class LoadSeriesWidget(QWidget):
                     chosen["series"] = int(meta["series"])
                 return SeriesRequest(inputs=list(inputs), forces_text=text, forces_n=forces,
                                      channel=channel, load_axis=load_axis, label=name,
-                                     **chosen)
+                                     series=chosen["series"], z=chosen["z"], t=chosen["t"])
             data = np.asarray(layer.data)
             if data.ndim != 3:
                 raise cs.InputError(f"layer '{name}' has {data.ndim} dimensions; a load series "
@@ -379,7 +379,7 @@ class LoadSeriesWidget(QWidget):
         self.run_button.setEnabled(False)
         self.status.setText("reading and thresholding…")
         # Errors go to _fail (one line), never re-raised from the thread as a traceback.
-        connect = {"returned": lambda outcome: self.show(request, outcome),
+        connect = {"returned": lambda outcome: self.show_outcome(request, outcome),
                    "errored": self._fail, "finished": lambda: self.run_button.setEnabled(True)}
         worker = create_worker(analyze, request, progress=self._report, _start_thread=False,
                                _connect=connect)
@@ -391,7 +391,7 @@ class LoadSeriesWidget(QWidget):
         """The same analysis in this thread (scripts and tests): the outcome, shown."""
         request = self.current_request()
         outcome = analyze(request, progress=self._report)
-        self.show(request, outcome)
+        self.show_outcome(request, outcome)
         return outcome
 
     def _fail(self, error: BaseException) -> None:
@@ -401,7 +401,7 @@ class LoadSeriesWidget(QWidget):
 
     # Results ---------------------------------------------------------------------------------
 
-    def show(self, request: SeriesRequest, outcome: Dict[str, Any]) -> None:
+    def show_outcome(self, request: SeriesRequest, outcome: Dict[str, Any]) -> None:
         """The outcome as layers, the table and the plot."""
         self.request, self.outcome = request, outcome
         result = outcome["result"]
@@ -584,10 +584,12 @@ def files_request(paths: str, forces: str, load_axis: str, selection: Dict[str, 
     if not inputs:
         raise cs.InputError(missing)
     forces = forces.strip()
+    plane = selected(selection)
     return SeriesRequest(inputs=inputs, forces_text=forces,
                          forces_n=cs.parse_forces(forces) if forces else None,
                          load_axis=None if load_axis == LOAD_AXES[0] else load_axis,
-                         label=stem(inputs[0]), **selected(selection))
+                         label=stem(inputs[0]), channel=plane["channel"],
+                         series=plane["series"], z=plane["z"], t=plane["t"])
 
 
 def choose_micrographs(parent: Any, field: Any) -> bool:
