@@ -39,7 +39,7 @@ mod support;
 use std::path::{Path, PathBuf};
 
 use contactscope::analysis::bootstrap::joint_fit_intervals;
-use contactscope::analysis::corrected::{correct_series, Assumptions};
+use contactscope::analysis::corrected::{correct_series, Assumptions, SignalSource};
 use contactscope::analysis::fit::fit_power_law;
 use contactscope::analysis::{analyze, AnalysisOptions};
 use contactscope::image::{PixelSize, PixelSizeSource, Plane};
@@ -79,6 +79,12 @@ struct Tally {
     beta_widths: Vec<f64>,
     estimate_outside: usize,
     pixel_beta_outside: usize,
+    /// Images whose signal rests on the bounds alone (no interior in the series), and how many
+    /// of their intervals held the truth.
+    bounds_images: usize,
+    bounds_covered: usize,
+    /// Series with corrected areas but without any interior.
+    bounds_series: usize,
 }
 
 impl Tally {
@@ -96,6 +102,9 @@ impl Tally {
         self.beta_widths.extend(other.beta_widths);
         self.estimate_outside += other.estimate_outside;
         self.pixel_beta_outside += other.pixel_beta_outside;
+        self.bounds_images += other.bounds_images;
+        self.bounds_covered += other.bounds_covered;
+        self.bounds_series += other.bounds_series;
     }
 
     fn coverage(&self, r: usize) -> f64 {
@@ -163,12 +172,19 @@ fn score(s: &Series, sigma_px: f64, pixel_m: f64, label: &str) -> Tally {
                     );
                 }
                 t.covered[r] += usize::from(held);
+                if c.source == SignalSource::Bounds {
+                    t.bounds_images += 1;
+                    t.bounds_covered += usize::from(held);
+                }
                 t.widths[r].push((c.hi_px - c.lo_px) / truth);
                 t.corrected_err[r].push(c.area_px / truth - 1.0);
             }
             None => t.widths[r].push(f64::INFINITY),
         }
     }
+    let read: Vec<_> = correction.areas.iter().flatten().collect();
+    t.bounds_series =
+        usize::from(!read.is_empty() && read.iter().all(|c| c.source == SignalSource::Bounds));
     let true_beta = fit_power_law(&s.forces_n, &s.truth_px).map(|f| f.exponent);
     if let (Some(true_beta), Some(i)) = (
         true_beta,
@@ -269,6 +285,20 @@ fn table(
         }
     }
     println!("{}", row("**all cells**", &pooled));
+    println!(
+        "\nSeries with corrected areas but no contact interior (the signal bounded only): {} of {}; their \
+         images' intervals held the truth in {} of {} ({:.1} %); the other images: {:.1} %",
+        pooled.bounds_series,
+        pooled.series,
+        pooled.bounds_covered,
+        pooled.bounds_images,
+        100.0 * pooled.bounds_covered as f64 / pooled.bounds_images.max(1) as f64,
+        {
+            let images: usize = pooled.images.iter().sum::<usize>() - pooled.bounds_images;
+            let covered: usize = pooled.covered.iter().sum::<usize>() - pooled.bounds_covered;
+            100.0 * covered as f64 / images.max(1) as f64
+        }
+    );
     all
 }
 
