@@ -437,6 +437,13 @@ fn messages_keep_clap_suggestions_and_point_to_the_right_command() {
     std::fs::write(&path, czi).unwrap();
     let err = stderr(&run(&["topography", s(&path)]));
     assert!(err.contains("a CZI micrograph, not a height map"), "{err}");
+    // The article as the name is spoken ("an ND2").
+    let path = dir.path().join("scan.nd2");
+    let mut nd2 = vec![0xda, 0xce, 0xbe, 0x0a];
+    nd2.resize(4096, 0);
+    std::fs::write(&path, nd2).unwrap();
+    let err = stderr(&run(&["topography", s(&path)]));
+    assert!(err.contains("an ND2 micrograph, not a height map"), "{err}");
     let path = dir.path().join("scan.xyz");
     std::fs::write(&path, b"\x01\x02\x00\x03binary").unwrap();
     let err = stderr(&run(&["topography", s(&path)]));

@@ -6,12 +6,25 @@
 //! image-tiff's `Limits` (a decoding budget); these limits are far above any real image or
 //! simulation and far below what would exhaust a workstation.
 
+/// The article of a number as it is spoken: "an" before 8, 11, 18, 80…89, 800…, 11 000, 18 000
+/// ("an 8×8 plane", "an 11×4 plane"), else "a".
+pub(crate) fn article(n: usize) -> &'static str {
+    let digits = n.to_string();
+    let eleven_or_eighteen =
+        digits.len() % 3 == 2 && (digits.starts_with("11") || digits.starts_with("18"));
+    if digits.starts_with('8') || eleven_or_eighteen {
+        "an"
+    } else {
+        "a"
+    }
+}
+
 /// A work size beyond the [`Limits`], with the numbers.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum LimitError {
     /// A plane with no pixels.
-    #[error("a {nx}×{ny} plane has no pixels")]
+    #[error("{} {nx}×{ny} plane has no pixels", article(*.nx))]
     EmptyPlane {
         /// Columns.
         nx: usize,
@@ -19,7 +32,7 @@ pub enum LimitError {
         ny: usize,
     },
     /// A side longer than [`Limits::max_side`].
-    #[error("a {nx}×{ny} plane exceeds the limit of {limit} pixels per side")]
+    #[error("{} {nx}×{ny} plane exceeds the limit of {limit} pixels per side", article(*.nx))]
     SideTooLong {
         /// Columns.
         nx: usize,
@@ -30,7 +43,8 @@ pub enum LimitError {
     },
     /// More bytes than [`Limits::max_plane_bytes`].
     #[error(
-        "a {nx}×{ny} plane of {bytes_per_value}-byte values exceeds the {limit_mib} MiB limit"
+        "{} {nx}×{ny} plane of {bytes_per_value}-byte values exceeds the {limit_mib} MiB limit",
+        article(*.nx)
     )]
     PlaneTooLarge {
         /// Columns.
@@ -157,6 +171,30 @@ impl Default for Limits {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_take_the_article_they_are_spoken_with() {
+        for (n, a) in [
+            (0, "a"),
+            (1, "a"),
+            (8, "an"),
+            (11, "an"),
+            (18, "an"),
+            (80, "an"),
+            (110, "a"),
+            (181, "a"),
+            (512, "a"),
+            (800, "an"),
+            (1100, "a"),
+            (11_000, "an"),
+            (18_432, "an"),
+            (180_000, "a"),
+        ] {
+            assert_eq!(article(n), a, "{n}");
+        }
+        let e = LimitError::EmptyPlane { nx: 8, ny: 0 };
+        assert_eq!(e.to_string(), "an 8×0 plane has no pixels");
+    }
 
     #[test]
     fn products_that_wrap_are_refused() {

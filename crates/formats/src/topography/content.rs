@@ -127,11 +127,18 @@ pub fn read_height_map(path: &Path, options: &ReadOptions) -> Result<HeightMap> 
         return single(read_gsf(path, options.pixel_size_m, options.height_unit_m));
     }
     if let Some(format) = crate::microscopy::detect(&head) {
+        // "an ND2", "an OME-ZARR": N is spoken "en"; "a CZI", "a LIF", "a TIFF".
+        let name = format.name().to_uppercase();
+        let article = if name.starts_with(['N', 'O']) {
+            "an"
+        } else {
+            "a"
+        };
         return Err(unsupported(
             path,
             format!(
-                "a {} micrograph, not a height map (info, threshold and analyze read it)",
-                format.name().to_uppercase()
+                "{article} {name} micrograph, not a height map (info, threshold and analyze \
+                 read it)"
             ),
         ));
     }
