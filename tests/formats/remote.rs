@@ -25,6 +25,8 @@ struct Faults {
     after: usize,
     /// Answer every GET with the whole file (200), ignoring `Range`.
     ignore_range: bool,
+    /// Wait this long before answering each request (a distant server's round trip).
+    delay_ms: u64,
 }
 
 const HONEST: Faults = Faults {
@@ -32,14 +34,26 @@ const HONEST: Faults = Faults {
     cut_all: false,
     after: 0,
     ignore_range: false,
+    delay_ms: 0,
 };
 
-/// Serve `root` on a loopback port; the base URL and the number of connections cut so far.
-fn serve(root: &Path, faults: Faults) -> (String, Arc<AtomicUsize>) {
+/// A server on loopback: its base URL, how many connections it has cut, and the most GET
+/// requests it has answered at the same time.
+struct Served {
+    base: String,
+    cut: Arc<AtomicUsize>,
+    most_at_once: Arc<AtomicUsize>,
+}
+
+/// Serve `root` on a loopback port.
+fn serve(root: &Path, faults: Faults) -> Served {
     let listener = TcpListener::bind("127.0.0.1:0").unwrap();
     let url = format!("http://{}", listener.local_addr().unwrap());
     let cut = Arc::new(AtomicUsize::new(0));
+    let most_at_once = Arc::new(AtomicUsize::new(0));
+    let active = Arc::new(AtomicUsize::new(0));
     let (root, counter) = (root.to_path_buf(), cut.clone());
+    let most = most_at_once.clone();
     std::thread::spawn(move || {
         for stream in listener.incoming().flatten() {
             let kill = faults.cut_all
@@ -49,16 +63,27 @@ fn serve(root: &Path, faults: Faults) -> (String, Arc<AtomicUsize>) {
                     })
                     .is_ok();
             let root = root.clone();
+            let gets = (active.clone(), most.clone());
             std::thread::spawn(move || {
-                let _ = connection(stream, &root, faults, kill);
+                let _ = connection(stream, &root, faults, kill, gets);
             });
         }
     });
-    (url, cut)
+    Served {
+        base: url,
+        cut,
+        most_at_once,
+    }
 }
 
 /// Answer the requests of one connection (keep-alive) until the client closes it.
-fn connection(stream: TcpStream, root: &Path, faults: Faults, kill: bool) -> std::io::Result<()> {
+fn connection(
+    stream: TcpStream,
+    root: &Path,
+    faults: Faults,
+    kill: bool,
+    (active, most): (Arc<AtomicUsize>, Arc<AtomicUsize>),
+) -> std::io::Result<()> {
     let mut reader = BufReader::new(stream.try_clone()?);
     let mut out = stream;
     let mut sent = 0usize;
@@ -76,6 +101,13 @@ fn connection(stream: TcpStream, root: &Path, faults: Faults, kill: bool) -> std
         }
         let mut words = request.split_whitespace();
         let (method, target) = (words.next().unwrap_or(""), words.next().unwrap_or("/"));
+        // GETs being answered now (this one included), counted while it waits and is sent.
+        let _answering = (method == "GET").then(|| {
+            let now = active.fetch_add(1, Ordering::SeqCst) + 1;
+            most.fetch_max(now, Ordering::SeqCst);
+            Decrement(active.clone())
+        });
+        std::thread::sleep(std::time::Duration::from_millis(faults.delay_ms));
         let range = request.lines().find_map(|l| {
             let (name, value) = l.split_once(':')?;
             name.eq_ignore_ascii_case("range")
@@ -125,6 +157,15 @@ fn connection(stream: TcpStream, root: &Path, faults: Faults, kill: bool) -> std
     }
 }
 
+/// Lowers a count when dropped.
+struct Decrement(Arc<AtomicUsize>);
+
+impl Drop for Decrement {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
 /// The URL of `file` below the served folder `root`.
 fn url_of(base: &str, root: &Path, file: &Path) -> PathBuf {
     let rel = file.strip_prefix(root).unwrap().to_str().unwrap();
@@ -154,7 +195,8 @@ fn files_and_stores_by_url_analyse_as_on_disk_through_cut_connections() {
             ..HONEST
         };
         for (j, faults) in [HONEST, cuts, no_ranges].into_iter().enumerate() {
-            let (base, cut) = serve(&root, faults);
+            let served = serve(&root, faults);
+            let (base, cut) = (served.base, served.cut);
             let url = url_of(&base, &root, input);
             let out = dir.path().join(format!("url{k}-{j}"));
             assert_eq!(
@@ -169,7 +211,7 @@ fn files_and_stores_by_url_analyse_as_on_disk_through_cut_connections() {
         }
     }
     // A reader fed by URL gives the same planes (Python and napari read through it).
-    let (base, _) = serve(&root, HONEST);
+    let base = serve(&root, HONEST).base;
     let mut local = contactscope_formats::microscopy::MicroscopyFile::open(&inputs[0]).unwrap();
     let mut remote =
         contactscope_formats::microscopy::MicroscopyFile::open(&url_of(&base, &root, &inputs[0]))
@@ -188,13 +230,13 @@ fn a_missing_object_or_a_dead_server_is_one_line_and_no_output() {
     let root = dir.path().join("served");
     std::fs::create_dir_all(&root).unwrap();
     let input = tiff(&root, &planes());
-    let (base, _) = serve(&root, HONEST);
+    let base = serve(&root, HONEST).base;
     let dead = Faults {
         cut_all: true,
         after: 100,
         ..HONEST
     };
-    let (dead_base, _) = serve(&root, dead);
+    let dead_base = serve(&root, dead).base;
     let missing = format!("{base}/nothing-here.tif");
     let cut = url_of(&dead_base, &root, &input);
     let cases = [
@@ -263,4 +305,79 @@ fn a_missing_object_or_a_dead_server_is_one_line_and_no_output() {
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.starts_with("contactscope: error: --endpoint-url") && err.lines().count() == 1);
+}
+
+/// A file of several of the reader's blocks (4 MiB), read in order: the blocks after the one
+/// read are fetched at the same time (each request waits 40 ms here, as a distant server's
+/// would), and every number is the same as from disk, also through cut connections. Reading
+/// one block at a time, `info` (one thread walking the headers) never had two requests out.
+#[test]
+fn a_file_read_in_order_is_fetched_ahead_on_parallel_connections() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().join("served");
+    std::fs::create_dir_all(&root).unwrap();
+    // Six 1024 × 1024 planes of 16 bits (12 MiB, three blocks): a disc growing on a pattern.
+    let (w, h) = (1024usize, 1024usize);
+    let planes: Vec<Vec<u16>> = (0..6)
+        .map(|t| {
+            let r = 100.0 + 60.0 * t as f64;
+            (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as f64 - 511.5, (i / w) as f64 - 511.5);
+                    let pattern = ((i * 7919 + t * 104_729) % 61) as u16;
+                    pattern + if x * x + y * y < r * r { 1800 } else { 120 }
+                })
+                .collect()
+        })
+        .collect();
+    let refs: Vec<&[u16]> = planes.iter().map(Vec::as_slice).collect();
+    let bytes =
+        contactscope_formats::tiff::encode_u16_stack(&refs, w, h, Some((2e-7, 2e-7)), "").unwrap();
+    assert!(bytes.len() > 12 << 20);
+    let input = root.join("big.tif");
+    std::fs::write(&input, bytes).unwrap();
+    let analyze = |path: &Path, out: &str| {
+        let out = dir.path().join(out);
+        let args = [
+            "analyze",
+            path.to_str().unwrap(),
+            "--forces",
+            "4mN..400mN:6",
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ];
+        crate::common::run_ok(&args);
+        std::fs::read_to_string(out.join("areas.csv")).unwrap()
+    };
+    let reference = analyze(&input, "disk");
+    let far = Faults {
+        delay_ms: 40,
+        ..HONEST
+    };
+    let served = serve(&root, far);
+    let url = url_of(&served.base, &root, &input);
+    let o = run(&["info", url.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        served.most_at_once.load(Ordering::SeqCst) >= 2,
+        "info asked for one block at a time"
+    );
+    // The areas table names its input: compare the rows below the header only.
+    let rows = |csv: &String| -> Vec<String> {
+        csv.lines()
+            .skip(1)
+            .map(|l| l.split_once(',').map_or("", |(_, rest)| rest).to_string())
+            .collect()
+    };
+    assert_eq!(rows(&analyze(&url, "far")), rows(&reference));
+    let cuts = Faults {
+        cut: 4,
+        after: 1 << 20,
+        ..far
+    };
+    let served = serve(&root, cuts);
+    let url = url_of(&served.base, &root, &input);
+    assert_eq!(rows(&analyze(&url, "cut")), rows(&reference));
+    assert_eq!(served.cut.load(Ordering::SeqCst), 4);
 }

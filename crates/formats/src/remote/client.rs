@@ -231,6 +231,11 @@ impl Client {
             .timeout_connect(Some(Duration::from_secs(15)))
             .timeout_recv_response(Some(Duration::from_secs(60)))
             .timeout_recv_body(Some(Duration::from_secs(120)))
+            // Connections kept open for the next requests: enough for every reader's read-ahead
+            // (`file::READ_AHEAD` blocks at once) on a few threads, so that each block does not
+            // pay a new connection (and TLS handshake).
+            .max_idle_connections_per_host(4 * super::file::READ_AHEAD as usize)
+            .max_idle_connections(8 * super::file::READ_AHEAD as usize)
             .build()
             .into();
         Client { agent }

@@ -2,12 +2,24 @@
 //! take either through [`open_input`]. An object is read in blocks of [`BLOCK`] bytes kept in a
 //! cache the whole process shares (at most [`CACHE_BYTES`]), so that the many short-lived readers
 //! of one series (one per page decoded) fetch its headers once.
+//!
+//! **Read-ahead.** A server far away answers each request after a round trip and sends one
+//! response no faster than one connection carries (tens of milliseconds and about 100 MB/s
+//! for a cloud bucket); a reader that asked for one block at a time would wait for both on
+//! every block. A block missed right after the one before it (a reader going through the file
+//! in order: a TIFF's pages, one after another) is therefore fetched together with the next
+//! [`READ_AHEAD`] − 1 blocks, each on its own connection at the same time; the reader goes on
+//! as soon as its own block is in, and a reader that needs a block still on its way waits for
+//! it rather than asking again. A block missed out of order (a header at the end of a file) is
+//! fetched alone. A block fetched ahead that fails is simply fetched again when it is read (with
+//! its retries and, if it keeps failing, its error).
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::{HashMap, HashSet, VecDeque};
 use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom};
 use std::path::Path;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, OnceLock};
+use std::time::Duration;
 
 use super::client::{client, network_error, Object, Range};
 use crate::error::{Error, Result};
@@ -16,6 +28,9 @@ use crate::error::{Error, Result};
 const BLOCK: u64 = 4 << 20;
 /// Bytes of blocks kept for later reads.
 const CACHE_BYTES: usize = 96 << 20;
+/// Blocks fetched at once when a reader goes through an object in order (module docs): its own
+/// and the next ones, at most 24 MiB on the way per reader.
+pub(crate) const READ_AHEAD: u64 = 8;
 
 /// An open input: a local file or an object on a server.
 pub(crate) enum Input {
@@ -23,12 +38,38 @@ pub(crate) enum Input {
     Remote(RemoteFile),
 }
 
+/// How long an object's length and version tag, once asked for, are taken as still true: the
+/// short-lived readers of one series (one per page and pass) open the object again and again
+/// within seconds, and each question would cost a round trip to the server.
+const STAT_VALID: Duration = Duration::from_secs(5);
+
+/// The length and version tag of `object` (named `url`): asked of the server, or as it answered
+/// within the last [`STAT_VALID`].
+fn stat(url: &str, object: &Object) -> io::Result<Option<(u64, String)>> {
+    type Stats = Mutex<HashMap<String, (std::time::Instant, u64, String)>>;
+    static STATS: OnceLock<Stats> = OnceLock::new();
+    let stats = STATS.get_or_init(Default::default);
+    if let Some((at, len, tag)) = stats.lock().ok().and_then(|s| s.get(url).cloned()) {
+        if at.elapsed() < STAT_VALID {
+            return Ok(Some((len, tag)));
+        }
+    }
+    let answer = client().stat(object, None)?;
+    if let (Some((len, tag)), Ok(mut s)) = (&answer, stats.lock()) {
+        s.retain(|_, (at, _, _)| at.elapsed() < STAT_VALID);
+        s.insert(
+            url.to_string(),
+            (std::time::Instant::now(), *len, tag.clone()),
+        );
+    }
+    Ok(answer)
+}
+
 /// Open `path` (a file, or an `s3://`/`http(s)://` URL) and return it with its length in bytes.
 pub(crate) fn open_input(path: &Path) -> Result<(Input, u64)> {
     if super::is_url(path) {
         let object = Object::parse(path).map_err(|e| Error::io(path, e))?;
-        let (len, tag) = client()
-            .stat(&object, None)
+        let (len, tag) = stat(&path.to_string_lossy(), &object)
             .map_err(|e| Error::io(path, e))?
             .ok_or_else(|| {
                 Error::io(
@@ -79,12 +120,14 @@ pub(crate) struct RemoteFile {
     pos: u64,
 }
 
-/// Blocks of objects by (URL, block index), the least recently used dropped first.
+/// Blocks of objects by (URL, block index), the least recently used dropped first, and the
+/// blocks being fetched.
 #[derive(Default)]
 struct Cache {
     blocks: HashMap<(String, u64), Arc<Vec<u8>>>,
     order: VecDeque<(String, u64)>,
     bytes: usize,
+    fetching: HashSet<(String, u64)>,
 }
 
 impl Cache {
@@ -105,45 +148,123 @@ impl Cache {
             }
         }
     }
+
+    /// Block `key`, marked as used most recently.
+    fn take(&mut self, key: &(String, u64)) -> Option<Arc<Vec<u8>>> {
+        let block = self.blocks.get(key).cloned()?;
+        if let Some(at) = self.order.iter().position(|k| k == key) {
+            let k = self.order.remove(at).expect("position is in range");
+            self.order.push_back(k);
+        }
+        Some(block)
+    }
+
+    /// The blocks after block `index` of `name` (of `blocks` in all) to fetch ahead: where the
+    /// block before it has been read or is on its way (a reader going through the object in
+    /// order), those of the next [`READ_AHEAD`] − 1 that are neither kept nor on their way;
+    /// else none.
+    fn ahead(&self, name: &str, index: u64, blocks: u64) -> Vec<u64> {
+        let known = |i: u64| {
+            let key = (name.to_string(), i);
+            self.blocks.contains_key(&key) || self.fetching.contains(&key)
+        };
+        if index > 0 && !known(index - 1) {
+            return Vec::new();
+        }
+        (index + 1..blocks.min(index + READ_AHEAD))
+            .filter(|&i| !known(i))
+            .collect()
+    }
 }
 
-fn cache() -> &'static Mutex<Cache> {
-    static CACHE: OnceLock<Mutex<Cache>> = OnceLock::new();
-    CACHE.get_or_init(Mutex::default)
+/// The shared cache, and the signal that a block fetched by one reader has come (or failed).
+fn cache() -> &'static (Mutex<Cache>, Condvar) {
+    static CACHE: OnceLock<(Mutex<Cache>, Condvar)> = OnceLock::new();
+    CACHE.get_or_init(Default::default)
+}
+
+/// The cache, locked (a poisoned lock is taken over: the cache holds only whole blocks).
+fn locked() -> MutexGuard<'static, Cache> {
+    cache().0.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Fetch block `index` (of `len` bytes of the object) from the server.
+fn fetch(object: &Object, len: u64, index: u64) -> io::Result<Arc<Vec<u8>>> {
+    let offset = index * BLOCK;
+    let want = BLOCK.min(len - offset);
+    let bytes = client()
+        .get(object, None, Range::At { offset, len: want })?
+        .ok_or_else(|| network_error(io::ErrorKind::NotFound, "the object is gone"))?;
+    if (bytes.len() as u64) < want {
+        return Err(network_error(
+            io::ErrorKind::Other,
+            format!(
+                "the object is shorter than it was ({} bytes at {offset}, {want} expected)",
+                bytes.len()
+            ),
+        ));
+    }
+    Ok(Arc::new(bytes))
+}
+
+/// Keep what fetching `key` gave (nothing after a failure), end its fetching and wake the
+/// readers waiting for it.
+fn arrived(key: (String, u64), fetched: &io::Result<Arc<Vec<u8>>>) {
+    let mut c = locked();
+    c.fetching.remove(&key);
+    if let Ok(block) = fetched {
+        c.insert(key, block.clone(), CACHE_BYTES);
+    }
+    drop(c);
+    cache().1.notify_all();
 }
 
 impl RemoteFile {
-    /// Block `index` of the object, from the cache or the server.
+    /// Block `index` of the object, from the cache, from another reader's fetch, or from the
+    /// server; read in order, the blocks after it are fetched meanwhile (module docs).
     fn block(&self, index: u64) -> io::Result<Arc<Vec<u8>>> {
-        let key = (self.object.0.clone(), index);
-        if let Ok(mut c) = cache().lock() {
-            if let Some(b) = c.blocks.get(&key).cloned() {
-                if let Some(at) = c.order.iter().position(|k| *k == key) {
-                    let k = c.order.remove(at).expect("position is in range");
-                    c.order.push_back(k);
-                }
-                return Ok(b);
+        let name = &self.object.0;
+        let key = (name.clone(), index);
+        let mut c = locked();
+        let ahead = c.ahead(name, index, self.len.div_ceil(BLOCK));
+        for &i in &ahead {
+            c.fetching.insert((name.clone(), i));
+        }
+        drop(c);
+        for i in ahead {
+            let (object, len) = (self.object.clone(), self.len);
+            let spawned = std::thread::Builder::new()
+                .name("contactscope-read-ahead".into())
+                .spawn(move || {
+                    let fetched = fetch(&object.1, len, i);
+                    arrived((object.0.clone(), i), &fetched);
+                });
+            if spawned.is_err() {
+                // No thread to be had: the block is fetched when it is read.
+                arrived((name.clone(), i), &Err(io::Error::other("no thread")));
             }
         }
-        let offset = index * BLOCK;
-        let len = BLOCK.min(self.len - offset);
-        let bytes = client()
-            .get(&self.object.1, None, Range::At { offset, len })?
-            .ok_or_else(|| network_error(io::ErrorKind::NotFound, "the object is gone"))?;
-        if (bytes.len() as u64) < len {
-            return Err(network_error(
-                io::ErrorKind::Other,
-                format!(
-                    "the object is shorter than it was ({} bytes at {offset}, {len} expected)",
-                    bytes.len()
-                ),
-            ));
+        let mut c = locked();
+        loop {
+            if let Some(b) = c.take(&key) {
+                return Ok(b);
+            }
+            if !c.fetching.contains(&key) {
+                break;
+            }
+            // On its way: wait for it (or for its fetch to fail, then fetch it here). The
+            // timeout only bounds a wait whose wake-up was missed.
+            c = cache()
+                .1
+                .wait_timeout(c, Duration::from_millis(200))
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
         }
-        let block = Arc::new(bytes);
-        if let Ok(mut c) = cache().lock() {
-            c.insert(key, block.clone(), CACHE_BYTES);
-        }
-        Ok(block)
+        c.fetching.insert(key.clone());
+        drop(c);
+        let fetched = fetch(&self.object.1, self.len, index);
+        arrived(key, &fetched);
+        fetched
     }
 }
 
@@ -177,6 +298,30 @@ impl Seek for RemoteFile {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn blocks_are_fetched_ahead_only_for_a_reader_going_in_order() {
+        let mut c = Cache::default();
+        let a = |i: u64| ("a".to_string(), i);
+        // The first block of an object: the next READ_AHEAD − 1 with it.
+        assert_eq!(c.ahead("a", 0, 100), (1..READ_AHEAD).collect::<Vec<_>>());
+        // A block whose predecessor is neither kept nor on its way (a header at the end of the
+        // file): alone.
+        assert!(c.ahead("a", 50, 100).is_empty());
+        // In order: the blocks after it, less those kept or on their way, not past the end.
+        c.insert(a(49), Arc::new(vec![0; 4]), 1 << 20);
+        c.fetching.insert(a(51));
+        c.insert(a(53), Arc::new(vec![0; 4]), 1 << 20);
+        let ahead = c.ahead("a", 50, 100);
+        assert_eq!(ahead[..3], [52, 54, 55]);
+        assert_eq!(ahead.len() as u64, READ_AHEAD - 1 - 2);
+        assert_eq!(c.ahead("a", 50, 53), vec![52]);
+        // Another object's blocks say nothing about this one's order.
+        assert!(c.ahead("b", 50, 100).is_empty());
+        // A block on its way counts as read for the order.
+        c.fetching.insert(a(70));
+        assert_eq!(c.ahead("a", 71, 100).len() as u64, READ_AHEAD - 1);
+    }
 
     #[test]
     fn the_cache_counts_each_block_once_and_keeps_to_its_capacity() {
