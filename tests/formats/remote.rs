@@ -381,3 +381,66 @@ fn a_file_read_in_order_is_fetched_ahead_on_parallel_connections() {
     assert_eq!(rows(&analyze(&url, "cut")), rows(&reference));
     assert_eq!(served.cut.load(Ordering::SeqCst), 4);
 }
+
+/// An OME-Zarr store on a server 40 ms away, read plane after plane: the next planes' chunks
+/// are fetched while one is read (more requests out at once than the analysis has threads),
+/// and the threshold is the one read from disk. Reading one chunk per request on each thread,
+/// at most two were ever out.
+#[test]
+fn a_store_read_plane_after_plane_fetches_the_next_chunks_ahead() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().join("served");
+    let store = root.join("ramp.ome.zarr");
+    std::fs::create_dir_all(store.join("0")).unwrap();
+    let (n, side) = (16usize, 64usize);
+    let write = |path: &Path, text: &str| std::fs::write(path, text).unwrap();
+    write(&store.join(".zgroup"), r#"{"zarr_format": 2}"#);
+    write(
+        &store.join(".zattrs"),
+        r#"{"multiscales": [{"version": "0.4", "axes": [{"name": "t", "type": "time"},
+            {"name": "y", "type": "space", "unit": "micrometer"},
+            {"name": "x", "type": "space", "unit": "micrometer"}],
+            "datasets": [{"path": "0", "coordinateTransformations":
+            [{"type": "scale", "scale": [1.0, 0.2, 0.2]}]}]}]}"#,
+    );
+    write(
+        &store.join("0/.zarray"),
+        &format!(
+            r#"{{"zarr_format": 2, "shape": [{n}, {side}, {side}], "chunks": [1, {side}, {side}],
+            "dtype": "<u2", "compressor": null, "fill_value": 0, "order": "C", "filters": null,
+            "dimension_separator": "/"}}"#
+        ),
+    );
+    for t in 0..n {
+        let r = 4.0 + 1.5 * t as f64;
+        let bytes: Vec<u8> = (0..side * side)
+            .flat_map(|i| {
+                let (x, y) = ((i % side) as f64 - 31.5, (i / side) as f64 - 31.5);
+                let v = ((i * 7919 + t * 104_729) % 61) as u16
+                    + if x * x + y * y < r * r { 1800 } else { 120 };
+                v.to_le_bytes()
+            })
+            .collect();
+        std::fs::create_dir_all(store.join(format!("0/{t}/0"))).unwrap();
+        std::fs::write(store.join(format!("0/{t}/0/0")), bytes).unwrap();
+    }
+    let threshold = |path: &Path| {
+        let o = crate::common::run_ok(&["threshold", path.to_str().unwrap(), "--load-axis", "t"]);
+        crate::common::stdout(&o)
+    };
+    let reference = threshold(&store);
+    let served = serve(
+        &root,
+        Faults {
+            delay_ms: 40,
+            ..HONEST
+        },
+    );
+    let url = url_of(&served.base, &root, &store);
+    assert_eq!(
+        threshold(&url),
+        reference.replace(store.to_str().unwrap(), url.to_str().unwrap())
+    );
+    let most = served.most_at_once.load(Ordering::SeqCst);
+    assert!(most >= 3, "at most {most} requests out at once");
+}

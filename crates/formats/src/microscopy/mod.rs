@@ -31,6 +31,7 @@ pub mod select;
 pub mod summary;
 mod tiff;
 pub mod zarr;
+mod zarr_ahead;
 pub mod zarr_write;
 
 pub use tiff::{series_of_tiff, set_member, tiff_series, LoadDefault, TiffPage};

@@ -276,25 +276,29 @@ impl ZarrReader {
     /// Decode one plane of series `info.index`.
     pub fn read_plane(&mut self, info: &SeriesInfo, index: &PlaneIndex) -> Result<Plane> {
         let image = &self.images[info.index];
-        let p = &image.places;
-        let shape = image.array.shape();
-        let mut ranges: Vec<std::ops::Range<u64>> = shape.iter().map(|_| 0..1).collect();
-        let mut set = |at: Option<usize>, i: usize| {
-            if let Some(at) = at {
-                ranges[at] = i as u64..i as u64 + 1;
-            }
-        };
-        set(p.t, index.t);
-        set(p.c, index.c);
-        set(p.z, index.z);
-        for (name, at) in &p.extra {
-            set(Some(*at), index.get(name));
-        }
-        ranges[p.y] = 0..shape[p.y];
-        ranges[p.x] = 0..shape[p.x];
         let (w, h) = (info.axes.x, info.axes.y);
         checked_bytes(&self.path, "plane", &[w, h], 8)?;
-        let subset = ArraySubset::new_with_ranges(&ranges);
+        let subset = plane_subset(image, index);
+        if let Some(remote) = &self.remote {
+            // A reader going through the series in order: the next planes' chunks come
+            // meanwhile (not for a sharded array, read in parts of its shards).
+            let store = self.path.to_string_lossy();
+            let next = super::zarr_ahead::note_read(&store, info.index, index, &info.axes);
+            if !next.is_empty() && !image.array.metadata().to_string().contains("sharding") {
+                let keys: Vec<_> = next
+                    .iter()
+                    .filter_map(|i| {
+                        image
+                            .array
+                            .chunks_in_array_subset(&plane_subset(image, i))
+                            .ok()?
+                    })
+                    .flat_map(|chunks| chunks.indices().into_iter().collect::<Vec<_>>())
+                    .map(|chunk| image.array.chunk_key(&chunk))
+                    .collect();
+                remote.fetch_ahead(&keys);
+            }
+        }
         let failed = |e: zarrs::array::ArrayError| {
             bad(
                 &self.path,
@@ -358,6 +362,27 @@ impl ZarrReader {
             samples,
         })
     }
+}
+
+/// The part of `image`'s array that holds plane `index`.
+fn plane_subset(image: &ZarrImage, index: &PlaneIndex) -> ArraySubset {
+    let p = &image.places;
+    let shape = image.array.shape();
+    let mut ranges: Vec<std::ops::Range<u64>> = shape.iter().map(|_| 0..1).collect();
+    let mut set = |at: Option<usize>, i: usize| {
+        if let Some(at) = at {
+            ranges[at] = i as u64..i as u64 + 1;
+        }
+    };
+    set(p.t, index.t);
+    set(p.c, index.c);
+    set(p.z, index.z);
+    for (name, at) in &p.extra {
+        set(Some(*at), index.get(name));
+    }
+    ranges[p.y] = 0..shape[p.y];
+    ranges[p.x] = 0..shape[p.x];
+    ArraySubset::new_with_ranges(&ranges)
 }
 
 impl ZarrReader {

@@ -41,7 +41,7 @@ pub(crate) enum Input {
 /// How long an object's length and version tag, once asked for, are taken as still true: the
 /// short-lived readers of one series (one per page and pass) open the object again and again
 /// within seconds, and each question would cost a round trip to the server.
-const STAT_VALID: Duration = Duration::from_secs(5);
+const STAT_VALID: Duration = super::ANSWER_VALID;
 
 /// The length and version tag of `object` (named `url`): asked of the server, or as it answered
 /// within the last [`STAT_VALID`].

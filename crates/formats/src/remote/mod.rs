@@ -22,8 +22,10 @@ mod client;
 mod file;
 mod zarr_store;
 
+use std::collections::HashMap;
 use std::path::Path;
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
+use std::time::{Duration, Instant};
 
 pub(crate) use client::is_network_error;
 pub(crate) use file::{open_input, Input};
@@ -63,8 +65,30 @@ pub fn set_endpoint_url(url: Option<&str>) -> Result<(), String> {
 
 /// Whether the object store at `path` is a Zarr store (its root holds `zarr.json`, `.zgroup`,
 /// `.zattrs` or `.zarray`). Asks the server, the four questions at once (each costs a round
-/// trip); any failure counts as "no" (opening it as a file then says what is wrong).
+/// trip), and takes the answer as still true for 5 s (a command asks several times); any
+/// failure counts as "no" (opening it as a file then says what is wrong).
 pub fn is_zarr_store(path: &Path) -> bool {
+    type Answers = Mutex<HashMap<String, (Instant, bool)>>;
+    static ANSWERS: OnceLock<Answers> = OnceLock::new();
+    let answers = ANSWERS.get_or_init(Default::default);
+    let name = path.to_string_lossy().to_string();
+    if let Some((at, yes)) = answers.lock().ok().and_then(|a| a.get(&name).copied()) {
+        if at.elapsed() < ANSWER_VALID {
+            return yes;
+        }
+    }
+    let yes = ask_is_zarr_store(path);
+    if let Ok(mut a) = answers.lock() {
+        a.retain(|_, (at, _)| at.elapsed() < ANSWER_VALID);
+        a.insert(name, (Instant::now(), yes));
+    }
+    yes
+}
+
+/// How long an answer about an object (its size, whether a store is there) is taken as true.
+pub(crate) const ANSWER_VALID: Duration = Duration::from_secs(5);
+
+fn ask_is_zarr_store(path: &Path) -> bool {
     let Ok(object) = client::Object::parse(path) else {
         return false;
     };
