@@ -307,6 +307,19 @@ fn a_missing_object_or_a_dead_server_is_one_line_and_no_output() {
     assert!(err.starts_with("contactscope: error: --endpoint-url") && err.lines().count() == 1);
 }
 
+/// A square plane of `side` pixels: a bright disc of radius `r` on a dim background, with a
+/// fixed pattern of noise that differs from plane `t` to plane.
+fn disc(side: usize, r: f64, t: usize) -> Vec<u16> {
+    let c = (side as f64 - 1.0) / 2.0;
+    (0..side * side)
+        .map(|i| {
+            let (x, y) = ((i % side) as f64 - c, (i / side) as f64 - c);
+            let pattern = ((i * 7919 + t * 104_729) % 61) as u16;
+            pattern + if x * x + y * y < r * r { 1800 } else { 120 }
+        })
+        .collect()
+}
+
 /// A file of several of the reader's blocks (4 MiB), read in order: the blocks after the one
 /// read are fetched at the same time (each request waits 40 ms here, as a distant server's
 /// would), and every number is the same as from disk, also through cut connections. Reading
@@ -316,19 +329,10 @@ fn a_file_read_in_order_is_fetched_ahead_on_parallel_connections() {
     let dir = tempfile::tempdir().unwrap();
     let root = dir.path().join("served");
     std::fs::create_dir_all(&root).unwrap();
-    // Six 1024 × 1024 planes of 16 bits (12 MiB, three blocks): a disc growing on a pattern.
+    // Six 1024 × 1024 planes of 16 bits (12 MiB, three blocks).
     let (w, h) = (1024usize, 1024usize);
     let planes: Vec<Vec<u16>> = (0..6)
-        .map(|t| {
-            let r = 100.0 + 60.0 * t as f64;
-            (0..w * h)
-                .map(|i| {
-                    let (x, y) = ((i % w) as f64 - 511.5, (i / w) as f64 - 511.5);
-                    let pattern = ((i * 7919 + t * 104_729) % 61) as u16;
-                    pattern + if x * x + y * y < r * r { 1800 } else { 120 }
-                })
-                .collect()
-        })
+        .map(|t| disc(w, 100.0 + 60.0 * t as f64, t))
         .collect();
     let refs: Vec<&[u16]> = planes.iter().map(Vec::as_slice).collect();
     let bytes =
@@ -412,14 +416,9 @@ fn a_store_read_plane_after_plane_fetches_the_next_chunks_ahead() {
         ),
     );
     for t in 0..n {
-        let r = 4.0 + 1.5 * t as f64;
-        let bytes: Vec<u8> = (0..side * side)
-            .flat_map(|i| {
-                let (x, y) = ((i % side) as f64 - 31.5, (i / side) as f64 - 31.5);
-                let v = ((i * 7919 + t * 104_729) % 61) as u16
-                    + if x * x + y * y < r * r { 1800 } else { 120 };
-                v.to_le_bytes()
-            })
+        let bytes: Vec<u8> = disc(side, 4.0 + 1.5 * t as f64, t)
+            .into_iter()
+            .flat_map(u16::to_le_bytes)
             .collect();
         std::fs::create_dir_all(store.join(format!("0/{t}/0"))).unwrap();
         std::fs::write(store.join(format!("0/{t}/0/0")), bytes).unwrap();
