@@ -4,8 +4,8 @@
 //!
 //! **Chunks fetched ahead.** A reader going through a series plane by plane names the chunks of
 //! the planes it will read next ([`RemoteStore::fetch_ahead`]); they are fetched at the same
-//! time, each on its own connection, into a small cache the process shares (at most
-//! [`AHEAD_BYTES`], the oldest dropped first), and each is handed once to the read that asks for
+//! time, each on its own connection (at most [`AHEAD_IN_FLIGHT`] at once), into a small cache
+//! the process shares (at most [`AHEAD_BYTES`], the oldest dropped first), and each is handed once to the read that asks for
 //! the whole chunk (a read that asks while it is on its way waits for it). A chunk fetched ahead
 //! that fails, or is missing, is simply read again when asked for, with its retries and errors.
 
@@ -22,6 +22,9 @@ use crate::error::{Error, Result};
 
 /// Bytes of chunks fetched ahead and not yet read, kept at most.
 const AHEAD_BYTES: usize = 64 << 20;
+/// Chunks on their way at most (a plane of many small chunks names many at once: each its own
+/// request and thread).
+const AHEAD_IN_FLIGHT: usize = 16;
 
 /// Chunks fetched ahead by (store URL/key), in the order they came, and those on their way.
 #[derive(Default)]
@@ -95,13 +98,14 @@ impl RemoteStore {
     }
 
     /// Fetch the whole objects at `keys` (chunks the reader will ask for next) at the same
-    /// time, each on its own thread, unless kept, on their way, or beyond what the cache holds.
+    /// time, each on its own thread, unless kept or on their way, and no more than
+    /// [`AHEAD_IN_FLIGHT`] at once (the first ones named first).
     pub(crate) fn fetch_ahead(self: &Arc<Self>, keys: &[StoreKey]) {
         let mut a = locked();
         let mut start = Vec::new();
         for key in keys {
             let name = format!("{}/{}", self.name, key.as_str());
-            if a.bytes >= AHEAD_BYTES {
+            if a.bytes >= AHEAD_BYTES || a.fetching.len() >= AHEAD_IN_FLIGHT {
                 break;
             }
             if !a.chunks.contains_key(&name) && a.fetching.insert(name.clone()) {
