@@ -615,7 +615,8 @@ def simulate(heights: Any, pixel_size: Optional[PixelSize], modulus: float,
     ``False`` mean ``"all"`` and ``"none"``). The command line's ``--maps`` takes the same choice.
 
     ``measurement`` chooses the measurement of a contact.engineering surface container by
-    index or name, as :func:`read_topography` does (a measurement marked periodic is solved with periodic boundaries). ``contact_engineering``: a
+    index or name, as :func:`read_topography` does (a measurement marked periodic is solved
+    with periodic boundaries). ``contact_engineering``: a
     ``.zip`` path to write contact.engineering's contact-mechanics download to (``plot.csv``,
     ``result-step-N.nc``, ``info.txt``; the command line's ``--export contact-engineering``,
     ``docs/outputs.md``), written once every load is solved.

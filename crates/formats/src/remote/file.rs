@@ -22,6 +22,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard, OnceLock};
 use std::time::Duration;
 
 use super::client::{client, network_error, Object, Range};
+use super::Remembered;
 use crate::error::{Error, Result};
 
 /// Bytes fetched per request.
@@ -38,29 +39,16 @@ pub(crate) enum Input {
     Remote(RemoteFile),
 }
 
-/// How long an object's length and version tag, once asked for, are taken as still true: the
-/// short-lived readers of one series (one per page and pass) open the object again and again
-/// within seconds, and each question would cost a round trip to the server.
-const STAT_VALID: Duration = super::ANSWER_VALID;
-
 /// The length and version tag of `object` (named `url`): asked of the server, or as it answered
-/// within the last [`STAT_VALID`].
+/// within the last few seconds ([`Remembered`]).
 fn stat(url: &str, object: &Object) -> io::Result<Option<(u64, String)>> {
-    type Stats = Mutex<HashMap<String, (std::time::Instant, u64, String)>>;
-    static STATS: OnceLock<Stats> = OnceLock::new();
-    let stats = STATS.get_or_init(Default::default);
-    if let Some((at, len, tag)) = stats.lock().ok().and_then(|s| s.get(url).cloned()) {
-        if at.elapsed() < STAT_VALID {
-            return Ok(Some((len, tag)));
-        }
+    static STATS: Remembered<(u64, String)> = Remembered::new();
+    if let Some(known) = STATS.get(url) {
+        return Ok(Some(known));
     }
     let answer = client().stat(object, None)?;
-    if let (Some((len, tag)), Ok(mut s)) = (&answer, stats.lock()) {
-        s.retain(|_, (at, _, _)| at.elapsed() < STAT_VALID);
-        s.insert(
-            url.to_string(),
-            (std::time::Instant::now(), *len, tag.clone()),
-        );
+    if let Some(known) = &answer {
+        STATS.put(url, known.clone());
     }
     Ok(answer)
 }

@@ -68,25 +68,48 @@ pub fn set_endpoint_url(url: Option<&str>) -> Result<(), String> {
 /// trip), and takes the answer as still true for 5 s (a command asks several times); any
 /// failure counts as "no" (opening it as a file then says what is wrong).
 pub fn is_zarr_store(path: &Path) -> bool {
-    type Answers = Mutex<HashMap<String, (Instant, bool)>>;
-    static ANSWERS: OnceLock<Answers> = OnceLock::new();
-    let answers = ANSWERS.get_or_init(Default::default);
-    let name = path.to_string_lossy().to_string();
-    if let Some((at, yes)) = answers.lock().ok().and_then(|a| a.get(&name).copied()) {
-        if at.elapsed() < ANSWER_VALID {
-            return yes;
-        }
-    }
-    let yes = ask_is_zarr_store(path);
-    if let Ok(mut a) = answers.lock() {
-        a.retain(|_, (at, _)| at.elapsed() < ANSWER_VALID);
-        a.insert(name, (Instant::now(), yes));
-    }
-    yes
+    static ANSWERS: Remembered<bool> = Remembered::new();
+    let name = path.to_string_lossy();
+    ANSWERS.get(&name).unwrap_or_else(|| {
+        let yes = ask_is_zarr_store(path);
+        ANSWERS.put(&name, yes);
+        yes
+    })
 }
 
-/// How long an answer about an object (its size, whether a store is there) is taken as true.
-pub(crate) const ANSWER_VALID: Duration = Duration::from_secs(5);
+/// Answers a server gave about objects (their size, whether a store is there, a metadata
+/// document), by name, each taken as still true for 5 s after it came: a command opens the
+/// same object many times within seconds (one short-lived reader per page and pass), and each
+/// question is a round trip. An object replaced on the server is seen afresh after that.
+pub(crate) struct Remembered<T>(OnceLock<Mutex<HashMap<String, (Instant, T)>>>);
+
+impl<T: Clone> Remembered<T> {
+    /// How long an answer is taken as true.
+    const VALID: Duration = Duration::from_secs(5);
+
+    pub(crate) const fn new() -> Self {
+        Remembered(OnceLock::new())
+    }
+
+    fn answers(&self) -> std::sync::MutexGuard<'_, HashMap<String, (Instant, T)>> {
+        let map = self.0.get_or_init(Default::default);
+        map.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The answer about `name` given within the last 5 s.
+    pub(crate) fn get(&self, name: &str) -> Option<T> {
+        let answers = self.answers();
+        let (at, value) = answers.get(name)?;
+        (at.elapsed() < Self::VALID).then(|| value.clone())
+    }
+
+    /// Keep the answer about `name` just given (answers past their time dropped).
+    pub(crate) fn put(&self, name: &str, value: T) {
+        let mut answers = self.answers();
+        answers.retain(|_, (at, _)| at.elapsed() < Self::VALID);
+        answers.insert(name.to_string(), (Instant::now(), value));
+    }
+}
 
 fn ask_is_zarr_store(path: &Path) -> bool {
     let Ok(object) = client::Object::parse(path) else {
@@ -122,6 +145,18 @@ mod tests {
         for path in ["s3/b/k.tif", "./s3:/x", "data/http.tif", "", "s3:/b"] {
             assert!(!is_url(Path::new(path)), "{path}");
         }
+    }
+
+    #[test]
+    fn answers_are_remembered_by_name() {
+        let answers: Remembered<Option<u32>> = Remembered::new();
+        assert_eq!(answers.get("s3://b/k"), None);
+        answers.put("s3://b/k", Some(3));
+        answers.put("s3://b/gone", None);
+        assert_eq!(answers.get("s3://b/k"), Some(Some(3)));
+        // A missing object is an answer too.
+        assert_eq!(answers.get("s3://b/gone"), Some(None));
+        assert_eq!(answers.get("s3://b/other"), None);
     }
 
     #[test]

@@ -12,12 +12,13 @@
 use std::collections::{HashMap, HashSet, VecDeque};
 use std::path::Path;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, OnceLock};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use zarrs::storage::byte_range::{ByteRange, ByteRangeIterator};
 use zarrs::storage::{Bytes, MaybeBytesIterator, ReadableStorageTraits, StorageError, StoreKey};
 
 use super::client::{client, Object, Range};
+use super::Remembered;
 use crate::error::{Error, Result};
 
 /// Bytes of chunks fetched ahead and not yet read, kept at most.
@@ -160,27 +161,20 @@ impl RemoteStore {
     }
 
     /// The metadata document at `key` (`None`: the server has none), from the server or as it
-    /// answered within the last `ANSWER_VALID`.
+    /// answered within the last few seconds ([`Remembered`]).
     fn metadata(&self, key: &StoreKey) -> std::result::Result<Option<Vec<u8>>, StorageError> {
-        type Documents = Mutex<HashMap<String, (Instant, Option<Vec<u8>>)>>;
-        static DOCUMENTS: OnceLock<Documents> = OnceLock::new();
-        let documents = DOCUMENTS.get_or_init(Default::default);
+        static DOCUMENTS: Remembered<Option<Vec<u8>>> = Remembered::new();
         let name = format!("{}/{}", self.name, key.as_str());
-        if let Some((at, doc)) = documents.lock().ok().and_then(|d| d.get(&name).cloned()) {
-            if at.elapsed() < super::ANSWER_VALID {
-                if doc.is_none() {
-                    self.note_missing(key);
-                }
-                return Ok(doc);
+        let doc = match DOCUMENTS.get(&name) {
+            Some(doc) => doc,
+            None => {
+                let doc = client().get(&self.root, Some(key.as_str()), Range::All)?;
+                DOCUMENTS.put(&name, doc.clone());
+                doc
             }
-        }
-        let doc = client().get(&self.root, Some(key.as_str()), Range::All)?;
+        };
         if doc.is_none() {
             self.note_missing(key);
-        }
-        if let Ok(mut d) = documents.lock() {
-            d.retain(|_, (at, _)| at.elapsed() < super::ANSWER_VALID);
-            d.insert(name, (Instant::now(), doc.clone()));
         }
         Ok(doc)
     }
