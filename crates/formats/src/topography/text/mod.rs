@@ -224,6 +224,18 @@ pub(crate) fn read_str(
                          give a height unit",
                     ));
                 }
+                // x and y stated in something other than a length (`[px]`): their spacing
+                // says nothing in metres, so the pixel size must be given.
+                if (ux.is_none() || uy.is_none()) && options.pixel_size_m.is_none() {
+                    return Err(bad(
+                        path,
+                        format!(
+                            "the x and y columns are not in a length unit ([…] under the \
+                             titles); give the pixel size with {}",
+                            Param::PixelSize
+                        ),
+                    ));
+                }
                 (ux.unwrap_or(unit), uy.unwrap_or(unit), uz.unwrap_or(unit))
             }
             _ => (unit, unit, unit),
@@ -330,10 +342,16 @@ mod tests {
         let m = read(&flagless, &given).unwrap();
         assert!((m.dx_m - 1e-5).abs() < 1e-15);
         assert!((m.heights[(2, 3)] - 5e-9).abs() < 1e-21);
-        // x and y in pixels: z keeps its stated unit.
+        // x and y in pixels: refused without a pixel size (they were read as metres); with
+        // one, z keeps its stated unit.
         let pixels = text.replace("[mm];[mm]", "[px];[px]");
-        let m = read(&pixels, &ReadOptions::default()).unwrap();
+        let err = read(&pixels, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("not in a length unit"), "{err}");
+        let m = read(&pixels, &sized()).unwrap();
         assert!((m.heights[(2, 3)] - 5e-6).abs() < 1e-18);
+        assert!((m.dx_m - 1e-8).abs() < 1e-20);
     }
 
     fn sized() -> ReadOptions {
