@@ -134,6 +134,7 @@ struct RankTally {
     covered: [usize; 3],
     images: [usize; 3],
     pixel_err_lightest: Vec<f64>,
+    corrected_err: [Vec<f64>; 3],
 }
 
 impl RankTally {
@@ -142,6 +143,7 @@ impl RankTally {
             covered: [0; 3],
             images: [0; 3],
             pixel_err_lightest: Vec::new(),
+            corrected_err: Default::default(),
         }
     }
 
@@ -193,6 +195,7 @@ impl RankTally {
             self.images[rank] += 1;
             self.covered[rank] += usize::from(c.lo_px <= truth && truth <= c.hi_px);
             assert!(c.lo_px <= c.area_px && c.area_px <= c.hi_px);
+            self.corrected_err[rank].push(c.area_px / truth - 1.0);
             if rank == 0 {
                 let pixels = analysis.images[k].measurement.contact_pixels as f64;
                 self.pixel_err_lightest.push(pixels / truth - 1.0);
@@ -208,6 +211,20 @@ impl RankTally {
                 "{what}, rank {r}: {} of {} intervals hold the truth",
                 self.covered[r],
                 self.images[r]
+            );
+        }
+    }
+
+    /// The corrected areas' median relative error is within `bound` at each rank.
+    fn assert_estimate(&self, what: &str, bound: f64) {
+        for (r, errors) in self.corrected_err.iter().enumerate() {
+            let mut e = errors.clone();
+            e.sort_by(f64::total_cmp);
+            let median = e[e.len() / 2];
+            eprintln!("{what}, rank {r}: median error of the corrected area {median:+.4}");
+            assert!(
+                median.abs() <= bound,
+                "{what}, rank {r}: median error of the corrected area {median:+.3}"
             );
         }
     }
@@ -253,6 +270,7 @@ fn corrected_areas_hold_the_truth_where_the_psf_biases_the_pixel_count() {
             );
         }
         tally.assert_coverage(&format!("scale {scale}"));
+        tally.assert_estimate(&format!("scale {scale}"), 0.08);
         if scale < 1.0 {
             // What the correction is for: the count is biased below the PSF.
             let mean = tally.lightest_pixel_bias();
@@ -294,6 +312,7 @@ fn corrected_areas_hold_the_truth_of_solved_rough_contacts() {
         }
     }
     tally.assert_coverage("solved sub-PSF ramps");
+    tally.assert_estimate("solved sub-PSF ramps", 0.08);
 }
 
 /// A smaller version of `cargo bench --bench k_intervals`: the reduced demo's synthetic
