@@ -195,6 +195,17 @@ fn fetch(object: &Object, len: u64, index: u64) -> io::Result<Arc<Vec<u8>>> {
     Ok(Arc::new(bytes))
 }
 
+/// Fetch block `index` of `object` (named `name`, `len` bytes) and hand it to the cache
+/// ([`arrived`]). A fetch that panics ends as an error, so that no reader waits for a block that
+/// will never come.
+fn fetch_and_keep(name: &str, object: &Object, len: u64, index: u64) -> io::Result<Arc<Vec<u8>>> {
+    let fetched =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| fetch(object, len, index)))
+            .unwrap_or_else(|_| Err(io::Error::other("fetching the block failed")));
+    arrived((name.to_string(), index), &fetched);
+    fetched
+}
+
 /// Keep what fetching `key` gave (nothing after a failure), end its fetching and wake the
 /// readers waiting for it.
 fn arrived(key: (String, u64), fetched: &io::Result<Arc<Vec<u8>>>) {
@@ -224,8 +235,7 @@ impl RemoteFile {
             let spawned = std::thread::Builder::new()
                 .name("contactscope-read-ahead".into())
                 .spawn(move || {
-                    let fetched = fetch(&object.1, len, i);
-                    arrived((object.0.clone(), i), &fetched);
+                    let _ = fetch_and_keep(&object.0, &object.1, len, i);
                 });
             if spawned.is_err() {
                 // No thread to be had: the block is fetched when it is read.
@@ -250,9 +260,7 @@ impl RemoteFile {
         }
         c.fetching.insert(key.clone());
         drop(c);
-        let fetched = fetch(&self.object.1, self.len, index);
-        arrived(key, &fetched);
-        fetched
+        fetch_and_keep(name, &self.object.1, self.len, index)
     }
 }
 

@@ -121,10 +121,13 @@ impl RemoteStore {
                 .spawn({
                     let name = name.clone();
                     move || {
-                        let got = client().get(&store.root, Some(key.as_str()), Range::All);
+                        // A fetch that panics ends like one that failed: no reader waits on.
+                        let got = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                            client().get(&store.root, Some(key.as_str()), Range::All)
+                        }));
                         let mut a = locked();
                         a.fetching.remove(&name);
-                        if let Ok(Some(bytes)) = got {
+                        if let Ok(Ok(Some(bytes))) = got {
                             a.insert(name, Arc::new(bytes));
                         }
                         drop(a);
