@@ -224,7 +224,7 @@ fn row(cell: &str, t: &Tally) -> String {
     for r in 0..3 {
         line += &format!(" {:.1} |", pct(&t.widths[r]));
     }
-    for r in [0, 2] {
+    for r in 0..3 {
         line += &format!(
             " {:+.1} / {:+.1} |",
             pct(&t.pixel_err[r]),
@@ -244,10 +244,10 @@ fn row(cell: &str, t: &Tally) -> String {
 fn header(title: &str) {
     println!("\n### {title}\n");
     println!(
-        "| PSF nm, px nm, photons | series | cover {} % | cover {} % | cover {} % | width {} % | width {} % | width {} % | err px / corr {} % | err px / corr {} % | β cover % | β width | β̂ out | β_px out |",
-        RANKS[0], RANKS[1], RANKS[2], RANKS[0], RANKS[1], RANKS[2], RANKS[0], RANKS[2]
+        "| PSF nm, px nm, photons | series | cover {} % | cover {} % | cover {} % | width {} % | width {} % | width {} % | err px / corr {} % | err px / corr {} % | err px / corr {} % | β cover % | β width | β̂ out | β_px out |",
+        RANKS[0], RANKS[1], RANKS[2], RANKS[0], RANKS[1], RANKS[2], RANKS[0], RANKS[1], RANKS[2]
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
 }
 
 /// Score every cell of one scale; `make(psf, px, photons, seed)` gives a series.
