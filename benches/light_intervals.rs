@@ -21,7 +21,9 @@
 //! relative width, the median error of the pixel count and of the corrected area; then the share
 //! of exponent intervals holding the true areas' exponent, their median width, and how many
 //! series have the corrected exponent (the estimate) and the pixel count's exponent outside the
-//! interval.
+//! interval; last, the range over the series of the reference interior's top reading over its
+//! mean (how flat the interior that sets the signal reads: a glow of sub-PSF patches follows the
+//! pressure; `docs/validation.md` B25, "A glow instead of an interior").
 //!
 //! ```sh
 //! cargo bench --bench light_intervals                    # 20 series per cell, both generators
@@ -85,6 +87,8 @@ struct Tally {
     bounds_covered: usize,
     /// Series with corrected areas but without any interior.
     bounds_series: usize,
+    /// Per series with a reading: its reference interior's top reading over its mean.
+    glow: Vec<f64>,
 }
 
 impl Tally {
@@ -105,6 +109,7 @@ impl Tally {
         self.bounds_images += other.bounds_images;
         self.bounds_covered += other.bounds_covered;
         self.bounds_series += other.bounds_series;
+        self.glow.extend(other.glow);
     }
 
     fn coverage(&self, r: usize) -> f64 {
@@ -182,6 +187,9 @@ fn score(s: &Series, sigma_px: f64, pixel_m: f64, label: &str) -> Tally {
             None => t.widths[r].push(f64::INFINITY),
         }
     }
+    if let Some(r) = correction.model.reference_interior() {
+        t.glow.push(r.top_over_mean);
+    }
     let read: Vec<_> = correction.areas.iter().flatten().collect();
     t.bounds_series =
         usize::from(!read.is_empty() && read.iter().all(|c| c.source == SignalSource::Bounds));
@@ -238,16 +246,19 @@ fn row(cell: &str, t: &Tally) -> String {
         t.estimate_outside,
         t.pixel_beta_outside
     );
+    let lowest = t.glow.iter().copied().fold(f64::INFINITY, f64::min);
+    let highest = t.glow.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    line += &format!(" {lowest:.3}…{highest:.3} |");
     line
 }
 
 fn header(title: &str) {
     println!("\n### {title}\n");
     println!(
-        "| PSF nm, px nm, photons | series | cover {} % | cover {} % | cover {} % | width {} % | width {} % | width {} % | err px / corr {} % | err px / corr {} % | err px / corr {} % | β cover % | β width | β̂ out | β_px out |",
+        "| PSF nm, px nm, photons | series | cover {} % | cover {} % | cover {} % | width {} % | width {} % | width {} % | err px / corr {} % | err px / corr {} % | err px / corr {} % | β cover % | β width | β̂ out | β_px out | reference top/mean |",
         RANKS[0], RANKS[1], RANKS[2], RANKS[0], RANKS[1], RANKS[2], RANKS[0], RANKS[1], RANKS[2]
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
 }
 
 /// Score every cell of one scale; `make(psf, px, photons, seed)` gives a series.

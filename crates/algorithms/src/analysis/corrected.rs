@@ -52,6 +52,16 @@
 //! image cannot show; it is not evidence of a higher signal. The drawn areas' median, which
 //! spreads it evenly, read the true areas up to 26 % low where it is wide (median errors per
 //! cell and load rank on both generators of `docs/validation.md` B25); the readings, −6…+6 %.
+//!
+//! **A glow instead of an interior** (not carried, not warned of). A cloud of patches below the
+//! PSF at every load blurs into a glow as bright as its local fill fraction; its deep tiles
+//! pass for an interior and every area of the series comes out too large (the `cloud` stress
+//! case of `docs/validation.md` B25: about twice). A contact in full contact reads flat over its
+//! interior, a glow follows the pressure, so the reference interior's top reading over its mean
+//! ([`SeriesLight::reference_interior`]) was tried as a warning: 1.04–1.42 on the cloud, but up to
+//! 1.12 on the paper's own porous contacts at 500 photons: a threshold would sit on the
+//! paper's highest with no margin, and no warning is given (B25, "A glow instead of an
+//! interior"). The rise of the readings with load separates them no better.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -158,6 +168,15 @@ pub struct CorrectedArea {
     pub source: SignalSource,
 }
 
+/// The interior that sets a series' signal ([`SeriesLight::reference_interior`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReferenceInterior {
+    /// Index of its image in the series.
+    pub image: usize,
+    /// Its top reading over its mean (1 for a flat interior).
+    pub top_over_mean: f64,
+}
+
 /// A reading of the signal: ln of its range's lower end, the range's width in ln, and the
 /// standard error of ln.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -176,6 +195,8 @@ pub struct SeriesLight {
     /// Per image: M and its standard deviation, the bounds on ln s, and the source.
     images: Vec<Option<ImagePlan>>,
     readings: Vec<Option<Reading>>,
+    /// The image whose interior sets the signal ([`SeriesLight::reference_interior`]).
+    reference: Option<usize>,
     /// The largest γ the readings allow (module docs).
     gamma_up: f64,
     /// The detector's gain estimated from the plateaus (variance per grey level of signal).
@@ -298,6 +319,19 @@ impl SeriesLight {
         self.assumptions
     }
 
+    /// The interior that sets the series' signal and how flat it reads (module docs, "A glow
+    /// instead of an interior", a diagnostic): the reference image (the heaviest load with a reading; without
+    /// forces, the image with the most light among those with one) and its top reading over its
+    /// mean. `None` without any reading.
+    pub fn reference_interior(&self) -> Option<ReferenceInterior> {
+        let image = self.reference?;
+        let r = self.readings[image]?;
+        Some(ReferenceInterior {
+            image,
+            top_over_mean: (r.ln_top - r.ln_low).exp(),
+        })
+    }
+
     /// The model of a series (module docs); `sigma_px`: the PSF's standard deviation in pixels;
     /// `hole_px`: [`Assumptions::hole_area_um2`] in pixels.
     pub fn new(
@@ -390,10 +424,20 @@ impl SeriesLight {
                 })
             })
             .collect();
+        // Without forces, the image with the most light stands for the heaviest load.
+        let reference = reference.or_else(|| {
+            (0..images.len())
+                .filter(|&j| readings[j].is_some())
+                .max_by(|&a, &b| {
+                    let light = |k: usize| images[k].budget.map_or(0.0, |b| b.excess);
+                    light(a).total_cmp(&light(b))
+                })
+        });
         SeriesLight {
             assumptions,
             images: plans,
             readings,
+            reference,
             gamma_up,
             gain,
         }
@@ -640,6 +684,57 @@ mod tests {
                 "median {median:.1} px, truth {truth:.1}"
             );
         }
+    }
+
+    /// The reference interior is the heaviest load's with a reading; without forces, the image
+    /// with the most light. Its top over mean is the top reading (the 90th percentile less the
+    /// noise's share) over the plateau's mean.
+    #[test]
+    fn the_reference_interior_is_the_heaviest_reading() {
+        let image = |force: Option<f64>, light: f64, q90: f64| ImageLight {
+            force_n: force,
+            budget: Some(LightBudget {
+                excess: light,
+                region_pixels: 4000,
+                background_variance: 25.0,
+                fit_variance: 0.0,
+                background_level: 400.0,
+                plateau: Some(super::super::light::Plateau {
+                    level: 1000.0,
+                    tiles: 100,
+                    pixels: 1600,
+                    white_variance: 16.0,
+                    texture_variance: 0.0,
+                    tile_q90: q90,
+                }),
+                faint_tiles: 0,
+                peak: q90,
+            }),
+            ceiling: None,
+        };
+        // A tile's noise: 1 grey level; the top reading is q90 − 1.2816.
+        let with_forces = [
+            image(Some(0.01), 3e6, 1100.0),
+            image(Some(0.04), 1e6, 1051.2816),
+            image(None, 9e6, 1300.0),
+        ];
+        let r = SeriesLight::new(&with_forces, 2.0, 1.0, Assumptions::default())
+            .reference_interior()
+            .unwrap();
+        assert_eq!(r.image, 1);
+        assert!((r.top_over_mean - 1.05).abs() < 1e-9, "{r:?}");
+        let without: Vec<ImageLight> = with_forces
+            .iter()
+            .map(|i| ImageLight {
+                force_n: None,
+                ..*i
+            })
+            .collect();
+        let r = SeriesLight::new(&without, 2.0, 1.0, Assumptions::default())
+            .reference_interior()
+            .unwrap();
+        assert_eq!(r.image, 2);
+        assert!((r.top_over_mean - (1300.0 - 1.2816) / 1000.0).abs() < 1e-9);
     }
 
     /// The hidden porosity's model against a porous interior made on purpose: holes of one

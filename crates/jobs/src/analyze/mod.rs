@@ -240,12 +240,13 @@ impl AreaIntervalFacts {
                 (true, true) => {
                     "the forces' calibration; a contact signal that varies over a contact by \
                      more than the illumination's 1 %; holes in a contact's interior finer than \
-                     hole_area_um2"
+                     hole_area_um2; patches below the PSF at every load"
                 }
                 (true, false) => {
                     "the pixel size's calibration; the forces' calibration; a contact signal \
                      that varies over a contact by more than the illumination's 1 %; holes in a \
-                     contact's interior finer than hole_area_um2"
+                     contact's interior finer than hole_area_um2; patches below the PSF at \
+                     every load"
                 }
                 (false, true) => {
                     "the forces' calibration; what the PSF does to patches near its size \
