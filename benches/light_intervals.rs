@@ -88,7 +88,7 @@ struct Tally {
     /// Series with corrected areas but without any interior.
     bounds_series: usize,
     /// Per series with a reading: its reference interior's top reading over its mean.
-    glow: Vec<f64>,
+    top_over_mean: Vec<f64>,
 }
 
 impl Tally {
@@ -109,7 +109,7 @@ impl Tally {
         self.bounds_images += other.bounds_images;
         self.bounds_covered += other.bounds_covered;
         self.bounds_series += other.bounds_series;
-        self.glow.extend(other.glow);
+        self.top_over_mean.extend(other.top_over_mean);
     }
 
     fn coverage(&self, r: usize) -> f64 {
@@ -188,7 +188,7 @@ fn score(s: &Series, sigma_px: f64, pixel_m: f64, label: &str) -> Tally {
         }
     }
     if let Some(r) = correction.model.reference_interior() {
-        t.glow.push(r.top_over_mean);
+        t.top_over_mean.push(r.top_over_mean);
     }
     let read: Vec<_> = correction.areas.iter().flatten().collect();
     t.bounds_series =
@@ -246,8 +246,16 @@ fn row(cell: &str, t: &Tally) -> String {
         t.estimate_outside,
         t.pixel_beta_outside
     );
-    let lowest = t.glow.iter().copied().fold(f64::INFINITY, f64::min);
-    let highest = t.glow.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let lowest = t
+        .top_over_mean
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let highest = t
+        .top_over_mean
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
     line += &format!(" {lowest:.3}…{highest:.3} |");
     line
 }

@@ -58,10 +58,11 @@
 //! pass for an interior and every area of the series comes out too large (the `cloud` stress
 //! case of `docs/validation.md` B25: about twice). A contact in full contact reads flat over its
 //! interior, a glow follows the pressure, so the reference interior's top reading over its mean
-//! ([`SeriesLight::reference_interior`]) was tried as a warning: 1.04–1.42 on the cloud, but up to
-//! 1.12 on the paper's own porous contacts at 500 photons: a threshold would sit on the
-//! paper's highest with no margin, and no warning is given (B25, "A glow instead of an
-//! interior"). The rise of the readings with load separates them no better.
+//! ([`SeriesLight::reference_interior`]) was tried as a warning: 1.00–1.42 on the cloud, up to
+//! 1.13 on the paper's own porous contacts at 500 photons, and no threshold warns of the
+//! clouds without warning of some of the paper's contacts, so no warning is given (B25, "A
+//! glow instead of an interior"). The rise of the readings with load separates them no
+//! better.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
