@@ -321,9 +321,9 @@ impl SeriesLight {
     }
 
     /// The interior that sets the series' signal and how flat it reads (module docs, "A glow
-    /// instead of an interior", a diagnostic): the reference image (the heaviest load with a reading; without
-    /// forces, the image with the most light among those with one) and its top reading over its
-    /// mean. `None` without any reading.
+    /// instead of an interior"; a diagnostic): the reference image (the heaviest load with a
+    /// reading; without forces, the image with the most light among those with one) and its top
+    /// reading over its mean. `None` without any reading.
     pub fn reference_interior(&self) -> Option<ReferenceInterior> {
         let image = self.reference?;
         let r = self.readings[image]?;
