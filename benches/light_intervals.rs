@@ -256,7 +256,11 @@ fn row(cell: &str, t: &Tally) -> String {
         .iter()
         .copied()
         .fold(f64::NEG_INFINITY, f64::max);
-    line += &format!(" {lowest:.3}…{highest:.3} |");
+    if t.top_over_mean.is_empty() {
+        line += " — |";
+    } else {
+        line += &format!(" {lowest:.3}…{highest:.3} |");
+    }
     line
 }
 

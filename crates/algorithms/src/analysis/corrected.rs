@@ -196,7 +196,9 @@ pub struct SeriesLight {
     /// Per image: M and its standard deviation, the bounds on ln s, and the source.
     images: Vec<Option<ImagePlan>>,
     readings: Vec<Option<Reading>>,
-    /// The image whose interior sets the signal ([`SeriesLight::reference_interior`]).
+    /// The image whose interior sets the signal (the heaviest load with a reading); without
+    /// forces, where each image takes its own, the one with the most light
+    /// ([`SeriesLight::reference_interior`]).
     reference: Option<usize>,
     /// The largest γ the readings allow (module docs).
     gamma_up: f64,
