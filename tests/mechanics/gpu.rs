@@ -23,6 +23,9 @@ fn gpu() -> Option<Gpu> {
 
 #[test]
 fn a_gpu_that_cannot_be_used_is_refused_in_one_line() {
+    // The message names the flag as the command line writes it (in a process of its own, as
+    // cargo-nextest runs each test, no other test has set that).
+    crate::common::cli_names();
     let Err(e) = DeviceChoice::Cuda.open() else {
         eprintln!("skipped: a GPU is usable here");
         return;
